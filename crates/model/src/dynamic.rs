@@ -1,0 +1,413 @@
+//! The dynamic model for one constant input: ω̇(ω), its roots and their
+//! stability, the relaxation time, the pusher force.
+//!
+//! With `r_i = p_i − p_c`, `s_i = r_i × n_φ`, `b_i = |r_i|²` and
+//! `u_i = v_c n_φ + ω D r_i` (so `|u_i|² = v_c² + 2 v_c ω s_i + ω² b_i`), the
+//! moment balance about the contact point is
+//!
+//! ```text
+//! I_P ω̇ = G(ω) = −Σ F_i (v_c s_i + ω b_i) / |u_i|  +  k ω,   k = m v_c (p_c · n_φ)
+//! G'(ω) = −Σ F_i v_c² (b_i − s_i²) / |u_i|³  +  k
+//! ```
+//!
+//! The friction part is non-increasing in ω (each term's derivative is
+//! `−F_i v_c² (b_i − s_i²)/|u_i|³ ≤ 0` by Cauchy–Schwarz), so for `k ≤ 0` there
+//! is exactly one root and it is stable. For `k > 0` the inertial term
+//! destabilises and roots come in odd numbers inside `|ω| ≤ M / k` with
+//! `M = Σ F_i |r_i|` the largest friction moment; all are found and reported.
+
+use crate::{cross, perp, Body, Push, Vec2};
+
+/// How a root of ω̇ behaves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RootKind {
+    /// ω̇ crosses zero downwards: nearby ω relax onto it with time constant τ.
+    Stable,
+    /// ω̇ crosses zero upwards: nearby ω move away from it.
+    Unstable,
+    /// ω̇ jumps through zero where a support stops sliding: the object pivots
+    /// on that support (friction there is set-valued). Stable if the jump is downward.
+    Pivot { support: usize, stable: bool },
+}
+
+/// A steady angular velocity of one segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SteadyState {
+    /// ω* (rad/s).
+    pub omega: f64,
+    pub kind: RootKind,
+    /// Relaxation time `τ = −I_P / G'(ω*)` (s) for a stable smooth root, else None.
+    pub tau: Option<f64>,
+}
+
+impl SteadyState {
+    /// Whether trajectories starting near it converge to it.
+    pub fn is_stable(&self) -> bool {
+        matches!(
+            self.kind,
+            RootKind::Stable | RootKind::Pivot { stable: true, .. }
+        )
+    }
+}
+
+/// Per-segment precomputation of the dynamic model (structure of arrays, so
+/// the friction loop vectorises).
+#[derive(Debug, Clone)]
+pub struct SegmentDynamics {
+    /// `F_i`, `s_i`, `b_i` for the supports with non-zero friction.
+    f: Vec<f64>,
+    s: Vec<f64>,
+    b: Vec<f64>,
+    /// Index into the body's supports of each entry above.
+    index: Vec<usize>,
+    /// Object-frame support positions relative to the contact point (for forces).
+    rx: Vec<f64>,
+    ry: Vec<f64>,
+    speed: f64,
+    dir: Vec2,
+    k: f64,
+    inertia_contact: f64,
+    mass: f64,
+    contact: Vec2,
+    max_moment: f64,
+}
+
+/// Relative speed below which a support counts as not sliding.
+pub const STICK_REL: f64 = 1e-9;
+
+impl SegmentDynamics {
+    /// Precomputes the segment for `push` (only its speed and direction matter).
+    pub fn new(body: &Body, push: &Push) -> Self {
+        let (sx, sy, fr) = body.arrays();
+        let pc = body.contact();
+        let dir = push.direction();
+        let n = body.len();
+        let mut me = Self {
+            f: Vec::with_capacity(n),
+            s: Vec::with_capacity(n),
+            b: Vec::with_capacity(n),
+            index: Vec::with_capacity(n),
+            rx: Vec::with_capacity(n),
+            ry: Vec::with_capacity(n),
+            speed: push.speed,
+            dir,
+            k: body.mass() * push.speed * pc.dot(&dir),
+            inertia_contact: body.inertia_contact(),
+            mass: body.mass(),
+            contact: pc,
+            max_moment: 0.0,
+        };
+        for i in 0..n {
+            if fr[i] == 0.0 {
+                continue;
+            }
+            let r = Vec2::new(sx[i] - pc.x, sy[i] - pc.y);
+            me.f.push(fr[i]);
+            me.s.push(cross(&r, &dir));
+            me.b.push(r.norm_squared());
+            me.index.push(i);
+            me.rx.push(r.x);
+            me.ry.push(r.y);
+            me.max_moment += fr[i] * r.norm();
+        }
+        me
+    }
+
+    /// Pusher speed (m/s).
+    pub fn speed(&self) -> f64 {
+        self.speed
+    }
+    /// `k = m v_c (p_c · n_φ)` (kg m²/s): the inertial term's slope.
+    pub fn inertial_slope(&self) -> f64 {
+        self.k
+    }
+    /// Largest possible friction moment about the contact, `Σ F_i |r_i|` (N m).
+    pub fn max_moment(&self) -> f64 {
+        self.max_moment
+    }
+    /// Inertia about the contact point (kg m²).
+    pub fn inertia_contact(&self) -> f64 {
+        self.inertia_contact
+    }
+
+    /// Friction moment about the contact point at `omega` for pusher speed `v`
+    /// (N m). A support with `|u_i| = 0` contributes zero (its friction is
+    /// set-valued there; see [`RootKind::Pivot`]).
+    #[inline]
+    pub fn friction_moment_at(&self, v: f64, omega: f64) -> f64 {
+        let (f, s, b) = (&self.f[..], &self.s[..], &self.b[..]);
+        let n = f.len().min(s.len()).min(b.len());
+        let v2 = v * v;
+        let mut acc = 0.0;
+        for i in 0..n {
+            let num = v * s[i] + omega * b[i];
+            let u2 = v2 + 2.0 * v * omega * s[i] + omega * omega * b[i];
+            // u2 can only vanish (or round below zero) where num also vanishes.
+            let inv = if u2 > 0.0 { u2.sqrt().recip() } else { 0.0 };
+            acc -= f[i] * num * inv;
+        }
+        acc
+    }
+
+    /// `G(ω) = I_P ω̇` (N m).
+    #[inline]
+    pub fn moment(&self, omega: f64) -> f64 {
+        self.friction_moment_at(self.speed, omega) + self.k * omega
+    }
+
+    /// ω̇ (rad/s²).
+    #[inline]
+    pub fn omega_dot(&self, omega: f64) -> f64 {
+        self.moment(omega) / self.inertia_contact
+    }
+
+    /// `G'(ω)` (N m s). Supports that are not sliding are skipped.
+    pub fn moment_slope(&self, omega: f64) -> f64 {
+        let v = self.speed;
+        let v2 = v * v;
+        let mut acc = self.k;
+        for i in 0..self.f.len() {
+            let u2 = v2 + 2.0 * v * omega * self.s[i] + omega * omega * self.b[i];
+            if u2 > 0.0 {
+                acc -= self.f[i] * v2 * (self.b[i] - self.s[i] * self.s[i]).max(0.0)
+                    / (u2 * u2.sqrt());
+            }
+        }
+        acc
+    }
+
+    /// Smallest support sliding speed at `omega` (m/s) and the body's index of
+    /// that support.
+    pub fn min_support_speed(&self, omega: f64) -> (f64, usize) {
+        let v = self.speed;
+        let mut best = (f64::INFINITY, 0);
+        for i in 0..self.f.len() {
+            let u2 = (v * v + 2.0 * v * omega * self.s[i] + omega * omega * self.b[i]).max(0.0);
+            if u2 < best.0 {
+                best = (u2, self.index[i]);
+            }
+        }
+        (best.0.sqrt(), best.1)
+    }
+
+    /// Speed scale for "has this support stopped?" tests (m/s).
+    fn speed_scale(&self, omega: f64) -> f64 {
+        let rmax = self.b.iter().fold(0.0f64, |a, &b| a.max(b)).sqrt();
+        self.speed + omega.abs() * rmax
+    }
+
+    /// Every steady state, sorted by ω, with its stability. Empty when ω̇ never
+    /// vanishes (possible only when all supports lie on the push line).
+    pub fn steady_states(&self) -> Vec<SteadyState> {
+        let g = |w: f64| self.moment(w);
+        let mut roots = Vec::new();
+        if self.speed == 0.0 {
+            // The contact point is held still: the object can only pivot about it,
+            // and friction stops it. ω* = 0, reached in finite time.
+            return vec![SteadyState {
+                omega: 0.0,
+                kind: RootKind::Stable,
+                tau: None,
+            }];
+        }
+        // Scale of ω: friction moment at most M, so |k ω*| ≤ M; with k = 0 the
+        // root sits where the friction moment changes sign, within a few v/r.
+        let rmin = self
+            .b
+            .iter()
+            .fold(f64::INFINITY, |a, &b| if b > 0.0 { a.min(b) } else { a })
+            .sqrt();
+        let bound = if self.k > 0.0 {
+            self.max_moment / self.k * (1.0 + 1e-9) + 1e-300
+        } else {
+            // Expand until the sign changes (G decreasing: G(+∞) < 0 < G(−∞)).
+            let mut w = self.speed / rmin.max(1e-300);
+            for _ in 0..200 {
+                if g(w) < 0.0 && g(-w) > 0.0 {
+                    break;
+                }
+                w *= 2.0;
+            }
+            w
+        };
+        if self.k <= 0.0 {
+            // Monotone: one sign change in [−bound, bound] at most.
+            let (lo, hi) = (-bound, bound);
+            if g(lo) > 0.0 && g(hi) < 0.0 {
+                roots.push(self.refine(lo, hi));
+            } else if g(lo) == 0.0 || g(hi) == 0.0 {
+                roots.push(if g(lo) == 0.0 { lo } else { hi });
+            }
+        } else {
+            // Several roots possible: scan a grid clustered where each support's
+            // term is steepest (ω = −v s_i / b_i, where |u_i| is smallest).
+            let mut grid: Vec<f64> = (0..=512)
+                .map(|j| -bound + 2.0 * bound * j as f64 / 512.0)
+                .collect();
+            for i in 0..self.f.len() {
+                if self.b[i] > 0.0 {
+                    let w0 = -self.speed * self.s[i] / self.b[i];
+                    let width = self.speed / self.b[i].sqrt();
+                    for d in [
+                        -1.0, -0.3, -0.1, -0.03, -0.01, 0.0, 0.01, 0.03, 0.1, 0.3, 1.0,
+                    ] {
+                        let w = w0 + d * width;
+                        if w.abs() < bound {
+                            grid.push(w);
+                        }
+                    }
+                }
+                if grid.len() > 20_000 {
+                    break;
+                }
+            }
+            grid.sort_by(f64::total_cmp);
+            grid.dedup();
+            let vals: Vec<f64> = grid.iter().map(|&w| g(w)).collect();
+            for j in 0..grid.len() - 1 {
+                let (a, b) = (vals[j], vals[j + 1]);
+                if a == 0.0 {
+                    roots.push(grid[j]);
+                } else if a * b < 0.0 {
+                    roots.push(self.refine(grid[j], grid[j + 1]));
+                }
+            }
+            if vals[grid.len() - 1] == 0.0 {
+                roots.push(grid[grid.len() - 1]);
+            }
+        }
+        roots.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (1.0 + b.abs()));
+        roots.into_iter().map(|w| self.classify(w)).collect()
+    }
+
+    fn classify(&self, w: f64) -> SteadyState {
+        let (umin, idx) = self.min_support_speed(w);
+        let scale = self.speed_scale(w);
+        let h = 1e-7 * scale.max(1e-300)
+            / self
+                .b
+                .iter()
+                .fold(0.0f64, |a, &b| a.max(b))
+                .sqrt()
+                .max(1e-300);
+        if umin <= 1e-6 * scale {
+            // A jump in G: decide stability from the sign on each side.
+            let stable = self.moment(w - h) > 0.0 && self.moment(w + h) < 0.0;
+            return SteadyState {
+                omega: w,
+                kind: RootKind::Pivot {
+                    support: idx,
+                    stable,
+                },
+                tau: None,
+            };
+        }
+        let slope = self.moment_slope(w);
+        if slope < 0.0 {
+            SteadyState {
+                omega: w,
+                kind: RootKind::Stable,
+                tau: Some(-self.inertia_contact / slope),
+            }
+        } else {
+            SteadyState {
+                omega: w,
+                kind: RootKind::Unstable,
+                tau: None,
+            }
+        }
+    }
+
+    /// Bracketed root refinement: Illinois-modified regula falsi, falling back to
+    /// bisection, to machine precision. `g(lo)` and `g(hi)` have opposite signs.
+    fn refine(&self, mut lo: f64, mut hi: f64) -> f64 {
+        let g = |w: f64| self.moment(w);
+        let (mut glo, mut ghi) = (g(lo), g(hi));
+        let mut side = 0i8;
+        for it in 0..200 {
+            let mut w = if it % 4 == 3 {
+                0.5 * (lo + hi)
+            } else {
+                (lo * ghi - hi * glo) / (ghi - glo)
+            };
+            if !(w > lo.min(hi) && w < lo.max(hi)) {
+                w = 0.5 * (lo + hi);
+            }
+            let gw = g(w);
+            if gw == 0.0 {
+                return w;
+            }
+            if gw.signum() == glo.signum() {
+                lo = w;
+                glo = gw;
+                if side == -1 {
+                    ghi *= 0.5;
+                }
+                side = -1;
+            } else {
+                hi = w;
+                ghi = gw;
+                if side == 1 {
+                    glo *= 0.5;
+                }
+                side = 1;
+            }
+            if (hi - lo).abs() <= 4.0 * f64::EPSILON * lo.abs().max(hi.abs()) + 1e-300 {
+                break;
+            }
+        }
+        if glo.abs() < ghi.abs() {
+            lo
+        } else {
+            hi
+        }
+    }
+
+    /// The steady state a transient starting at `omega` converges to: the
+    /// nearest root in the direction ω̇ drives it. None when ω runs away.
+    pub fn attractor(&self, roots: &[SteadyState], omega: f64) -> Option<SteadyState> {
+        let gw = self.moment(omega);
+        if let Some(r) = roots
+            .iter()
+            .find(|r| (r.omega - omega).abs() <= 1e-12 * (1.0 + omega.abs()))
+        {
+            return Some(*r);
+        }
+        if gw > 0.0 {
+            roots.iter().find(|r| r.omega > omega).copied()
+        } else if gw < 0.0 {
+            roots.iter().rev().find(|r| r.omega < omega).copied()
+        } else {
+            roots
+                .iter()
+                .min_by(|a, b| (a.omega - omega).abs().total_cmp(&(b.omega - omega).abs()))
+                .copied()
+        }
+    }
+
+    /// Sum of the support friction forces in the object frame (N).
+    pub fn friction_force(&self, omega: f64) -> Vec2 {
+        let v = self.speed;
+        let mut acc = Vec2::zeros();
+        for i in 0..self.f.len() {
+            let u = Vec2::new(
+                v * self.dir.x - omega * self.ry[i],
+                v * self.dir.y + omega * self.rx[i],
+            );
+            let n = u.norm();
+            if n > 0.0 {
+                acc -= u * (self.f[i] / n);
+            }
+        }
+        acc
+    }
+
+    /// Pusher force in the object frame (N), `f_c = m a_cm − Σ f_i`, with
+    /// `a_cm = v_c ω D n_φ − ω̇ D p_c + ω² p_c` (object frame).
+    pub fn pusher_force(&self, omega: f64) -> Vec2 {
+        let wd = self.omega_dot(omega);
+        let a = perp(&self.dir) * (self.speed * omega) - perp(&self.contact) * wd
+            + self.contact * (omega * omega);
+        a * self.mass - self.friction_force(omega)
+    }
+}

@@ -1,0 +1,26 @@
+use thiserror::Error;
+
+/// Why a model input was refused or a run could not be completed.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// A physical parameter is outside its domain (named, with its value).
+    #[error("{name} must be {requirement}, got {value}")]
+    Parameter {
+        name: &'static str,
+        requirement: &'static str,
+        value: f64,
+    },
+    /// The object has no support points.
+    #[error("the object needs at least one support point")]
+    NoSupports,
+    /// The push schedule is empty.
+    #[error("the push schedule is empty")]
+    EmptySchedule,
+    /// The integrator could not keep its error below the tolerance.
+    #[error("integration failed at t = {t} s: {reason}")]
+    Integration { t: f64, reason: String },
+    /// The state left the finite numbers (a blow-up).
+    #[error("the state became non-finite at t = {t} s (step {step})")]
+    NonFinite { t: f64, step: usize },
+}

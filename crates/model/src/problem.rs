@@ -1,0 +1,198 @@
+use crate::{Body, ModelError, Push, Trajectory, Vec2};
+
+/// What happens to ω when the pusher velocity jumps at a switch (or at the start
+/// of an object at rest).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Switching {
+    /// The contact impulse has no moment about the contact point, so the angular
+    /// momentum about it, `H = I_P ω − m v_c (p_c × n_φ)`, is the same just
+    /// before and just after the switch: ω jumps. What a rigid body does.
+    #[default]
+    Impulsive,
+    /// ω is continuous across the switch (the seed paper's reading).
+    Continuous,
+}
+
+/// The state of the object when the first push starts.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Initial {
+    /// Object angle θ (rad).
+    pub theta: f64,
+    /// Angular velocity ω (rad/s); ignored when `from_rest`.
+    pub omega: f64,
+    /// World position of the centre of mass (m).
+    pub position: Vec2,
+    /// The object is at rest when the pusher starts: the start is a switch from
+    /// zero velocity (with [`Switching::Impulsive`], ω jumps to the value
+    /// `H = 0` gives). When false, the object already moves with the pusher at
+    /// ω = `omega` (the seed paper's start).
+    pub from_rest: bool,
+}
+
+/// What the contact can transmit, for the assumption checks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactLimits {
+    /// Inward unit normals of the polygon edges that meet at the contact
+    /// (equal for a contact inside an edge). The pusher pushes when its force
+    /// lies within 90° of this normal cone (m, object frame; unit vectors).
+    pub normals: (Vec2, Vec2),
+    /// Pusher–object friction coefficient; None: contact slip is not checked.
+    pub mu: Option<f64>,
+    /// Largest force the pusher can apply (N); None: not checked.
+    pub max_force: Option<f64>,
+}
+
+impl Default for ContactLimits {
+    /// No limits and a cone covering every direction (nothing is flagged).
+    fn default() -> Self {
+        Self {
+            normals: (Vec2::zeros(), Vec2::zeros()),
+            mu: None,
+            max_force: None,
+        }
+    }
+}
+
+impl ContactLimits {
+    /// Angle (rad) between `force` and the cone of inward normals: 0 inside it.
+    /// With zero normals (unknown geometry) always 0.
+    pub fn cone_angle(&self, force: &Vec2) -> f64 {
+        let (mut a, mut b) = self.normals;
+        if a.norm_squared() == 0.0 || force.norm_squared() == 0.0 {
+            return 0.0;
+        }
+        if crate::cross(&a, &b) < 0.0 {
+            std::mem::swap(&mut a, &mut b);
+        }
+        let inside = crate::cross(&a, force) >= 0.0 && crate::cross(force, &b) >= 0.0;
+        if inside && crate::cross(&a, &b) > 0.0 {
+            return 0.0;
+        }
+        let ang = |n: &Vec2| crate::cross(n, force).atan2(n.dot(force)).abs();
+        ang(&a).min(ang(&b))
+    }
+}
+
+/// A complete pushing problem: the body, the input schedule, the start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    pub body: Body,
+    /// Contact geometry and limits for the assumption checks.
+    pub limits: ContactLimits,
+    pub pushes: Vec<Push>,
+    pub initial: Initial,
+    pub switching: Switching,
+    /// Spacing of the output samples (s), > 0.
+    pub sample_dt: f64,
+}
+
+impl Problem {
+    /// Checks the schedule and the sampling interval.
+    pub fn check(&self) -> Result<(), ModelError> {
+        if self.pushes.is_empty() {
+            return Err(ModelError::EmptySchedule);
+        }
+        for p in &self.pushes {
+            if !(p.duration.is_finite() && p.duration > 0.0) {
+                return Err(ModelError::Parameter {
+                    name: "push duration",
+                    requirement: "finite and > 0",
+                    value: p.duration,
+                });
+            }
+            if !(p.speed.is_finite() && p.speed >= 0.0) {
+                return Err(ModelError::Parameter {
+                    name: "push speed",
+                    requirement: "finite and >= 0",
+                    value: p.speed,
+                });
+            }
+            if !p.phi.is_finite() {
+                return Err(ModelError::Parameter {
+                    name: "push phi",
+                    requirement: "finite",
+                    value: p.phi,
+                });
+            }
+        }
+        if !(self.sample_dt.is_finite() && self.sample_dt > 0.0) {
+            return Err(ModelError::Parameter {
+                name: "sample_dt",
+                requirement: "finite and > 0",
+                value: self.sample_dt,
+            });
+        }
+        Ok(())
+    }
+
+    /// Start and end time (s) of every push.
+    pub fn segment_times(&self) -> Vec<(f64, f64)> {
+        let mut t = 0.0;
+        self.pushes
+            .iter()
+            .map(|p| {
+                let t0 = t;
+                t += p.duration;
+                (t0, t)
+            })
+            .collect()
+    }
+
+    /// Total duration (s).
+    pub fn duration(&self) -> f64 {
+        self.pushes.iter().map(|p| p.duration).sum()
+    }
+
+    /// The output sample times: `k · sample_dt` up to the end (inclusive, within
+    /// a relative 1e-9 of a step), plus the end time when it is not on the grid.
+    pub fn sample_times(&self) -> Vec<f64> {
+        let end = self.duration();
+        let n = (end / self.sample_dt * (1.0 + 1e-12) + 1e-9).floor() as usize;
+        let mut times: Vec<f64> = (0..=n).map(|k| k as f64 * self.sample_dt).collect();
+        if let Some(&last) = times.last() {
+            if end - last > 1e-9 * self.sample_dt {
+                times.push(end);
+            } else if let Some(l) = times.last_mut() {
+                *l = end;
+            }
+        }
+        times
+    }
+
+    /// Angular momentum about the contact point (kg m²/s) of a body turning at
+    /// `omega` while its contact point moves with `push` (`H = I_P ω − m v_c (p_c × n_φ)`).
+    pub fn contact_momentum(body: &Body, push: Option<&Push>, omega: f64) -> f64 {
+        let lin = push
+            .map(|p| crate::cross(&body.contact(), &p.velocity()))
+            .unwrap_or(0.0);
+        body.inertia_contact() * omega - body.mass() * lin
+    }
+
+    /// ω just after a switch from `before` (None: at rest) to `after`, given ω
+    /// just before.
+    pub fn omega_after_switch(
+        &self,
+        before: Option<&Push>,
+        after: &Push,
+        omega_before: f64,
+    ) -> f64 {
+        match self.switching {
+            Switching::Continuous => omega_before,
+            Switching::Impulsive => {
+                let h = Self::contact_momentum(&self.body, before, omega_before);
+                let lin = self.body.mass() * crate::cross(&self.body.contact(), &after.velocity());
+                (h + lin) / self.body.inertia_contact()
+            }
+        }
+    }
+}
+
+/// Anything that turns a [`Problem`] into a sampled [`Trajectory`]: the analytic
+/// models and every engine adapter answer this one trait, so comparing,
+/// benchmarking and sweeping treat them alike.
+pub trait Simulator {
+    /// The model name used in outputs (`"dynamic"`, `"rapier2d"`, …).
+    fn name(&self) -> String;
+    /// Runs the problem; the trajectory is sampled at [`Problem::sample_times`].
+    fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError>;
+}
