@@ -1,0 +1,113 @@
+//! The scenario file as written: one struct per TOML table, unknown keys refused.
+
+use serde::Deserialize;
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScenario {
+    pub name: String,
+    pub description: Option<String>,
+    pub object: RawObject,
+    pub supports: RawSupports,
+    pub contact: RawContact,
+    pub initial: Option<RawInitial>,
+    #[serde(default)]
+    pub push: Vec<RawPush>,
+    pub run: Option<RawRun>,
+    pub tolerance: Option<RawTolerance>,
+    pub engine: Option<RawEngine>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawObject {
+    /// kg
+    pub mass: f64,
+    /// m, object frame, counter-clockwise
+    pub polygon: Vec<[f64; 2]>,
+    /// m; default: the polygon's centroid
+    pub center_of_mass: Option<[f64; 2]>,
+    /// kg m² about the centre of mass; default: uniform density over the polygon
+    pub inertia_cm: Option<f64>,
+    /// kg m² about the contact point (the seed paper's Table I reading); an
+    /// alternative to `inertia_cm`
+    pub inertia_contact: Option<f64>,
+}
+
+/// One value for every support, or one per support.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum PerPoint {
+    One(f64),
+    Each(Vec<f64>),
+}
+
+/// `"equal"`, `"statics"`, `"uniform"` or explicit loads in newtons.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum RawLoad {
+    Named(String),
+    Explicit(Vec<f64>),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSupports {
+    pub points: Option<Vec<[f64; 2]>>,
+    /// m spacing of a uniform-pressure grid, instead of `points`
+    pub uniform_grid: Option<f64>,
+    pub mu: PerPoint,
+    pub load: Option<RawLoad>,
+    /// m/s², default 9.81
+    pub gravity: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawContact {
+    pub point: [f64; 2],
+    pub mu: Option<f64>,
+    pub max_force: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawInitial {
+    pub theta: Option<f64>,
+    pub omega: Option<f64>,
+    pub position: Option<[f64; 2]>,
+    pub from_rest: Option<bool>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPush {
+    pub duration: f64,
+    pub speed: f64,
+    pub phi: f64,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRun {
+    pub models: Option<Vec<String>>,
+    pub sample_dt: Option<f64>,
+    pub switching: Option<String>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTolerance {
+    pub omega_steady_rel: Option<f64>,
+    pub position_max: Option<f64>,
+    pub theta_max: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawEngine {
+    pub dt: Option<f64>,
+    pub solver_iterations: Option<usize>,
+    pub precision: Option<String>,
+    pub friction_velocity: Option<String>,
+}

@@ -1,0 +1,8 @@
+//! The pushval harness: runs a scenario's models, compares them with the
+//! dynamic model, and writes the contract outputs (`summary.json`,
+//! `trajectory.csv`). The command line in `main.rs` is a thin layer over this.
+
+pub mod harness;
+pub mod output;
+
+pub use harness::{run_scenario, Comparison, ModelRun, RunOptions, ScenarioReport, SegmentInfo};

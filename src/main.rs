@@ -1,0 +1,135 @@
+//! The pushval command line.
+//!
+//! Exit codes: 0 every gated tolerance holds, 1 a tolerance failed, 2 unusable
+//! input or an error (nothing is written then).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context};
+use clap::{Parser, Subcommand};
+use pushval::{output, run_scenario, RunOptions, ScenarioReport};
+use pushval_scenario::Scenario;
+
+#[derive(Parser)]
+#[command(name = "pushval", version, about = "Cross-validates an analytic model of single-point pushing against physics engines.\n\nWith no command: validate every scenario in scenarios/.")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run every model of the given scenarios, compare them with the dynamic
+    /// model and print a table; exit 1 when a gated tolerance fails.
+    Validate {
+        /// Scenario files (default: every *.toml in scenarios/).
+        files: Vec<PathBuf>,
+        /// Print the table as JSON instead.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
+    Run {
+        file: PathBuf,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// Every scenario file in the default folder: `./scenarios`, else the one
+/// beside this crate's manifest.
+fn default_scenarios() -> anyhow::Result<Vec<PathBuf>> {
+    let local = PathBuf::from("scenarios");
+    let dir = if local.is_dir() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        bail!("no scenario files in {}", dir.display());
+    }
+    Ok(files)
+}
+
+/// Loads every file first, so that unusable input stops the run before any work.
+fn load_all(files: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
+    files
+        .iter()
+        .map(|f| Scenario::from_path(f).map_err(anyhow::Error::from))
+        .collect()
+}
+
+fn validate(files: Vec<PathBuf>, as_json: bool) -> anyhow::Result<ExitCode> {
+    let files = if files.is_empty() { default_scenarios()? } else { files };
+    let scenarios = load_all(&files)?;
+    let opts = RunOptions::default();
+    let mut reports: Vec<ScenarioReport> = Vec::new();
+    for sc in &scenarios {
+        let r = run_scenario(sc, &opts).with_context(|| format!("{}: running the models", sc.path.display()))?;
+        reports.push(r);
+    }
+    if as_json {
+        let rows: Vec<serde_json::Value> = reports.iter().map(output::summary).collect();
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        print!("{}", output::table(&reports));
+    }
+    let failed: Vec<String> = reports
+        .iter()
+        .flat_map(|r| {
+            r.comparisons
+                .iter()
+                .filter(|c| c.pass == Some(false))
+                .map(move |c| format!("{} / {}: {}", r.scenario.name, c.model, c.failed.join("; ")))
+        })
+        .collect();
+    if failed.is_empty() {
+        if !as_json {
+            println!("\n{} scenarios: every gated tolerance holds", reports.len());
+        }
+        Ok(ExitCode::SUCCESS)
+    } else {
+        for f in &failed {
+            eprintln!("FAIL {f}");
+        }
+        Ok(ExitCode::from(1))
+    }
+}
+
+fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
+    let sc = Scenario::from_path(&file)?;
+    let report = run_scenario(&sc, &RunOptions::default())
+        .with_context(|| format!("{}: running the models", file.display()))?;
+    let summary = serde_json::to_string_pretty(&output::summary(&report))?;
+    let csv = output::trajectory_csv(&report);
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    output::write_atomic(&out.join("trajectory.csv"), csv.as_bytes())?;
+    output::write_atomic(&out.join("summary.json"), summary.as_bytes())?;
+    print!("{}", output::table(std::slice::from_ref(&report)));
+    println!("wrote {} and {}", out.join("summary.json").display(), out.join("trajectory.csv").display());
+    Ok(if report.pass() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => validate(Vec::new(), false),
+        Some(Command::Validate { files, json }) => validate(files, json),
+        Some(Command::Run { file, out }) => run(file, out),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

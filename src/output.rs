@@ -1,0 +1,272 @@
+//! Output formats: `summary.json`, `trajectory.csv`, the terminal table.
+//!
+//! # `summary.json`
+//! ```text
+//! { "scenario": NAME, "file": PATH,
+//!   "settings": {...},                       // what produced the numbers
+//!   "segments": [{ "index", "t_start", "t_end", "speed", "phi", "froude",
+//!                  "omega_kinematic", "omega_limit_surface", "omega_steady", "tau",
+//!                  "steady_states": [{"omega", "stability", "tau"}] }],
+//!   "models": { MODEL: { "position_max", "theta_max", "omega_steady_rel_max",
+//!                        "pass", "gated", "settings", "wall_time_s", ... } },
+//!   "assumptions": { "all_hold", "pulling", "contact_slip", "force_limit",
+//!                    "sticking", "pulling_impulse", "runaway", "max_force", ... } }
+//! ```
+//! SI units (m, rad, s, rad/s, N). Numbers that do not exist are `null`; no
+//! NaN or infinity is ever written.
+//!
+//! # `trajectory.csv`
+//! Header `model,t,x,y,theta,omega`; one row per model per sample time; x, y
+//! the centre of mass in the world frame (m), theta unwrapped (rad).
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::Context;
+use pushval_model::{RootKind, Violation};
+use serde_json::{json, Value};
+
+use crate::ScenarioReport;
+
+/// A finite number, or null.
+pub fn num(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+fn opt(v: Option<f64>) -> Value {
+    v.map_or(Value::Null, num)
+}
+
+fn violation(v: &Option<Violation>) -> Value {
+    match v {
+        None => Value::Null,
+        Some(v) => json!({
+            "first_t": num(v.first_t), "worst_t": num(v.worst_t), "worst": num(v.worst),
+            "segment": v.segment, "support": v.support,
+        }),
+    }
+}
+
+/// The `summary.json` document.
+pub fn summary(report: &ScenarioReport) -> Value {
+    let sc = &report.scenario;
+    let segments: Vec<Value> = report
+        .segments
+        .iter()
+        .map(|s| {
+            json!({
+                "index": s.index,
+                "t_start": num(s.t_start),
+                "t_end": num(s.t_end),
+                "speed": num(s.speed),
+                "phi": num(s.phi),
+                "froude": num(s.froude),
+                "omega_kinematic": opt(s.omega_kinematic),
+                "omega_limit_surface": num(s.omega_limit_surface),
+                "omega_steady": opt(s.omega_steady.map(|r| r.omega)),
+                "tau": opt(s.tau()),
+                "omega_start": num(s.omega_start),
+                "settles": s.settles(),
+                "steady_states": s.steady_states.iter().map(|r| json!({
+                    "omega": num(r.omega),
+                    "stability": match r.kind {
+                        RootKind::Stable => "stable".to_string(),
+                        RootKind::Unstable => "unstable".to_string(),
+                        RootKind::Pivot { support, stable } =>
+                            format!("pivot on support {support} ({})", if stable { "stable" } else { "unstable" }),
+                    },
+                    "tau": opt(r.tau),
+                })).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let mut models = serde_json::Map::new();
+    for c in &report.comparisons {
+        let run = report.runs.iter().find(|r| r.kind.name() == c.model);
+        models.insert(
+            c.model.clone(),
+            json!({
+                "position_max": num(c.position_max),
+                "theta_max": num(c.theta_max),
+                "omega_steady_rel_max": opt(c.omega_steady_rel_max),
+                "pass": c.pass,
+                "gated": c.pass.is_some(),
+                "failed": c.failed,
+                "error": c.error,
+                "settings": run.map_or(Value::Null, |r| r.settings.clone()),
+                "wall_time_s": run.map_or(Value::Null, |r| num(r.elapsed.as_secs_f64())),
+                "rhs_evals": run.map(|r| r.trajectory.stats.rhs_evals),
+                "steps": run.map(|r| r.trajectory.stats.steps),
+            }),
+        );
+    }
+    let a = &report.dynamic().trajectory.assumptions;
+    json!({
+        "scenario": sc.name,
+        "file": sc.path.display().to_string(),
+        "description": sc.description,
+        "settings": {
+            "switching": format!("{:?}", sc.switching).to_lowercase(),
+            "from_rest": sc.initial.from_rest,
+            "sample_dt": num(sc.sample_dt),
+            "inertia_cm": num(sc.inertia_cm),
+            "inertia_source": sc.inertia_source,
+            "load_rule": sc.load_rule,
+            "supports": sc.supports.len(),
+            "froude_length": num(sc.froude_length()),
+            "effective_mu": num(sc.effective_mu()),
+            "tolerance": {
+                "omega_steady_rel": num(sc.tolerance.omega_steady_rel),
+                "position_max": num(sc.tolerance.position_max),
+                "theta_max": num(sc.tolerance.theta_max),
+            },
+        },
+        "segments": segments,
+        "models": models,
+        "assumptions": {
+            "all_hold": a.all_hold(),
+            "pulling": violation(&a.pulling),
+            "contact_slip": violation(&a.contact_slip),
+            "force_limit": violation(&a.force_limit),
+            "sticking": violation(&a.sticking),
+            "pulling_impulse": violation(&a.pulling_impulse),
+            "runaway": violation(&a.runaway),
+            "max_force": num(a.max_force),
+            "max_cone_angle": num(a.max_cone_angle),
+            "min_support_speed": num(a.min_support_speed),
+        },
+    })
+}
+
+/// Short names of the assumption checks that failed, for the table.
+pub fn assumption_flags(report: &ScenarioReport) -> Vec<&'static str> {
+    let a = &report.dynamic().trajectory.assumptions;
+    let mut f = Vec::new();
+    if a.pulling.is_some() {
+        f.push("pulling");
+    }
+    if a.pulling_impulse.is_some() {
+        f.push("pulling-impulse");
+    }
+    if a.contact_slip.is_some() {
+        f.push("contact-slip");
+    }
+    if a.force_limit.is_some() {
+        f.push("force-limit");
+    }
+    if a.sticking.is_some() {
+        f.push("sticking");
+    }
+    if a.runaway.is_some() {
+        f.push("runaway");
+    }
+    f
+}
+
+/// The `trajectory.csv` text.
+pub fn trajectory_csv(report: &ScenarioReport) -> String {
+    let mut s = String::from("model,t,x,y,theta,omega\n");
+    for r in &report.runs {
+        for p in &r.trajectory.samples {
+            // Samples are finite: the models return an error on a blow-up.
+            s.push_str(&format!(
+                "{},{},{},{},{},{}\n",
+                r.kind.name(),
+                p.t,
+                p.x,
+                p.y,
+                p.theta,
+                p.omega
+            ));
+        }
+    }
+    s
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a
+/// rename, so a reader never sees a half-written file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
+    tmp.write_all(bytes)
+        .with_context(|| format!("writing {}", path.display()))?;
+    tmp.persist(path)
+        .with_context(|| format!("renaming into {}", path.display()))?;
+    Ok(())
+}
+
+fn fmt_e(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.2e}")
+    } else {
+        "-".into()
+    }
+}
+
+/// The human-readable table: one row per scenario and model.
+pub fn table(reports: &[ScenarioReport]) -> String {
+    let mut rows: Vec<[String; 7]> = vec![[
+        "scenario".into(),
+        "model".into(),
+        "pos_max[m]".into(),
+        "theta_max[rad]".into(),
+        "omega_ss_rel".into(),
+        "result".into(),
+        "notes".into(),
+    ]];
+    for r in reports {
+        let flags = assumption_flags(r);
+        for c in &r.comparisons {
+            let result = match (&c.error, c.pass) {
+                (Some(_), _) => "n/a",
+                (None, Some(true)) => "PASS",
+                (None, Some(false)) => "FAIL",
+                (None, None) if c.model == "dynamic" => "reference",
+                (None, None) => "info",
+            };
+            let mut notes = Vec::new();
+            if let Some(e) = &c.error {
+                notes.push(e.clone());
+            }
+            notes.extend(c.failed.iter().cloned());
+            if c.model == "dynamic" && !flags.is_empty() {
+                notes.push(format!("assumptions fail: {}", flags.join(", ")));
+            }
+            rows.push([
+                r.scenario.name.clone(),
+                c.model.clone(),
+                fmt_e(c.position_max),
+                fmt_e(c.theta_max),
+                c.omega_steady_rel_max.map_or("-".into(), fmt_e),
+                result.into(),
+                notes.join("; "),
+            ]);
+        }
+    }
+    let mut w = [0usize; 7];
+    for row in &rows {
+        for (i, c) in row.iter().enumerate() {
+            w[i] = w[i].max(c.chars().count());
+        }
+    }
+    let mut out = String::new();
+    for (k, row) in rows.iter().enumerate() {
+        let line: Vec<String> = row
+            .iter()
+            .enumerate()
+            .map(|(i, c)| format!("{c:<width$}", width = w[i]))
+            .collect();
+        out.push_str(line.join("  ").trim_end());
+        out.push('\n');
+        if k == 0 {
+            out.push_str(&"-".repeat(w.iter().sum::<usize>() + 12));
+            out.push('\n');
+        }
+    }
+    out
+}
