@@ -122,12 +122,18 @@ impl ScenarioReport {
 }
 
 /// The simulator for a model kind, or None for a model this build cannot run.
-fn simulator(kind: ModelKind, sc: &Scenario, opts: &RunOptions) -> Option<(Box<dyn Simulator>, serde_json::Value)> {
+fn simulator(
+    kind: ModelKind,
+    sc: &Scenario,
+    opts: &RunOptions,
+) -> Option<(Box<dyn Simulator>, serde_json::Value)> {
     let _ = sc;
     match kind {
         ModelKind::Dynamic => Some((
             Box::new(DynamicModel {
-                integrator: Integrator::Adaptive { tol: opts.model_tol },
+                integrator: Integrator::Adaptive {
+                    tol: opts.model_tol,
+                },
                 ..Default::default()
             }),
             serde_json::json!({"integrator": "dormand_prince_5_4", "tolerance": opts.model_tol, "skip_settled": true}),
@@ -153,7 +159,11 @@ pub fn tail_omega(tr: &Trajectory, t_start: f64, t_end: f64) -> Option<f64> {
 }
 
 /// The steady-state analysis of every segment, following ω across switches.
-pub fn analyse_segments(sc: &Scenario, problem: &Problem, dynamic: &Trajectory) -> Vec<SegmentInfo> {
+pub fn analyse_segments(
+    sc: &Scenario,
+    problem: &Problem,
+    dynamic: &Trajectory,
+) -> Vec<SegmentInfo> {
     problem
         .pushes
         .iter()
@@ -161,7 +171,11 @@ pub fn analyse_segments(sc: &Scenario, problem: &Problem, dynamic: &Trajectory) 
         .enumerate()
         .map(|(j, (push, (t0, t1)))| {
             let seg = SegmentDynamics::new(&problem.body, push);
-            let roots = if push.speed > 0.0 { seg.steady_states() } else { vec![] };
+            let roots = if push.speed > 0.0 {
+                seg.steady_states()
+            } else {
+                vec![]
+            };
             let omega_start = dynamic.segments.get(j).map_or(0.0, |s| s.omega_start);
             let omega_steady = if push.speed > 0.0 {
                 seg.attractor(&roots, omega_start)
@@ -169,7 +183,8 @@ pub fn analyse_segments(sc: &Scenario, problem: &Problem, dynamic: &Trajectory) 
                 None
             };
             let tail_deviation = omega_steady.and_then(|r| {
-                tail_omega(dynamic, t0, t1).map(|w| rel_err(w, r.omega, push.speed, sc.froude_length()))
+                tail_omega(dynamic, t0, t1)
+                    .map(|w| rel_err(w, r.omega, push.speed, sc.froude_length()))
             });
             SegmentInfo {
                 index: j,
@@ -219,7 +234,9 @@ pub fn compare(
         let ws = s.omega_steady.expect("settles implies a root").omega;
         let w = match run.kind {
             ModelKind::Dynamic => tr.segments.get(s.index).map(|r| r.omega_end),
-            ModelKind::Kinematic | ModelKind::LimitSurface => tr.segments.get(s.index).map(|r| r.omega_end),
+            ModelKind::Kinematic | ModelKind::LimitSurface => {
+                tr.segments.get(s.index).map(|r| r.omega_end)
+            }
             _ => tail_omega(tr, s.t_start, s.t_end),
         };
         if let Some(w) = w {
@@ -231,14 +248,23 @@ pub fn compare(
     let mut failed = Vec::new();
     if gated {
         if !(position_max <= tol.position_max) {
-            failed.push(format!("position_max {position_max:.3e} m > {:.3e} m", tol.position_max));
+            failed.push(format!(
+                "position_max {position_max:.3e} m > {:.3e} m",
+                tol.position_max
+            ));
         }
         if !(theta_max <= tol.theta_max) {
-            failed.push(format!("theta_max {theta_max:.3e} rad > {:.3e} rad", tol.theta_max));
+            failed.push(format!(
+                "theta_max {theta_max:.3e} rad > {:.3e} rad",
+                tol.theta_max
+            ));
         }
         if let Some(e) = omega_rel {
             if !(e <= tol.omega_steady_rel) {
-                failed.push(format!("omega_steady_rel_max {e:.3e} > {:.3e}", tol.omega_steady_rel));
+                failed.push(format!(
+                    "omega_steady_rel_max {e:.3e} > {:.3e}",
+                    tol.omega_steady_rel
+                ));
             }
         }
     }
@@ -260,7 +286,12 @@ pub fn compare(
 pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, ModelError> {
     let problem = sc.problem();
     let mut kinds: Vec<ModelKind> = vec![ModelKind::Dynamic];
-    kinds.extend(sc.models.iter().copied().filter(|k| *k != ModelKind::Dynamic));
+    kinds.extend(
+        sc.models
+            .iter()
+            .copied()
+            .filter(|k| *k != ModelKind::Dynamic),
+    );
     let mut runs = Vec::new();
     let mut missing = Vec::new();
     for kind in kinds {

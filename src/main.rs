@@ -12,7 +12,11 @@ use pushval::{output, run_scenario, RunOptions, ScenarioReport};
 use pushval_scenario::Scenario;
 
 #[derive(Parser)]
-#[command(name = "pushval", version, about = "Cross-validates an analytic model of single-point pushing against physics engines.\n\nWith no command: validate every scenario in scenarios/.")]
+#[command(
+    name = "pushval",
+    version,
+    about = "Cross-validates an analytic model of single-point pushing against physics engines.\n\nWith no command: validate every scenario in scenarios/."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -68,12 +72,17 @@ fn load_all(files: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
 }
 
 fn validate(files: Vec<PathBuf>, as_json: bool) -> anyhow::Result<ExitCode> {
-    let files = if files.is_empty() { default_scenarios()? } else { files };
+    let files = if files.is_empty() {
+        default_scenarios()?
+    } else {
+        files
+    };
     let scenarios = load_all(&files)?;
     let opts = RunOptions::default();
     let mut reports: Vec<ScenarioReport> = Vec::new();
     for sc in &scenarios {
-        let r = run_scenario(sc, &opts).with_context(|| format!("{}: running the models", sc.path.display()))?;
+        let r = run_scenario(sc, &opts)
+            .with_context(|| format!("{}: running the models", sc.path.display()))?;
         reports.push(r);
     }
     if as_json {
@@ -114,8 +123,16 @@ fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
     output::write_atomic(&out.join("trajectory.csv"), csv.as_bytes())?;
     output::write_atomic(&out.join("summary.json"), summary.as_bytes())?;
     print!("{}", output::table(std::slice::from_ref(&report)));
-    println!("wrote {} and {}", out.join("summary.json").display(), out.join("trajectory.csv").display());
-    Ok(if report.pass() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    println!(
+        "wrote {} and {}",
+        out.join("summary.json").display(),
+        out.join("trajectory.csv").display()
+    );
+    Ok(if report.pass() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 fn main() -> ExitCode {

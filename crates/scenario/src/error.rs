@@ -15,7 +15,11 @@ pub struct ScenarioError {
 }
 
 impl ScenarioError {
-    pub(crate) fn new(file: &std::path::Path, key: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn new(
+        file: &std::path::Path,
+        key: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
         Self {
             file: file.to_path_buf(),
             key: key.into(),

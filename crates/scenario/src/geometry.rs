@@ -130,12 +130,23 @@ pub(crate) fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
 pub(crate) fn clip_to_box(poly: &[Vec2], lo: Vec2, hi: Vec2) -> Vec<Vec2> {
     let mut out: Vec<Vec2> = poly.to_vec();
     // (axis, bound, keep >= bound?)
-    for (axis, bound, keep_ge) in [(0, lo.x, true), (0, hi.x, false), (1, lo.y, true), (1, hi.y, false)] {
+    for (axis, bound, keep_ge) in [
+        (0, lo.x, true),
+        (0, hi.x, false),
+        (1, lo.y, true),
+        (1, hi.y, false),
+    ] {
         if out.is_empty() {
             break;
         }
         let input = std::mem::take(&mut out);
-        let inside = |p: &Vec2| if keep_ge { p[axis] >= bound } else { p[axis] <= bound };
+        let inside = |p: &Vec2| {
+            if keep_ge {
+                p[axis] >= bound
+            } else {
+                p[axis] <= bound
+            }
+        };
         for k in 0..input.len() {
             let cur = input[k];
             let prev = input[(k + input.len() - 1) % input.len()];
@@ -201,7 +212,13 @@ mod tests {
         // A square offset from the origin and an irregular convex pentagon.
         for poly in [
             vec![v(1.0, 1.0), v(1.5, 1.0), v(1.5, 1.5), v(1.0, 1.5)],
-            vec![v(0.0, 0.0), v(0.4, -0.1), v(0.6, 0.3), v(0.3, 0.6), v(-0.1, 0.35)],
+            vec![
+                v(0.0, 0.0),
+                v(0.4, -0.1),
+                v(0.6, 0.3),
+                v(0.3, 0.6),
+                v(-0.1, 0.35),
+            ],
         ] {
             let ours = polygon_mass_properties(&poly);
             let pts: Vec<_> = poly
@@ -212,7 +229,11 @@ mod tests {
             assert_relative_eq!(ours.area, mp.mass(), max_relative = 1e-12);
             assert_relative_eq!(ours.centroid.x, mp.local_com.x, max_relative = 1e-12);
             assert_relative_eq!(ours.centroid.y, mp.local_com.y, max_relative = 1e-12);
-            assert_relative_eq!(ours.polar_moment, mp.principal_inertia(), max_relative = 1e-10);
+            assert_relative_eq!(
+                ours.polar_moment,
+                mp.principal_inertia(),
+                max_relative = 1e-10
+            );
         }
     }
 
@@ -227,7 +248,14 @@ mod tests {
 
     #[test]
     fn grid_weights_sum_to_area_and_centroid_of_a_concave_polygon() {
-        let l = vec![v(0.0, 0.0), v(0.3, 0.0), v(0.3, 0.1), v(0.1, 0.1), v(0.1, 0.4), v(0.0, 0.4)];
+        let l = vec![
+            v(0.0, 0.0),
+            v(0.3, 0.0),
+            v(0.3, 0.1),
+            v(0.1, 0.1),
+            v(0.1, 0.4),
+            v(0.0, 0.4),
+        ];
         let props = polygon_mass_properties(&l);
         let g = grid_supports(&l, 0.037);
         let a: f64 = g.iter().map(|(_, w)| w).sum();

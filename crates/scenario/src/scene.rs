@@ -143,7 +143,11 @@ fn finite_pos(file: &Path, key: &str, v: f64) -> Result<f64, ScenarioError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(ScenarioError::new(file, key, format!("must be a finite number > 0, got {v}")))
+        Err(ScenarioError::new(
+            file,
+            key,
+            format!("must be a finite number > 0, got {v}"),
+        ))
     }
 }
 
@@ -151,7 +155,11 @@ fn finite(file: &Path, key: &str, v: f64) -> Result<f64, ScenarioError> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(ScenarioError::new(file, key, format!("must be finite, got {v}")))
+        Err(ScenarioError::new(
+            file,
+            key,
+            format!("must be finite, got {v}"),
+        ))
     }
 }
 
@@ -159,7 +167,11 @@ fn point(file: &Path, key: &str, p: [f64; 2]) -> Result<Vec2, ScenarioError> {
     if p.iter().all(|c| c.is_finite()) {
         Ok(Vec2::new(p[0], p[1]))
     } else {
-        Err(ScenarioError::new(file, key, format!("must be finite, got [{}, {}]", p[0], p[1])))
+        Err(ScenarioError::new(
+            file,
+            key,
+            format!("must be finite, got [{}, {}]", p[0], p[1]),
+        ))
     }
 }
 
@@ -200,7 +212,10 @@ impl Scenario {
         if raw.object.polygon.len() < 3 {
             return Err(err(
                 "object.polygon",
-                format!("needs at least 3 vertices, got {}", raw.object.polygon.len()),
+                format!(
+                    "needs at least 3 vertices, got {}",
+                    raw.object.polygon.len()
+                ),
             ));
         }
         let polygon = raw
@@ -216,7 +231,10 @@ impl Scenario {
             .fold(0.0f64, f64::max);
         let props = polygon_mass_properties(&polygon);
         if !(props.area.abs() > 1e-12 * size * size) || size == 0.0 {
-            return Err(err("object.polygon", format!("is degenerate (area {:e} m²)", props.area)));
+            return Err(err(
+                "object.polygon",
+                format!("is degenerate (area {:e} m²)", props.area),
+            ));
         }
         if let Some((i, j)) = self_intersection(&polygon) {
             return Err(err(
@@ -283,7 +301,8 @@ impl Scenario {
             .transpose()?;
         // Inertia.
         let pc_cm = contact - center_of_mass;
-        let (inertia_cm, inertia_source) = match (raw.object.inertia_cm, raw.object.inertia_contact) {
+        let (inertia_cm, inertia_source) = match (raw.object.inertia_cm, raw.object.inertia_contact)
+        {
             (Some(_), Some(_)) => {
                 return Err(err(
                     "object.inertia_contact",
@@ -308,7 +327,8 @@ impl Scenario {
             (None, None) => {
                 let pp = if raw.object.center_of_mass.is_some() {
                     // Uniform density: inertia about the given centre of mass by the parallel-axis theorem.
-                    props.polar_moment + props.area * (props.centroid - center_of_mass).norm_squared()
+                    props.polar_moment
+                        + props.area * (props.centroid - center_of_mass).norm_squared()
                 } else {
                     props.polar_moment
                 };
@@ -316,7 +336,11 @@ impl Scenario {
             }
         };
         // Supports.
-        let gravity = finite_pos(file, "supports.gravity", raw.supports.gravity.unwrap_or(9.81))?;
+        let gravity = finite_pos(
+            file,
+            "supports.gravity",
+            raw.supports.gravity.unwrap_or(9.81),
+        )?;
         let weight = mass * gravity;
         let (positions, grid_weights): (Vec<Vec2>, Option<Vec<f64>>) =
             match (&raw.supports.points, raw.supports.uniform_grid) {
@@ -354,11 +378,16 @@ impl Scenario {
                     if cells > 2.0e6 {
                         return Err(err(
                             "supports.uniform_grid",
-                            format!("spacing {h} m gives about {cells:.0} supports; the limit is 2e6"),
+                            format!(
+                                "spacing {h} m gives about {cells:.0} supports; the limit is 2e6"
+                            ),
                         ));
                     }
                     let g = grid_supports(&polygon, h);
-                    (g.iter().map(|p| p.0).collect(), Some(g.iter().map(|p| p.1).collect()))
+                    (
+                        g.iter().map(|p| p.0).collect(),
+                        Some(g.iter().map(|p| p.1).collect()),
+                    )
                 }
             };
         let ns = positions.len();
@@ -395,7 +424,11 @@ impl Scenario {
                 ));
             }
         }
-        let default_load = if grid_weights.is_some() { "uniform" } else { "equal" };
+        let default_load = if grid_weights.is_some() {
+            "uniform"
+        } else {
+            "equal"
+        };
         let (loads, load_rule): (Vec<f64>, &'static str) =
             match raw.supports.load.clone().unwrap_or(RawLoad::Named(default_load.into())) {
                 RawLoad::Named(s) => match s.as_str() {
@@ -452,7 +485,10 @@ impl Scenario {
                 }
             };
         if loads.iter().zip(&mu).all(|(l, m)| l * m == 0.0) {
-            return Err(err("supports.load", "every support carries zero friction".into()));
+            return Err(err(
+                "supports.load",
+                "every support carries zero friction".into(),
+            ));
         }
         let supports: Vec<SupportLoad> = positions
             .iter()
@@ -466,7 +502,10 @@ impl Scenario {
             .collect();
         // Schedule.
         if raw.push.is_empty() {
-            return Err(err("push", "the schedule is empty: add at least one [[push]]".into()));
+            return Err(err(
+                "push",
+                "the schedule is empty: add at least one [[push]]".into(),
+            ));
         }
         let pushes = raw
             .push
@@ -476,10 +515,17 @@ impl Scenario {
                 let duration = finite_pos(file, &format!("push[{i}].duration"), p.duration)?;
                 let speed = finite(file, &format!("push[{i}].speed"), p.speed)?;
                 if speed < 0.0 {
-                    return Err(err(&format!("push[{i}].speed"), format!("must be >= 0, got {speed}")));
+                    return Err(err(
+                        &format!("push[{i}].speed"),
+                        format!("must be >= 0, got {speed}"),
+                    ));
                 }
                 let phi = finite(file, &format!("push[{i}].phi"), p.phi)?;
-                Ok(Push { duration, speed, phi })
+                Ok(Push {
+                    duration,
+                    speed,
+                    phi,
+                })
             })
             .collect::<Result<Vec<_>, _>>()?;
         // Initial state.
@@ -537,15 +583,35 @@ impl Scenario {
         let rt = raw.tolerance.unwrap_or_default();
         let d = Tolerance::default();
         let tolerance = Tolerance {
-            omega_steady_rel: finite_pos(file, "tolerance.omega_steady_rel", rt.omega_steady_rel.unwrap_or(d.omega_steady_rel))?,
-            position_max: finite_pos(file, "tolerance.position_max", rt.position_max.unwrap_or(d.position_max))?,
-            theta_max: finite_pos(file, "tolerance.theta_max", rt.theta_max.unwrap_or(d.theta_max))?,
+            omega_steady_rel: finite_pos(
+                file,
+                "tolerance.omega_steady_rel",
+                rt.omega_steady_rel.unwrap_or(d.omega_steady_rel),
+            )?,
+            position_max: finite_pos(
+                file,
+                "tolerance.position_max",
+                rt.position_max.unwrap_or(d.position_max),
+            )?,
+            theta_max: finite_pos(
+                file,
+                "tolerance.theta_max",
+                rt.theta_max.unwrap_or(d.theta_max),
+            )?,
         };
         let re = raw.engine.unwrap_or_default();
         let engine = EngineConfig {
-            dt: re.dt.map(|v| finite_pos(file, "engine.dt", v)).transpose()?,
+            dt: re
+                .dt
+                .map(|v| finite_pos(file, "engine.dt", v))
+                .transpose()?,
             solver_iterations: match re.solver_iterations {
-                Some(0) => return Err(err("engine.solver_iterations", "must be >= 1, got 0".into())),
+                Some(0) => {
+                    return Err(err(
+                        "engine.solver_iterations",
+                        "must be >= 1, got 0".into(),
+                    ))
+                }
                 v => v,
             },
             precision: match re.precision.as_deref() {
@@ -610,8 +676,13 @@ impl Scenario {
                 friction: s.mu * s.load,
             })
             .collect();
-        Body::new(self.mass, self.inertia_cm, self.contact - self.center_of_mass, &supports)
-            .expect("validated scenario gives a valid body")
+        Body::new(
+            self.mass,
+            self.inertia_cm,
+            self.contact - self.center_of_mass,
+            &supports,
+        )
+        .expect("validated scenario gives a valid body")
     }
 
     /// The problem the models run.
@@ -666,7 +737,9 @@ fn statics_loads(p: &[Vec2], cm: Vec2, weight: f64) -> Result<Vec<f64>, String> 
             let d = p[1] - p[0];
             let s = (cm - p[0]).dot(&d) / d.norm_squared();
             if (p[0] + d * s - cm).norm() > 1e-9 * d.norm() {
-                return Err("with 2 supports the centre of mass must lie on the line between them".into());
+                return Err(
+                    "with 2 supports the centre of mass must lie on the line between them".into(),
+                );
             }
             vec![weight * (1.0 - s), weight * s]
         }
