@@ -186,17 +186,37 @@ impl Scenario {
 
     /// Parses and validates scenario text; `file` names it in errors.
     pub fn from_toml(text: &str, file: &Path) -> Result<Self, ScenarioError> {
-        let raw: RawScenario = toml::from_str(text).map_err(|e| {
+        let line_of = |span: Option<std::ops::Range<usize>>| {
+            span.map(|s| {
+                let line = text[..s.start.min(text.len())].lines().count().max(1);
+                format!(" (line {line})")
+            })
+            .unwrap_or_default()
+        };
+        // Syntax first; then the structure, with serde_path_to_error naming
+        // the key (`object.mass`, `push[2].speed`) that failed.
+        let de = toml::Deserializer::parse(text).map_err(|e| {
             let msg = e.message().trim().to_string();
-            let at = e
-                .span()
-                .map(|s| {
-                    let line = text[..s.start.min(text.len())].lines().count().max(1);
-                    format!(" (line {line})")
-                })
-                .unwrap_or_default();
-            let key = key_of_toml_error(&msg, text, e.span());
-            ScenarioError::new(file, key, format!("{msg}{at}"))
+            let key = key_of_toml_error(text, e.span());
+            ScenarioError::new(file, key, format!("{msg}{}", line_of(e.span())))
+        })?;
+        let raw: RawScenario = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let msg = inner.message().trim().to_string();
+            let mut key = if path == "." { String::new() } else { path };
+            for quote in ["unknown field `", "missing field `"] {
+                if let Some(rest) = msg.strip_prefix(quote) {
+                    let name = rest.split('`').next().unwrap_or_default();
+                    if !key.ends_with(name) {
+                        key = if key.is_empty() { name.to_string() } else { format!("{key}.{name}") };
+                    }
+                }
+            }
+            if key.is_empty() {
+                key = "toml".into();
+            }
+            ScenarioError::new(file, key, format!("{msg}{}", line_of(inner.span())))
         })?;
         Self::from_raw(raw, file)
     }
@@ -229,17 +249,17 @@ impl Scenario {
             .iter()
             .flat_map(|p| polygon.iter().map(move |q| (p - q).norm()))
             .fold(0.0f64, f64::max);
+        if let Some((i, j)) = self_intersection(&polygon) {
+            return Err(err(
+                "object.polygon",
+                format!("is self-intersecting (edges {i} and {j} cross)"),
+            ));
+        }
         let props = polygon_mass_properties(&polygon);
         if !(props.area.abs() > 1e-12 * size * size) || size == 0.0 {
             return Err(err(
                 "object.polygon",
                 format!("is degenerate (area {:e} m²)", props.area),
-            ));
-        }
-        if let Some((i, j)) = self_intersection(&polygon) {
-            return Err(err(
-                "object.polygon",
-                format!("is self-intersecting (edges {i} and {j} cross)"),
             ));
         }
         if props.area < 0.0 {
@@ -772,36 +792,16 @@ fn statics_loads(p: &[Vec2], cm: Vec2, weight: f64) -> Result<Vec<f64>, String> 
     Ok(loads.into_iter().map(|l| l.max(0.0)).collect())
 }
 
-/// Best-effort dotted key for a TOML deserialisation error: the key on the
-/// line the error points at, prefixed by its table header.
-fn key_of_toml_error(msg: &str, text: &str, span: Option<std::ops::Range<usize>>) -> String {
-    if let Some(rest) = msg.strip_prefix("unknown field `") {
-        if let Some(k) = rest.split('`').next() {
-            let table = span
-                .as_ref()
-                .and_then(|s| header_before(text, s.start))
-                .map(|t| format!("{t}."))
-                .unwrap_or_default();
-            return format!("{table}{k}");
-        }
-    }
-    if let Some(rest) = msg.strip_prefix("missing field `") {
-        if let Some(k) = rest.split('`').next() {
-            let table = span
-                .as_ref()
-                .and_then(|s| header_before(text, s.start))
-                .map(|t| format!("{t}."))
-                .unwrap_or_default();
-            return format!("{table}{k}");
-        }
-    }
+/// Best-effort dotted key for a TOML syntax error: the key on the line the
+/// error points at, prefixed by its table header.
+fn key_of_toml_error(text: &str, span: Option<std::ops::Range<usize>>) -> String {
     let Some(span) = span else {
         return "toml".into();
     };
     let start = span.start.min(text.len());
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let line = text[line_start..].lines().next().unwrap_or("");
-    let table = header_before(text, start);
+    let table = header_before(text, line_start);
     match line.split_once('=') {
         Some((k, _)) if !line.trim_start().starts_with('[') => {
             let k = k.trim();

@@ -1,0 +1,9 @@
+//! pushval's integration tests, one module per topic. Physics tests run in
+//! the optimised test profile (see the README's test command).
+
+mod bad_input;
+mod cli;
+mod common;
+mod integrators;
+mod physics;
+mod scenarios;

@@ -1,0 +1,150 @@
+//! Every scenario file is its own test case.
+
+use std::path::PathBuf;
+
+use approx::assert_relative_eq;
+use pushval::{output, run_scenario, RunOptions};
+use pushval_model::{DynamicModel, Simulator};
+use rstest::rstest;
+
+use crate::common::*;
+
+/// Loads, runs every model, writes the contract outputs; they parse, carry the
+/// contract's fields, and hold no NaN.
+#[rstest]
+fn scenario_runs_and_writes_contract_outputs(#[files("scenarios/*.toml")] path: PathBuf) {
+    let sc = load(&path);
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let summary = output::summary(&report);
+    let text = serde_json::to_string(&summary).unwrap();
+    assert!(!text.contains("NaN") && !text.contains("inf"));
+    assert_eq!(summary["scenario"], sc.name);
+    let segs = summary["segments"].as_array().unwrap();
+    assert_eq!(segs.len(), sc.pushes.len());
+    for key in ["index", "t_start", "t_end", "speed", "phi", "froude", "omega_kinematic", "omega_steady", "tau"] {
+        assert!(segs[0].get(key).is_some(), "segments[0] lacks {key}");
+    }
+    for (name, m) in summary["models"].as_object().unwrap() {
+        for key in ["position_max", "theta_max", "omega_steady_rel_max", "pass"] {
+            assert!(m.get(key).is_some(), "models.{name} lacks {key}");
+        }
+    }
+    assert!(summary["assumptions"].is_object());
+    let csv = output::trajectory_csv(&report);
+    let mut lines = csv.lines();
+    assert_eq!(lines.next().unwrap(), "model,t,x,y,theta,omega");
+    let rows: Vec<&str> = lines.collect();
+    let n_samples = sc.problem().sample_times().len();
+    assert_eq!(rows.len(), n_samples * report.runs.len());
+    for r in rows {
+        let f: Vec<&str> = r.split(',').collect();
+        assert_eq!(f.len(), 6);
+        for v in &f[1..] {
+            assert!(v.parse::<f64>().unwrap().is_finite());
+        }
+    }
+}
+
+/// Every scenario: the dynamic model's ω at the end of each settled segment is
+/// its steady root, and a segment pushed through the centre has ω* = 0.
+#[rstest]
+fn scenario_segments_settle_on_their_roots(#[files("scenarios/*.toml")] path: PathBuf) {
+    let sc = load(&path);
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let dynamic = &report.dynamic().trajectory;
+    for s in report.segments.iter().filter(|s| s.settles()) {
+        let ws = s.omega_steady.unwrap().omega;
+        let we = dynamic.segments[s.index].omega_end;
+        assert!((we - ws).abs() <= 1e-6 * ws.abs().max(1e-3 * s.speed / sc.froude_length()), "segment {}: {we} vs {ws}", s.index);
+    }
+}
+
+/// Mirror symmetry over every scenario: reflect the file's geometry across the
+/// x-axis and negate φ and the initial angle: θ, ω and y change sign.
+#[rstest]
+fn scenario_mirror_symmetry(#[files("scenarios/*.toml")] path: PathBuf) {
+    let sc = load(&path);
+    let mut m = sc.clone();
+    let flip = |v: &mut pushval_model::Vec2| v.y = -v.y;
+    m.polygon.iter_mut().for_each(flip);
+    m.polygon.reverse();
+    m.supports.iter_mut().for_each(|s| s.position.y = -s.position.y);
+    flip(&mut m.contact);
+    flip(&mut m.center_of_mass);
+    flip(&mut m.contact_limits.normals.0);
+    flip(&mut m.contact_limits.normals.1);
+    m.pushes.iter_mut().for_each(|p| p.phi = -p.phi);
+    m.initial.theta = -m.initial.theta;
+    m.initial.omega = -m.initial.omega;
+    m.initial.position.y = -m.initial.position.y;
+    let model = DynamicModel::default();
+    let a = model.simulate(&sc.problem()).unwrap();
+    let b = model.simulate(&m.problem()).unwrap();
+    for (p, q) in a.samples.iter().zip(&b.samples) {
+        assert!((p.omega + q.omega).abs() < 1e-7 * (1.0 + p.omega.abs()), "{p:?} {q:?}");
+        assert!((p.theta + q.theta).abs() < 1e-7 && (p.x - q.x).abs() < 1e-7 && (p.y + q.y).abs() < 1e-7);
+    }
+}
+
+/// Mass independence over every scenario: scaling mass, loads and inertia by
+/// 7.3 leaves the trajectory unchanged.
+#[rstest]
+fn scenario_mass_independence(#[files("scenarios/*.toml")] path: PathBuf) {
+    let sc = load(&path);
+    let mut h = sc.clone();
+    h.mass *= 7.3;
+    h.inertia_cm *= 7.3;
+    h.supports.iter_mut().for_each(|s| s.load *= 7.3);
+    let model = DynamicModel::default();
+    let (dp, dt) = max_diff(&model.simulate(&sc.problem()).unwrap(), &model.simulate(&h.problem()).unwrap());
+    assert!(dp < 1e-9 && dt < 1e-9, "{dp} {dt}");
+}
+
+/// The 10 kg scenario file moves exactly like the 1 kg one.
+#[test]
+fn heavy_file_matches_paper_file() {
+    let a = load(&root().join("scenarios/paper-square-v1.0.toml"));
+    let b = load(&root().join("scenarios/heavy-square-v1.0.toml"));
+    assert_eq!(b.mass, 10.0 * a.mass);
+    let model = DynamicModel::default();
+    let (dp, dt) = max_diff(&model.simulate(&a.problem()).unwrap(), &model.simulate(&b.problem()).unwrap());
+    assert!(dp < 1e-9 && dt < 1e-9);
+}
+
+/// Statics loads balance force and moment about the centre of mass.
+#[test]
+fn statics_loads_balance() {
+    let sc = load(&root().join("scenarios/triangle-statics.toml"));
+    let w = sc.mass * sc.gravity;
+    let sum: f64 = sc.supports.iter().map(|s| s.load).sum();
+    assert_relative_eq!(sum, w, max_relative = 1e-12);
+    let m = sc.supports.iter().fold(pushval_model::Vec2::zeros(), |a, s| a + (s.position - sc.center_of_mass) * s.load);
+    assert!(m.norm() < 1e-12 * w);
+    assert!(sc.supports.iter().all(|s| s.load > 0.0));
+}
+
+/// The printed-inertia file states 0.1667 kg m² about the contact point:
+/// the centre-of-mass inertia follows by the parallel-axis theorem, and it is
+/// the contact-point inertia of a 0.5 m plate, four times the 0.25 m plate's.
+#[test]
+fn printed_inertia_is_read_about_the_contact() {
+    let printed = load(&root().join("scenarios/printed-inertia-v1.0.toml"));
+    let geometric = load(&root().join("scenarios/paper-square-v1.0.toml"));
+    assert_relative_eq!(geometric.inertia_cm, 0.25f64.powi(2) / 6.0, max_relative = 1e-12);
+    assert_relative_eq!(printed.body().inertia_contact(), 0.1667, max_relative = 1e-12);
+    // A 0.5 m, 1 kg plate about its corner: 0.5²/6 + 2 (0.25)² = 0.16667.
+    assert_relative_eq!(0.5f64.powi(2) / 6.0 + 2.0 * 0.25f64.powi(2), 0.1667, max_relative = 1e-3);
+    // The 0.25 m plate about its corner: 0.0417, as the text's plate should have.
+    assert_relative_eq!(geometric.body().inertia_contact(), 0.0417, max_relative = 1e-3);
+}
+
+/// Uniform pressure: the grid's loads sum to m g and are centred on the centroid.
+#[test]
+fn uniform_grid_is_centred_and_complete() {
+    let sc = load(&root().join("scenarios/uniform-pressure-square.toml"));
+    assert_eq!(sc.supports.len(), 100);
+    let w: f64 = sc.supports.iter().map(|s| s.load).sum();
+    assert_relative_eq!(w, sc.mass * sc.gravity, max_relative = 1e-12);
+    let c = sc.supports.iter().fold(pushval_model::Vec2::zeros(), |a, s| a + s.position * s.load) / w;
+    assert!(c.norm() < 1e-12);
+}
