@@ -6,6 +6,7 @@ use pushval_model::{
     kinematic, limit_surface, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel,
     ModelError, Problem, RootKind, SegmentDynamics, Simulator, SteadyState, Trajectory,
 };
+use pushval_rapier::{EngineRun, EngineSettings, RapierSimulator};
 use pushval_scenario::{ModelKind, Scenario};
 
 /// Settings of a harness run.
@@ -30,6 +31,9 @@ pub struct ModelRun {
     pub settings: serde_json::Value,
     /// Wall time of the run.
     pub elapsed: Duration,
+    /// Engine diagnostics (joint drift, steps, convergence in dt); null for
+    /// the analytic models.
+    pub diagnostics: serde_json::Value,
 }
 
 /// The steady-state analysis of one push segment.
@@ -96,6 +100,41 @@ pub struct Comparison {
     pub failed: Vec<String>,
     /// Why there is no comparison (the model failed to run), if so.
     pub error: Option<String>,
+    /// Engine runs only: the steady ω extrapolated to dt → 0.
+    pub convergence: Option<Convergence>,
+}
+
+/// How an engine's steady ω converges as its time step shrinks: runs at 4h,
+/// 2h and h (h the scenario's step), the observed order
+/// `p = log2(|ω(4h) − ω(2h)| / |ω(2h) − ω(h)|)`, and Richardson extrapolations
+/// to dt → 0: first order `2ω(h) − ω(2h)` and, removing the h² term as well,
+/// `(8ω(h) − 6ω(2h) + ω(4h)) / 3`.
+#[derive(Debug, Clone)]
+pub struct Convergence {
+    /// The three time steps (s), largest first.
+    pub dts: [f64; 3],
+    /// Observed order per settled segment.
+    pub orders: Vec<(usize, f64)>,
+    /// Largest relative error to ω* of the first-order extrapolation.
+    pub richardson1_rel_max: f64,
+    /// Largest relative error to ω* of the second-order extrapolation.
+    pub richardson2_rel_max: f64,
+    /// Largest relative error to ω* of the plain run at h (for comparison).
+    pub plain_rel_max: f64,
+}
+
+impl Convergence {
+    /// Median observed order over the settled segments.
+    pub fn order(&self) -> Option<f64> {
+        let mut o: Vec<f64> = self
+            .orders
+            .iter()
+            .map(|p| p.1)
+            .filter(|p| p.is_finite())
+            .collect();
+        o.sort_by(f64::total_cmp);
+        (!o.is_empty()).then(|| o[o.len() / 2])
+    }
 }
 
 /// Everything a scenario run produced.
@@ -121,13 +160,57 @@ impl ScenarioReport {
     }
 }
 
+/// The engine settings a scenario asks for: its `[engine]` table over the
+/// adapter's defaults.
+pub fn engine_settings(sc: &Scenario) -> EngineSettings {
+    let mut s = EngineSettings::default();
+    let e = &sc.engine;
+    if let Some(dt) = e.dt {
+        s.dt = dt;
+    }
+    if let Some(n) = e.solver_iterations {
+        s.solver_iterations = n;
+    }
+    if let Some(p) = e.precision {
+        s.precision = match p {
+            pushval_scenario::Precision::F64 => pushval_rapier::Precision::F64,
+            pushval_scenario::Precision::F32 => pushval_rapier::Precision::F32,
+        };
+    }
+    if let Some(f) = e.friction_velocity {
+        s.friction_velocity = match f {
+            pushval_scenario::FrictionVelocity::Body => pushval_rapier::FrictionVelocity::Body,
+            pushval_scenario::FrictionVelocity::Constraint => {
+                pushval_rapier::FrictionVelocity::Constraint
+            }
+            pushval_scenario::FrictionVelocity::Midpoint => {
+                pushval_rapier::FrictionVelocity::Midpoint
+            }
+        };
+    }
+    s
+}
+
+/// The settings record written beside an engine's figures.
+pub fn engine_settings_json(s: &EngineSettings) -> serde_json::Value {
+    serde_json::json!({
+        "engine": "rapier2d 0.36",
+        "dt": s.dt,
+        "solver_iterations": s.solver_iterations,
+        "pgs_iterations": s.pgs_iterations,
+        "precision": s.precision.as_str(),
+        "friction_velocity": s.friction_velocity.as_str(),
+        "switch_step_fraction": s.switch_step_fraction,
+        "label": s.label(),
+    })
+}
+
 /// The simulator for a model kind, or None for a model this build cannot run.
 fn simulator(
     kind: ModelKind,
     sc: &Scenario,
     opts: &RunOptions,
 ) -> Option<(Box<dyn Simulator>, serde_json::Value)> {
-    let _ = sc;
     match kind {
         ModelKind::Dynamic => Some((
             Box::new(DynamicModel {
@@ -140,8 +223,68 @@ fn simulator(
         )),
         ModelKind::Kinematic => Some((Box::new(KinematicModel), serde_json::json!({}))),
         ModelKind::LimitSurface => Some((Box::new(LimitSurfaceModel), serde_json::json!({}))),
-        ModelKind::Rapier2d => None,
+        ModelKind::Rapier2d => {
+            let settings = engine_settings(sc);
+            Some((
+                Box::new(RapierSimulator { settings }),
+                engine_settings_json(&settings),
+            ))
+        }
     }
+}
+
+fn engine_run(problem: &Problem, settings: EngineSettings) -> Result<EngineRun, ModelError> {
+    RapierSimulator { settings }.run(problem)
+}
+
+/// Runs the engine at 2h and 4h beside the run at h and measures how its
+/// steady ω converges.
+fn engine_convergence(
+    sc: &Scenario,
+    problem: &Problem,
+    segments: &[SegmentInfo],
+    fine: &Trajectory,
+    settings: EngineSettings,
+) -> Result<Convergence, ModelError> {
+    let h = settings.dt;
+    let mid = engine_run(
+        problem,
+        EngineSettings {
+            dt: 2.0 * h,
+            ..settings
+        },
+    )?;
+    let coarse = engine_run(
+        problem,
+        EngineSettings {
+            dt: 4.0 * h,
+            ..settings
+        },
+    )?;
+    let mut out = Convergence {
+        dts: [4.0 * h, 2.0 * h, h],
+        orders: Vec::new(),
+        richardson1_rel_max: 0.0,
+        richardson2_rel_max: 0.0,
+        plain_rel_max: 0.0,
+    };
+    for s in segments.iter().filter(|s| s.settles()) {
+        let ws = s.omega_steady.expect("settled segment has a root").omega;
+        let w = |tr: &Trajectory| tail_omega(tr, s.t_start, s.t_end);
+        let (Some(w1), Some(w2), Some(w4)) = (w(fine), w(&mid.trajectory), w(&coarse.trajectory))
+        else {
+            continue;
+        };
+        let p = ((w4 - w2).abs() / (w2 - w1).abs()).log2();
+        out.orders.push((s.index, p));
+        let r1 = 2.0 * w1 - w2;
+        let r2 = (8.0 * w1 - 6.0 * w2 + w4) / 3.0;
+        let e = |x: f64| rel_err(x, ws, s.speed, sc.froude_length());
+        out.richardson1_rel_max = out.richardson1_rel_max.max(e(r1));
+        out.richardson2_rel_max = out.richardson2_rel_max.max(e(r2));
+        out.plain_rel_max = out.plain_rel_max.max(e(w1));
+    }
+    Ok(out)
 }
 
 /// Steady ω per segment read off a trajectory: the mean ω over the last 20 %
@@ -276,6 +419,7 @@ pub fn compare(
         pass: gated.then_some(failed.is_empty()),
         failed,
         error: None,
+        convergence: None,
     }
 }
 
@@ -294,13 +438,24 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
     );
     let mut runs = Vec::new();
     let mut missing = Vec::new();
+    let mut failures: Vec<(ModelKind, String)> = Vec::new();
     for kind in kinds {
         let Some((sim, settings)) = simulator(kind, sc, opts) else {
             missing.push(kind);
             continue;
         };
         let t0 = Instant::now();
-        let result = sim.simulate(&problem);
+        let (result, diagnostics) = if kind == ModelKind::Rapier2d {
+            match engine_run(&problem, engine_settings(sc)) {
+                Ok(r) => (
+                    Ok(r.trajectory),
+                    serde_json::json!({"max_joint_drift": r.max_joint_drift, "steps": r.steps}),
+                ),
+                Err(e) => (Err(e), serde_json::Value::Null),
+            }
+        } else {
+            (sim.simulate(&problem), serde_json::Value::Null)
+        };
         let elapsed = t0.elapsed();
         match result {
             Ok(trajectory) => runs.push(ModelRun {
@@ -308,12 +463,10 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
                 trajectory,
                 settings,
                 elapsed,
+                diagnostics,
             }),
             Err(e) if kind == ModelKind::Dynamic => return Err(e),
-            Err(e) => missing.push({
-                let _ = e;
-                kind
-            }),
+            Err(e) => failures.push((kind, e.to_string())),
         }
     }
     let reference = runs[0].trajectory.clone();
@@ -325,6 +478,32 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             compare(sc, &segments, &reference, r, gated)
         })
         .collect();
+    for c in comparisons.iter_mut().filter(|c| c.model == "rapier2d") {
+        let run = runs
+            .iter()
+            .find(|r| r.kind == ModelKind::Rapier2d)
+            .expect("compared runs exist");
+        c.convergence = Some(engine_convergence(
+            sc,
+            &problem,
+            &segments,
+            &run.trajectory,
+            engine_settings(sc),
+        )?);
+    }
+    for (kind, e) in failures {
+        // An engine that blows up fails the gate and says where.
+        comparisons.push(Comparison {
+            model: kind.name().into(),
+            position_max: f64::NAN,
+            theta_max: f64::NAN,
+            omega_steady_rel_max: None,
+            pass: Some(false),
+            failed: vec![format!("run failed: {e}")],
+            error: Some(e),
+            convergence: None,
+        });
+    }
     for kind in missing {
         comparisons.push(Comparison {
             model: kind.name().into(),
@@ -334,6 +513,7 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             pass: None,
             failed: vec![],
             error: Some("not available in this build".into()),
+            convergence: None,
         });
     }
     Ok(ScenarioReport {

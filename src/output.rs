@@ -100,6 +100,15 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "settings": run.map_or(Value::Null, |r| r.settings.clone()),
                 "wall_time_s": run.map_or(Value::Null, |r| num(r.elapsed.as_secs_f64())),
                 "rhs_evals": run.map(|r| r.trajectory.stats.rhs_evals),
+                "diagnostics": run.map_or(Value::Null, |r| r.diagnostics.clone()),
+                "convergence": c.convergence.as_ref().map_or(Value::Null, |v| json!({
+                    "dts": v.dts,
+                    "observed_order": opt(v.order()),
+                    "orders": v.orders.iter().map(|(i, p)| json!({"segment": i, "order": num(*p)})).collect::<Vec<_>>(),
+                    "omega_steady_rel_max_plain": num(v.plain_rel_max),
+                    "omega_steady_rel_max_richardson1": num(v.richardson1_rel_max),
+                    "omega_steady_rel_max_richardson2": num(v.richardson2_rel_max),
+                })),
                 "steps": run.map(|r| r.trajectory.stats.steps),
             }),
         );

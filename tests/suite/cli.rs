@@ -19,8 +19,13 @@ fn run_writes_summary_and_trajectory() {
         .arg(&out)
         .output()
         .unwrap();
-    assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
-    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["scenario"], "paper-square-v0.2");
     let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     assert!(csv.starts_with("model,t,x,y,theta,omega\n"));
@@ -34,7 +39,13 @@ fn bad_file_exits_2_and_writes_nothing() {
     let bad = dir.path().join("bad.toml");
     std::fs::write(&bad, "name = \"x\"\n[object]\nmass = -1\n").unwrap();
     let out = dir.path().join("out");
-    let st = pushval().arg("run").arg(&bad).arg("--out").arg(&out).output().unwrap();
+    let st = pushval()
+        .arg("run")
+        .arg(&bad)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
     assert_eq!(st.status.code(), Some(2));
     let err = String::from_utf8_lossy(&st.stderr);
     assert!(err.contains("bad.toml"), "{err}");
@@ -45,8 +56,17 @@ fn bad_file_exits_2_and_writes_nothing() {
 
 #[test]
 fn validate_passes_on_the_shipped_scenarios() {
-    let st = pushval().arg("validate").current_dir(root()).output().unwrap();
+    let st = pushval()
+        .arg("validate")
+        .current_dir(root())
+        .output()
+        .unwrap();
     let text = String::from_utf8_lossy(&st.stdout);
-    assert_eq!(st.status.code(), Some(0), "{text}\n{}", String::from_utf8_lossy(&st.stderr));
+    assert_eq!(
+        st.status.code(),
+        Some(0),
+        "{text}\n{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
     assert!(text.contains("paper-square-v1.0") && text.contains("kinematic"));
 }

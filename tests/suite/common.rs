@@ -73,13 +73,16 @@ pub fn run(model: &DynamicModel, p: &Problem) -> Trajectory {
 #[track_caller]
 pub fn max_diff(a: &Trajectory, b: &Trajectory) -> (f64, f64) {
     assert_eq!(a.samples.len(), b.samples.len());
-    a.samples.iter().zip(&b.samples).fold((0.0f64, 0.0f64), |(p, t), (x, y)| {
-        assert_eq!(x.t, y.t);
-        (
-            p.max(((x.x - y.x).powi(2) + (x.y - y.y).powi(2)).sqrt()),
-            t.max((x.theta - y.theta).abs()),
-        )
-    })
+    a.samples
+        .iter()
+        .zip(&b.samples)
+        .fold((0.0f64, 0.0f64), |(p, t), (x, y)| {
+            assert_eq!(x.t, y.t);
+            (
+                p.max(((x.x - y.x).powi(2) + (x.y - y.y).powi(2)).sqrt()),
+                t.max((x.theta - y.theta).abs()),
+            )
+        })
 }
 
 pub fn root() -> PathBuf {

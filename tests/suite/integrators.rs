@@ -9,9 +9,18 @@ use crate::common::*;
 fn paper_problem() -> pushval_model::Problem {
     let pushes = [PHI, std::f64::consts::FRAC_PI_4, 0.485, 1.285, 0.935]
         .iter()
-        .map(|&phi| Push { duration: 2.0, speed: 1.0, phi })
+        .map(|&phi| Push {
+            duration: 2.0,
+            speed: 1.0,
+            phi,
+        })
         .collect();
-    problem(paper_plate(), pushes, Initial::default(), Switching::Impulsive)
+    problem(
+        paper_plate(),
+        pushes,
+        Initial::default(),
+        Switching::Impulsive,
+    )
 }
 
 /// RK4's error falls as h⁴ on one smooth segment (no settled-arc shortcut, so
@@ -21,14 +30,21 @@ fn rk4_observed_order_is_four() {
     let p = one_push(paper_plate(), 1.0, 1.0, PHI);
     let reference = run(&adaptive(1e-14, false), &p);
     let err = |dt: f64| {
-        let m = DynamicModel { integrator: Integrator::Rk4 { dt }, skip_settled: false, check_assumptions: false };
+        let m = DynamicModel {
+            integrator: Integrator::Rk4 { dt },
+            skip_settled: false,
+            check_assumptions: false,
+        };
         let (dp, dt_) = max_diff(&m.simulate(&p).unwrap(), &reference);
         dp.max(dt_)
     };
     let e: Vec<f64> = [0.02, 0.01, 0.005].iter().map(|&h| err(h)).collect();
     for w in e.windows(2) {
         let order = (w[0] / w[1]).log2();
-        assert!((3.8..4.3).contains(&order), "observed order {order} from {e:?}");
+        assert!(
+            (3.8..4.3).contains(&order),
+            "observed order {order} from {e:?}"
+        );
     }
 }
 
@@ -45,11 +61,17 @@ fn adaptive_meets_its_tolerance(#[case] tol: f64) {
     let reference = run(&adaptive(1e-13, true), &p);
     let tr = run(&adaptive(tol, true), &p);
     let (dp, dt) = max_diff(&tr, &reference);
-    assert!(dp <= 10.0 * tol && dt <= 10.0 * tol, "tol {tol:e}: position {dp:e} m, angle {dt:e} rad");
+    assert!(
+        dp <= 10.0 * tol && dt <= 10.0 * tol,
+        "tol {tol:e}: position {dp:e} m, angle {dt:e} rad"
+    );
     // And the shortcut does not change the answer beyond the tolerance.
     let full = run(&adaptive(tol, false), &p);
     let (dp2, dt2) = max_diff(&full, &reference);
-    assert!(dp2 <= 10.0 * tol && dt2 <= 10.0 * tol, "no shortcut, tol {tol:e}: {dp2:e} m, {dt2:e} rad");
+    assert!(
+        dp2 <= 10.0 * tol && dt2 <= 10.0 * tol,
+        "no shortcut, tol {tol:e}: {dp2:e} m, {dt2:e} rad"
+    );
 }
 
 /// The settled-arc shortcut saves work on the paper trajectory.
@@ -59,5 +81,10 @@ fn settled_arcs_skip_integration() {
     let with = run(&adaptive(1e-9, true), &p);
     let without = run(&adaptive(1e-9, false), &p);
     assert!(with.segments.iter().all(|s| s.settled_at.is_some()));
-    assert!(with.stats.rhs_evals < without.stats.rhs_evals, "{:?} vs {:?}", with.stats, without.stats);
+    assert!(
+        with.stats.rhs_evals < without.stats.rhs_evals,
+        "{:?} vs {:?}",
+        with.stats,
+        without.stats
+    );
 }

@@ -21,7 +21,17 @@ fn scenario_runs_and_writes_contract_outputs(#[files("scenarios/*.toml")] path: 
     assert_eq!(summary["scenario"], sc.name);
     let segs = summary["segments"].as_array().unwrap();
     assert_eq!(segs.len(), sc.pushes.len());
-    for key in ["index", "t_start", "t_end", "speed", "phi", "froude", "omega_kinematic", "omega_steady", "tau"] {
+    for key in [
+        "index",
+        "t_start",
+        "t_end",
+        "speed",
+        "phi",
+        "froude",
+        "omega_kinematic",
+        "omega_steady",
+        "tau",
+    ] {
         assert!(segs[0].get(key).is_some(), "segments[0] lacks {key}");
     }
     for (name, m) in summary["models"].as_object().unwrap() {
@@ -55,7 +65,11 @@ fn scenario_segments_settle_on_their_roots(#[files("scenarios/*.toml")] path: Pa
     for s in report.segments.iter().filter(|s| s.settles()) {
         let ws = s.omega_steady.unwrap().omega;
         let we = dynamic.segments[s.index].omega_end;
-        assert!((we - ws).abs() <= 1e-6 * ws.abs().max(1e-3 * s.speed / sc.froude_length()), "segment {}: {we} vs {ws}", s.index);
+        assert!(
+            (we - ws).abs() <= 1e-6 * ws.abs().max(1e-3 * s.speed / sc.froude_length()),
+            "segment {}: {we} vs {ws}",
+            s.index
+        );
     }
 }
 
@@ -68,7 +82,9 @@ fn scenario_mirror_symmetry(#[files("scenarios/*.toml")] path: PathBuf) {
     let flip = |v: &mut pushval_model::Vec2| v.y = -v.y;
     m.polygon.iter_mut().for_each(flip);
     m.polygon.reverse();
-    m.supports.iter_mut().for_each(|s| s.position.y = -s.position.y);
+    m.supports
+        .iter_mut()
+        .for_each(|s| s.position.y = -s.position.y);
     flip(&mut m.contact);
     flip(&mut m.center_of_mass);
     flip(&mut m.contact_limits.normals.0);
@@ -81,8 +97,15 @@ fn scenario_mirror_symmetry(#[files("scenarios/*.toml")] path: PathBuf) {
     let a = model.simulate(&sc.problem()).unwrap();
     let b = model.simulate(&m.problem()).unwrap();
     for (p, q) in a.samples.iter().zip(&b.samples) {
-        assert!((p.omega + q.omega).abs() < 1e-7 * (1.0 + p.omega.abs()), "{p:?} {q:?}");
-        assert!((p.theta + q.theta).abs() < 1e-7 && (p.x - q.x).abs() < 1e-7 && (p.y + q.y).abs() < 1e-7);
+        assert!(
+            (p.omega + q.omega).abs() < 1e-7 * (1.0 + p.omega.abs()),
+            "{p:?} {q:?}"
+        );
+        assert!(
+            (p.theta + q.theta).abs() < 1e-7
+                && (p.x - q.x).abs() < 1e-7
+                && (p.y + q.y).abs() < 1e-7
+        );
     }
 }
 
@@ -96,7 +119,10 @@ fn scenario_mass_independence(#[files("scenarios/*.toml")] path: PathBuf) {
     h.inertia_cm *= 7.3;
     h.supports.iter_mut().for_each(|s| s.load *= 7.3);
     let model = DynamicModel::default();
-    let (dp, dt) = max_diff(&model.simulate(&sc.problem()).unwrap(), &model.simulate(&h.problem()).unwrap());
+    let (dp, dt) = max_diff(
+        &model.simulate(&sc.problem()).unwrap(),
+        &model.simulate(&h.problem()).unwrap(),
+    );
     assert!(dp < 1e-9 && dt < 1e-9, "{dp} {dt}");
 }
 
@@ -107,7 +133,10 @@ fn heavy_file_matches_paper_file() {
     let b = load(&root().join("scenarios/heavy-square-v1.0.toml"));
     assert_eq!(b.mass, 10.0 * a.mass);
     let model = DynamicModel::default();
-    let (dp, dt) = max_diff(&model.simulate(&a.problem()).unwrap(), &model.simulate(&b.problem()).unwrap());
+    let (dp, dt) = max_diff(
+        &model.simulate(&a.problem()).unwrap(),
+        &model.simulate(&b.problem()).unwrap(),
+    );
     assert!(dp < 1e-9 && dt < 1e-9);
 }
 
@@ -118,7 +147,12 @@ fn statics_loads_balance() {
     let w = sc.mass * sc.gravity;
     let sum: f64 = sc.supports.iter().map(|s| s.load).sum();
     assert_relative_eq!(sum, w, max_relative = 1e-12);
-    let m = sc.supports.iter().fold(pushval_model::Vec2::zeros(), |a, s| a + (s.position - sc.center_of_mass) * s.load);
+    let m = sc
+        .supports
+        .iter()
+        .fold(pushval_model::Vec2::zeros(), |a, s| {
+            a + (s.position - sc.center_of_mass) * s.load
+        });
     assert!(m.norm() < 1e-12 * w);
     assert!(sc.supports.iter().all(|s| s.load > 0.0));
 }
@@ -130,12 +164,28 @@ fn statics_loads_balance() {
 fn printed_inertia_is_read_about_the_contact() {
     let printed = load(&root().join("scenarios/printed-inertia-v1.0.toml"));
     let geometric = load(&root().join("scenarios/paper-square-v1.0.toml"));
-    assert_relative_eq!(geometric.inertia_cm, 0.25f64.powi(2) / 6.0, max_relative = 1e-12);
-    assert_relative_eq!(printed.body().inertia_contact(), 0.1667, max_relative = 1e-12);
+    assert_relative_eq!(
+        geometric.inertia_cm,
+        0.25f64.powi(2) / 6.0,
+        max_relative = 1e-12
+    );
+    assert_relative_eq!(
+        printed.body().inertia_contact(),
+        0.1667,
+        max_relative = 1e-12
+    );
     // A 0.5 m, 1 kg plate about its corner: 0.5²/6 + 2 (0.25)² = 0.16667.
-    assert_relative_eq!(0.5f64.powi(2) / 6.0 + 2.0 * 0.25f64.powi(2), 0.1667, max_relative = 1e-3);
+    assert_relative_eq!(
+        0.5f64.powi(2) / 6.0 + 2.0 * 0.25f64.powi(2),
+        0.1667,
+        max_relative = 1e-3
+    );
     // The 0.25 m plate about its corner: 0.0417, as the text's plate should have.
-    assert_relative_eq!(geometric.body().inertia_contact(), 0.0417, max_relative = 1e-3);
+    assert_relative_eq!(
+        geometric.body().inertia_contact(),
+        0.0417,
+        max_relative = 1e-3
+    );
 }
 
 /// Uniform pressure: the grid's loads sum to m g and are centred on the centroid.
@@ -145,6 +195,10 @@ fn uniform_grid_is_centred_and_complete() {
     assert_eq!(sc.supports.len(), 100);
     let w: f64 = sc.supports.iter().map(|s| s.load).sum();
     assert_relative_eq!(w, sc.mass * sc.gravity, max_relative = 1e-12);
-    let c = sc.supports.iter().fold(pushval_model::Vec2::zeros(), |a, s| a + s.position * s.load) / w;
+    let c = sc
+        .supports
+        .iter()
+        .fold(pushval_model::Vec2::zeros(), |a, s| a + s.position * s.load)
+        / w;
     assert!(c.norm() < 1e-12);
 }

@@ -133,16 +133,21 @@ impl SegmentDynamics {
     /// Friction moment about the contact point at `omega` for pusher speed `v`
     /// (N m). A support with `|u_i| = 0` contributes zero (its friction is
     /// set-valued there; see [`RootKind::Pivot`]).
+    ///
+    /// `u_i` is formed component by component rather than from
+    /// `|u_i|² = v² + 2 v ω s_i + ω² b_i`, which cancels catastrophically where
+    /// a support nearly stops and would misplace a pivot by ~1e-8 relative.
     #[inline]
     pub fn friction_moment_at(&self, v: f64, omega: f64) -> f64 {
-        let (f, s, b) = (&self.f[..], &self.s[..], &self.b[..]);
-        let n = f.len().min(s.len()).min(b.len());
-        let v2 = v * v;
+        let (f, rx, ry) = (&self.f[..], &self.rx[..], &self.ry[..]);
+        let n = f.len().min(rx.len()).min(ry.len());
+        let (vx, vy) = (v * self.dir.x, v * self.dir.y);
         let mut acc = 0.0;
         for i in 0..n {
-            let num = v * s[i] + omega * b[i];
-            let u2 = v2 + 2.0 * v * omega * s[i] + omega * omega * b[i];
-            // u2 can only vanish (or round below zero) where num also vanishes.
+            let ux = vx - omega * ry[i];
+            let uy = vy + omega * rx[i];
+            let u2 = ux * ux + uy * uy;
+            let num = rx[i] * uy - ry[i] * ux;
             let inv = if u2 > 0.0 { u2.sqrt().recip() } else { 0.0 };
             acc -= f[i] * num * inv;
         }
@@ -161,16 +166,19 @@ impl SegmentDynamics {
         self.moment(omega) / self.inertia_contact
     }
 
-    /// `G'(ω)` (N m s). Supports that are not sliding are skipped.
+    /// `G'(ω)` (N m s), using `b_i − s_i² = (r_i · n_φ)²`. Supports that are
+    /// not sliding are skipped.
     pub fn moment_slope(&self, omega: f64) -> f64 {
         let v = self.speed;
-        let v2 = v * v;
+        let (vx, vy) = (v * self.dir.x, v * self.dir.y);
         let mut acc = self.k;
         for i in 0..self.f.len() {
-            let u2 = v2 + 2.0 * v * omega * self.s[i] + omega * omega * self.b[i];
+            let ux = vx - omega * self.ry[i];
+            let uy = vy + omega * self.rx[i];
+            let u2 = ux * ux + uy * uy;
             if u2 > 0.0 {
-                acc -= self.f[i] * v2 * (self.b[i] - self.s[i] * self.s[i]).max(0.0)
-                    / (u2 * u2.sqrt());
+                let c = v * (self.rx[i] * self.dir.x + self.ry[i] * self.dir.y);
+                acc -= self.f[i] * c * c / (u2 * u2.sqrt());
             }
         }
         acc
@@ -179,10 +187,12 @@ impl SegmentDynamics {
     /// Smallest support sliding speed at `omega` (m/s) and the body's index of
     /// that support.
     pub fn min_support_speed(&self, omega: f64) -> (f64, usize) {
-        let v = self.speed;
+        let (vx, vy) = (self.speed * self.dir.x, self.speed * self.dir.y);
         let mut best = (f64::INFINITY, 0);
         for i in 0..self.f.len() {
-            let u2 = (v * v + 2.0 * v * omega * self.s[i] + omega * omega * self.b[i]).max(0.0);
+            let ux = vx - omega * self.ry[i];
+            let uy = vy + omega * self.rx[i];
+            let u2 = ux * ux + uy * uy;
             if u2 < best.0 {
                 best = (u2, self.index[i]);
             }

@@ -513,6 +513,33 @@ impl Simulator for DynamicModel {
                 _ => None,
             };
             let settled = |t: f64, w: f64| settle.filter(|r| r.holds(w, t1 - t));
+            // A stable pivot is reached in finite time (ω̇ jumps there); past
+            // it the support sticks and the object turns about it at the
+            // constant ω_p. Integrating across the jump would chatter, so the
+            // step is aimed at the pivot and the motion continues as an arc.
+            let pivot = match target {
+                Some(SteadyState {
+                    kind: crate::RootKind::Pivot { stable: true, .. },
+                    omega: wp,
+                    ..
+                }) => Some(wp),
+                _ => None,
+            };
+            let pivot_reached = |w0: f64, w1: f64| {
+                pivot.is_some_and(|wp| {
+                    (w1 - wp).abs() <= 10.0 * tol * (1.0 + wp.abs())
+                        || (w1 - wp).signum() != (w0 - wp).signum()
+                })
+            };
+            let pivot_tail = |t: f64, c: Vec2, theta: f64| Tail {
+                t,
+                c,
+                theta,
+                omega: pivot.unwrap_or(0.0),
+                delta: 0.0,
+                tau: 1.0,
+                vel,
+            };
 
             // Segment start: the state just after the switch.
             while let Some(ts) = sampler.due(t0, t1, last) {
@@ -522,8 +549,11 @@ impl Simulator for DynamicModel {
             }
 
             let mut t = t0;
-            let mut settle_state: Option<Tail> =
-                settled(t0, omega).map(|r| r.tail(t0, c, theta, omega, vel));
+            let mut settle_state: Option<Tail> = if pivot_reached(omega, omega) {
+                Some(pivot_tail(t0, c, theta))
+            } else {
+                settled(t0, omega).map(|r| r.tail(t0, c, theta, omega, vel))
+            };
 
             if push.speed == 0.0 {
                 // The contact point is held: the object pivots about it and
@@ -581,8 +611,16 @@ impl Simulator for DynamicModel {
                             integrate::initial_step(&mut rhs, &y, &k1, tol, tol, t1 - t0)
                         });
                         while t < t1 {
-                            let landing = t + h >= t1 - 1e-12 * t1.abs().max(1.0);
-                            let hh = if landing { t1 - t } else { h };
+                            let mut landing = t + h >= t1 - 1e-12 * t1.abs().max(1.0);
+                            let mut hh = if landing { t1 - t } else { h };
+                            if let Some(wp) = pivot {
+                                // Aim at the pivot by the local ω̇ (smooth on this side).
+                                let t_hit = (wp - y[1]) / k1[1];
+                                if t_hit > 0.0 && t_hit < hh {
+                                    hh = t_hit;
+                                    landing = false;
+                                }
+                            }
                             let a = integrate::dp5_attempt(&mut rhs, &y, &k1, hh, tol, &rtol);
                             out.stats.rhs_evals += 6;
                             if a.err <= 1.0 {
@@ -600,10 +638,18 @@ impl Simulator for DynamicModel {
                                     checker.sample(&seg, ys[1], ts, j);
                                     sampler.next += 1;
                                 }
+                                let w_before = y[1];
                                 y = a.y1;
                                 k1 = a.k7;
                                 t = t_new;
                                 out.stats.steps += 1;
+                                if t < t1
+                                    && (pivot_reached(w_before, y[1])
+                                        || (pivot.is_some() && hh < 1e-12 * t.abs().max(1.0)))
+                                {
+                                    settle_state = Some(pivot_tail(t, Vec2::new(y[2], y[3]), y[0]));
+                                    break;
+                                }
                                 if !y.iter().all(|v| v.is_finite()) {
                                     return Err(ModelError::NonFinite {
                                         t,
@@ -658,10 +704,16 @@ impl Simulator for DynamicModel {
                                 checker.sample(&seg, ys[1], ts, j);
                                 sampler.next += 1;
                             }
+                            let w_before = y[1];
                             y = y1;
                             k1 = k2;
                             t = t_new;
                             out.stats.steps += 1;
+                            if t < t1 && pivot_reached(w_before, y[1]) {
+                                // First order in h here: RK4 is kept for benchmarks.
+                                settle_state = Some(pivot_tail(t, Vec2::new(y[2], y[3]), y[0]));
+                                break;
+                            }
                             if !y.iter().all(|v| v.is_finite()) {
                                 return Err(ModelError::NonFinite {
                                     t,

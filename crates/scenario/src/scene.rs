@@ -57,6 +57,8 @@ pub enum FrictionVelocity {
     Body,
     /// The commanded pusher velocity plus `ω × r` (the joint constraint).
     Constraint,
+    /// The constraint velocity evaluated at the middle of the step.
+    Midpoint,
 }
 
 /// `[engine]`: settings for engine models; unset fields take the adapter's defaults.
@@ -209,7 +211,11 @@ impl Scenario {
                 if let Some(rest) = msg.strip_prefix(quote) {
                     let name = rest.split('`').next().unwrap_or_default();
                     if !key.ends_with(name) {
-                        key = if key.is_empty() { name.to_string() } else { format!("{key}.{name}") };
+                        key = if key.is_empty() {
+                            name.to_string()
+                        } else {
+                            format!("{key}.{name}")
+                        };
                     }
                 }
             }
@@ -649,12 +655,13 @@ impl Scenario {
                 None => None,
                 Some("body") => Some(FrictionVelocity::Body),
                 Some("constraint") => Some(FrictionVelocity::Constraint),
-                Some(o) => {
-                    return Err(err(
-                        "engine.friction_velocity",
-                        format!("unknown value \"{o}\"; expected \"body\" or \"constraint\""),
-                    ))
-                }
+                Some("midpoint") => Some(FrictionVelocity::Midpoint),
+                Some(o) => return Err(err(
+                    "engine.friction_velocity",
+                    format!(
+                        "unknown value \"{o}\"; expected \"body\", \"constraint\" or \"midpoint\""
+                    ),
+                )),
             },
         };
         Ok(Self {

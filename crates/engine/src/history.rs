@@ -1,0 +1,183 @@
+//! The engine's step history, and how it is turned into samples.
+//!
+//! rapier integrates with symplectic Euler: a step first updates the velocities,
+//! then moves the poses with the new velocities. So the pose after a step is a
+//! value *at* the step's end, while the angular velocity after a step is the one
+//! the body held *over* the step, best read as the value at the step's middle.
+//! Samples are built accordingly:
+//!
+//! * `x`, `y`, `θ` at a sample time: linear interpolation between the poses at
+//!   the two step ends around it (exact for the engine's piecewise-linear motion);
+//! * `ω` at a sample time: linear interpolation between the step velocities
+//!   placed at the step middles, **within the segment the sample belongs to**,
+//!   extrapolated linearly from the segment's first (last) two steps near its
+//!   start (end). A sample at a switch time belongs to the segment that starts
+//!   there, so its ω is the engine's ω just after the switch impulse.
+
+use pushval_model::{Problem, Sample, SegmentReport};
+
+/// One engine step, or (the first record of a history) the initial state.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepRecord {
+    /// Index of the push segment the step belongs to.
+    pub segment: usize,
+    /// Start and end time of the step (s); equal for the initial-state record.
+    pub t0: f64,
+    pub t1: f64,
+    /// World position of the centre of mass at `t1` (m).
+    pub x: f64,
+    pub y: f64,
+    /// Object angle at `t1`, unwrapped (rad).
+    pub theta: f64,
+    /// Angular velocity the engine held over the step (rad/s); for the
+    /// initial-state record, the initial angular velocity.
+    pub omega: f64,
+}
+
+impl StepRecord {
+    fn is_step(&self) -> bool {
+        self.t1 > self.t0
+    }
+    fn mid(&self) -> f64 {
+        0.5 * (self.t0 + self.t1)
+    }
+}
+
+/// What the per-precision engine code hands back.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct RawRun {
+    pub history: Vec<StepRecord>,
+    pub steps: usize,
+    pub max_drift: f64,
+    pub min_support_speed: f64,
+}
+
+/// The segment a time belongs to: a switch time belongs to the segment that
+/// starts there; the end time to the last segment.
+fn segment_of(times: &[(f64, f64)], t: f64) -> usize {
+    let tol = 1e-12 * times.last().map(|s| s.1).unwrap_or(1.0).max(1.0);
+    times
+        .iter()
+        .position(|&(_, t1)| t < t1 - tol)
+        .unwrap_or(times.len() - 1)
+}
+
+/// Range of history indices of the (non-initial) steps of each segment.
+fn segment_ranges(n_segments: usize, history: &[StepRecord]) -> Vec<std::ops::Range<usize>> {
+    let mut ranges = vec![0..0; n_segments];
+    for (j, range) in ranges.iter_mut().enumerate() {
+        let a = history.partition_point(|r| r.segment < j || !r.is_step());
+        let b = history.partition_point(|r| r.segment <= j);
+        *range = a..b.max(a);
+    }
+    ranges
+}
+
+/// ω at time `t` from the steps `steps` of one segment (see the module docs).
+fn omega_in(steps: &[StepRecord], t: f64) -> f64 {
+    match steps.len() {
+        0 => f64::NAN,
+        1 => steps[0].omega,
+        n => {
+            // Index of the first step whose middle is after t, clamped so that
+            // (k-1, k) is a valid pair of neighbouring nodes.
+            let k = steps.partition_point(|r| r.mid() <= t).clamp(1, n - 1);
+            let (a, b) = (&steps[k - 1], &steps[k]);
+            let s = (t - a.mid()) / (b.mid() - a.mid());
+            a.omega + s * (b.omega - a.omega)
+        }
+    }
+}
+
+/// Samples at `problem.sample_times()`.
+pub(crate) fn sample(problem: &Problem, history: &[StepRecord]) -> Vec<Sample> {
+    let times = problem.segment_times();
+    let ranges = segment_ranges(times.len(), history);
+    problem
+        .sample_times()
+        .into_iter()
+        .map(|t| {
+            // Pose: the last node at or before t, and the one after it.
+            let k = history.partition_point(|r| r.t1 <= t);
+            let (x, y, theta) = if k == 0 {
+                let r = &history[0];
+                (r.x, r.y, r.theta)
+            } else if k >= history.len() {
+                let r = &history[history.len() - 1];
+                (r.x, r.y, r.theta)
+            } else {
+                let (a, b) = (&history[k - 1], &history[k]);
+                let s = if b.t1 > a.t1 {
+                    (t - a.t1) / (b.t1 - a.t1)
+                } else {
+                    1.0
+                };
+                (
+                    a.x + s * (b.x - a.x),
+                    a.y + s * (b.y - a.y),
+                    a.theta + s * (b.theta - a.theta),
+                )
+            };
+            let j = segment_of(&times, t);
+            let omega = omega_in(&history[ranges[j].clone()], t);
+            Sample {
+                t,
+                x,
+                y,
+                theta,
+                omega,
+            }
+        })
+        .collect()
+}
+
+/// One report per segment: ω just after the switch into it and at its end.
+pub(crate) fn segment_reports(
+    problem: &Problem,
+    history: &[StepRecord],
+    _samples: &[Sample],
+) -> Vec<SegmentReport> {
+    let times = problem.segment_times();
+    let ranges = segment_ranges(times.len(), history);
+    times
+        .iter()
+        .enumerate()
+        .map(|(j, &(t0, t1))| {
+            let steps = &history[ranges[j].clone()];
+            SegmentReport {
+                index: j,
+                t_start: t0,
+                t_end: t1,
+                omega_start: omega_in(steps, t0),
+                omega_end: omega_in(steps, t1),
+                settled_at: None,
+            }
+        })
+        .collect()
+}
+
+/// Per segment, the time-weighted mean of the step ω over the steps that lie
+/// in the last `fraction` of the segment.
+pub(crate) fn tail_omega(problem: &Problem, history: &[StepRecord], fraction: f64) -> Vec<f64> {
+    let times = problem.segment_times();
+    let ranges = segment_ranges(times.len(), history);
+    times
+        .iter()
+        .enumerate()
+        .map(|(j, &(t0, t1))| {
+            let from = t1 - fraction * (t1 - t0);
+            let steps = &history[ranges[j].clone()];
+            let (mut w, mut sum) = (0.0, 0.0);
+            for r in steps.iter().filter(|r| r.mid() >= from) {
+                let h = r.t1 - r.t0;
+                w += h;
+                sum += h * r.omega;
+            }
+            if w > 0.0 {
+                sum / w
+            } else {
+                steps.last().map(|r| r.omega).unwrap_or(f64::NAN)
+            }
+        })
+        .collect()
+}
