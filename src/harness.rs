@@ -3,8 +3,9 @@
 use std::time::{Duration, Instant};
 
 use pushval_model::{
-    kinematic, limit_surface, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel,
-    ModelError, Problem, RootKind, SegmentDynamics, Simulator, SteadyState, Trajectory,
+    kinematic, limit_surface, DynamicModel, InertialTerm, Integrator, KinematicModel,
+    LimitSurfaceModel, ModelError, Problem, RootKind, SegmentDynamics, Simulator, SteadyState,
+    Trajectory,
 };
 use pushval_rapier::{EngineRun, EngineSettings, RapierSimulator};
 use pushval_scenario::{ModelKind, Scenario};
@@ -307,13 +308,23 @@ pub fn analyse_segments(
     problem: &Problem,
     dynamic: &Trajectory,
 ) -> Vec<SegmentInfo> {
+    analyse_segments_with(sc, problem, dynamic, InertialTerm::Derived)
+}
+
+/// [`analyse_segments`] for a chosen reading of the inertial term.
+pub fn analyse_segments_with(
+    sc: &Scenario,
+    problem: &Problem,
+    dynamic: &Trajectory,
+    term: InertialTerm,
+) -> Vec<SegmentInfo> {
     problem
         .pushes
         .iter()
         .zip(problem.segment_times())
         .enumerate()
         .map(|(j, (push, (t0, t1)))| {
-            let seg = SegmentDynamics::new(&problem.body, push);
+            let seg = SegmentDynamics::with_inertial_term(&problem.body, push, term);
             let roots = if push.speed > 0.0 {
                 seg.steady_states()
             } else {

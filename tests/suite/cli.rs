@@ -70,3 +70,22 @@ fn validate_passes_on_the_shipped_scenarios() {
     );
     assert!(text.contains("paper-square-v1.0") && text.contains("kinematic"));
 }
+
+#[test]
+fn failing_tolerance_exits_1_and_names_the_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("scenarios/paper-square-v0.2.toml")).unwrap();
+    let tight = dir.path().join("tight.toml");
+    std::fs::write(
+        &tight,
+        format!("{text}\n[tolerance]\nposition_max = 1e-9\n"),
+    )
+    .unwrap();
+    let st = pushval().arg("validate").arg(&tight).output().unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("paper-square-v0.2 / rapier2d: position_max"),
+        "{err}"
+    );
+}

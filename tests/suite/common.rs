@@ -62,6 +62,7 @@ pub fn adaptive(tol: f64, skip: bool) -> DynamicModel {
         integrator: Integrator::Adaptive { tol },
         skip_settled: skip,
         check_assumptions: true,
+        ..Default::default()
     }
 }
 

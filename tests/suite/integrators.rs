@@ -34,6 +34,7 @@ fn rk4_observed_order_is_four() {
             integrator: Integrator::Rk4 { dt },
             skip_settled: false,
             check_assumptions: false,
+            ..Default::default()
         };
         let (dp, dt_) = max_diff(&m.simulate(&p).unwrap(), &reference);
         dp.max(dt_)

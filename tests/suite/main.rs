@@ -4,6 +4,7 @@
 mod bad_input;
 mod cli;
 mod common;
+mod gate;
 mod integrators;
 mod physics;
 mod scenarios;

@@ -50,6 +50,18 @@ impl SteadyState {
     }
 }
 
+/// The inertial term `m v_c ω (p_c · n_φ)` of the moment balance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InertialTerm {
+    /// As derived (DESIGN.md): the moment about the contact point of the
+    /// centre of mass's acceleration.
+    #[default]
+    Derived,
+    /// Deliberately wrong: the term with its sign flipped. Exists so that the
+    /// tests can show the engine gate catches a sign error in a model.
+    Flipped,
+}
+
 /// Per-segment precomputation of the dynamic model (structure of arrays, so
 /// the friction loop vectorises).
 #[derive(Debug, Clone)]
@@ -78,6 +90,15 @@ pub const STICK_REL: f64 = 1e-9;
 impl SegmentDynamics {
     /// Precomputes the segment for `push` (only its speed and direction matter).
     pub fn new(body: &Body, push: &Push) -> Self {
+        Self::with_inertial_term(body, push, InertialTerm::Derived)
+    }
+
+    /// As [`SegmentDynamics::new`], with a chosen reading of the inertial term.
+    pub fn with_inertial_term(body: &Body, push: &Push, term: InertialTerm) -> Self {
+        let sign = match term {
+            InertialTerm::Derived => 1.0,
+            InertialTerm::Flipped => -1.0,
+        };
         let (sx, sy, fr) = body.arrays();
         let pc = body.contact();
         let dir = push.direction();
@@ -91,7 +112,7 @@ impl SegmentDynamics {
             ry: Vec::with_capacity(n),
             speed: push.speed,
             dir,
-            k: body.mass() * push.speed * pc.dot(&dir),
+            k: sign * body.mass() * push.speed * pc.dot(&dir),
             inertia_contact: body.inertia_contact(),
             mass: body.mass(),
             contact: pc,

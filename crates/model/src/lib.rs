@@ -31,7 +31,7 @@ mod trajectory;
 
 pub use arc::{arc_advance, sinc_versc};
 pub use body::{Body, Push, Support};
-pub use dynamic::{RootKind, SegmentDynamics, SteadyState};
+pub use dynamic::{InertialTerm, RootKind, SegmentDynamics, SteadyState};
 pub use error::ModelError;
 pub use problem::{ContactLimits, Initial, Problem, Simulator, Switching};
 pub use trajectory::{

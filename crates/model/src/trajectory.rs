@@ -170,6 +170,8 @@ pub struct DynamicModel {
     /// Evaluate the pusher force and the assumption checks at every sample.
     /// Default true.
     pub check_assumptions: bool,
+    /// Which reading of the inertial term; default the derived one.
+    pub inertial_term: crate::InertialTerm,
 }
 
 impl Default for DynamicModel {
@@ -178,6 +180,7 @@ impl Default for DynamicModel {
             integrator: Integrator::Adaptive { tol: 1e-10 },
             skip_settled: true,
             check_assumptions: true,
+            inertial_term: crate::InertialTerm::Derived,
         }
     }
 }
@@ -455,7 +458,7 @@ impl Simulator for DynamicModel {
                 omega = w1;
             }
             prev = Some(*push);
-            let seg = SegmentDynamics::new(body, push);
+            let seg = SegmentDynamics::with_inertial_term(body, push, self.inertial_term);
             let mut report = SegmentReport {
                 index: j,
                 t_start: t0,

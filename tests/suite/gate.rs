@@ -1,0 +1,114 @@
+//! The engine gate must be able to fail: wrong readings of the model are
+//! caught by `validate`'s comparison against rapier2d, the derived one passes.
+
+use std::path::PathBuf;
+
+use pushval::harness::{analyse_segments_with, compare, run_scenario, ModelRun, RunOptions};
+use pushval_model::{DynamicModel, InertialTerm, Problem, Simulator, Switching};
+use pushval_rapier::RapierSimulator;
+use pushval_scenario::{ModelKind, Scenario};
+use rstest::rstest;
+
+use crate::common::*;
+
+/// The engine's run of the physical scene.
+fn engine(sc: &Scenario) -> ModelRun {
+    let settings = pushval::harness::engine_settings(sc);
+    ModelRun {
+        kind: ModelKind::Rapier2d,
+        trajectory: RapierSimulator { settings }
+            .simulate(&sc.problem())
+            .unwrap(),
+        settings: serde_json::Value::Null,
+        elapsed: Default::default(),
+        diagnostics: serde_json::Value::Null,
+    }
+}
+
+/// Gate a model reading (its problem and its model) against the engine run of
+/// the physical scene `sc`, with `sc`'s tolerances.
+fn gate(sc: &Scenario, model: DynamicModel, model_problem: &Problem) -> pushval::Comparison {
+    let tr = model.simulate(model_problem).unwrap();
+    let segments = analyse_segments_with(sc, model_problem, &tr, model.inertial_term);
+    compare(sc, &segments, &tr, &engine(sc), true)
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Reading {
+    Derived,
+    PrintedInertia,
+    FlippedInertialTerm,
+    ContinuousSwitching,
+}
+
+// Columns: the scenario the engine runs, the model's reading, whether the gate passes.
+#[rstest]
+#[case::derived_v1("paper-square-v1.0.toml", Reading::Derived, true)]
+#[case::derived_v06("paper-square-v0.6.toml", Reading::Derived, true)]
+#[case::printed("paper-square-v1.0.toml", Reading::PrintedInertia, false)]
+#[case::flipped("paper-square-v1.0.toml", Reading::FlippedInertialTerm, false)]
+#[case::continuous("paper-square-v1.0.toml", Reading::ContinuousSwitching, false)]
+fn gate_catches_wrong_models(#[case] file: &str, #[case] reading: Reading, #[case] passes: bool) {
+    let sc = load(&root().join("scenarios").join(file));
+    let mut model = DynamicModel::default();
+    let mut problem = sc.problem();
+    match reading {
+        Reading::Derived => {}
+        Reading::PrintedInertia => {
+            // The paper's Table I: 0.1667 kg m² about the contact point.
+            let printed = load(&root().join("scenarios/printed-inertia-v1.0.toml"));
+            problem.body = printed.body();
+        }
+        Reading::FlippedInertialTerm => model.inertial_term = InertialTerm::Flipped,
+        Reading::ContinuousSwitching => problem.switching = Switching::Continuous,
+    }
+    let c = gate(&sc, model, &problem);
+    assert_eq!(c.pass, Some(passes), "{reading:?}: {c:?}");
+    if !passes {
+        assert!(
+            !c.failed.is_empty() && c.failed.iter().all(|f| f.contains("_max")),
+            "{:?}",
+            c.failed
+        );
+    }
+}
+
+/// The engine converges to the model at first order in dt, and Richardson
+/// extrapolation of its steady ω lands within 1e-6 of ω* (issue target).
+#[test]
+fn engine_converges_at_first_order_and_extrapolates_to_the_root() {
+    let sc = load(&root().join("scenarios/paper-square-v1.0.toml"));
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let c = report
+        .comparisons
+        .iter()
+        .find(|c| c.model == "rapier2d")
+        .unwrap();
+    let conv = c.convergence.as_ref().unwrap();
+    assert!(conv.orders.len() >= 3, "too few settled segments: {conv:?}");
+    for (seg, p) in &conv.orders {
+        assert!((0.9..=1.1).contains(p), "segment {seg}: observed order {p}");
+    }
+    assert!(conv.richardson2_rel_max <= 1e-6, "{conv:?}");
+    assert!(
+        conv.richardson1_rel_max < conv.plain_rel_max / 10.0,
+        "{conv:?}"
+    );
+}
+
+/// At the default dt = 1e-3, every scenario's engine steady ω is within 1e-4
+/// (relative) of ω* (issue target), and the scenario's own tolerances hold.
+#[rstest]
+fn engine_meets_steady_target(#[files("scenarios/*.toml")] path: PathBuf) {
+    let sc = load(&path);
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let c = report
+        .comparisons
+        .iter()
+        .find(|c| c.model == "rapier2d")
+        .unwrap();
+    assert_eq!(c.pass, Some(true), "{c:?}");
+    if let Some(e) = c.omega_steady_rel_max {
+        assert!(e <= 1e-4, "steady-ω error {e:e}");
+    }
+}
