@@ -372,7 +372,43 @@ pub fn compare(
     run: &ModelRun,
     gated: bool,
 ) -> Comparison {
-    let tr = &run.trajectory;
+    let steady = match run.kind {
+        ModelKind::Dynamic | ModelKind::Kinematic | ModelKind::LimitSurface => {
+            SteadyRead::SegmentEnd
+        }
+        ModelKind::Rapier2d => SteadyRead::TailMean,
+    };
+    compare_trajectory(
+        sc,
+        segments,
+        reference,
+        run.kind.name(),
+        &run.trajectory,
+        steady,
+        gated,
+    )
+}
+
+/// How a trajectory's steady ω per segment is read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SteadyRead {
+    /// ω at the segment's end (analytic models: exact).
+    SegmentEnd,
+    /// Mean ω over the segment's last 20 % (engines, outside trajectories).
+    TailMean,
+}
+
+/// Compares any trajectory, named `name`, with a reference at common sample
+/// times, and its steady ω with the roots ω* of the settled segments.
+pub fn compare_trajectory(
+    sc: &Scenario,
+    segments: &[SegmentInfo],
+    reference: &Trajectory,
+    name: &str,
+    tr: &Trajectory,
+    steady: SteadyRead,
+    gated: bool,
+) -> Comparison {
     let mut position_max: f64 = 0.0;
     let mut theta_max: f64 = 0.0;
     for (a, b) in tr.samples.iter().zip(&reference.samples) {
@@ -386,12 +422,9 @@ pub fn compare(
     let mut omega_rel: Option<f64> = None;
     for s in segments.iter().filter(|s| s.settles()) {
         let ws = s.omega_steady.expect("settles implies a root").omega;
-        let w = match run.kind {
-            ModelKind::Dynamic => tr.segments.get(s.index).map(|r| r.omega_end),
-            ModelKind::Kinematic | ModelKind::LimitSurface => {
-                tr.segments.get(s.index).map(|r| r.omega_end)
-            }
-            _ => tail_omega(tr, s.t_start, s.t_end),
+        let w = match steady {
+            SteadyRead::SegmentEnd => tr.segments.get(s.index).map(|r| r.omega_end),
+            SteadyRead::TailMean => tail_omega(tr, s.t_start, s.t_end),
         };
         if let Some(w) = w {
             let e = rel_err(w, ws, s.speed, sc.froude_length());
@@ -423,7 +456,7 @@ pub fn compare(
         }
     }
     Comparison {
-        model: run.kind.name().into(),
+        model: name.into(),
         position_max,
         theta_max,
         omega_steady_rel_max: omega_rel,

@@ -4,5 +4,6 @@
 
 pub mod harness;
 pub mod output;
+pub mod outside;
 
 pub use harness::{run_scenario, Comparison, ModelRun, RunOptions, ScenarioReport, SegmentInfo};

@@ -29,9 +29,21 @@ enum Command {
     Validate {
         /// Scenario files (default: every *.toml in scenarios/).
         files: Vec<PathBuf>,
-        /// Print the table as JSON instead.
+        /// Print the table as JSON instead (one summary.json document per scenario).
         #[arg(long)]
         json: bool,
+        /// Also write a JUnit XML report to this file (for CI systems).
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
+    },
+    /// Measure an outside trajectory (trajectory.csv columns) against the
+    /// dynamic model and rapier2d with the scenario's tolerances; exit 1 when
+    /// one fails.
+    Compare {
+        file: PathBuf,
+        /// The outside trajectory: model,t,x,y,theta,omega on the scenario's time grid.
+        #[arg(long, value_name = "CSV")]
+        trajectory: PathBuf,
     },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
@@ -71,7 +83,11 @@ fn load_all(files: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
         .collect()
 }
 
-fn validate(files: Vec<PathBuf>, as_json: bool) -> anyhow::Result<ExitCode> {
+fn validate(
+    files: Vec<PathBuf>,
+    as_json: bool,
+    junit: Option<PathBuf>,
+) -> anyhow::Result<ExitCode> {
     let files = if files.is_empty() {
         default_scenarios()?
     } else {
@@ -84,6 +100,9 @@ fn validate(files: Vec<PathBuf>, as_json: bool) -> anyhow::Result<ExitCode> {
         let r = run_scenario(sc, &opts)
             .with_context(|| format!("{}: running the models", sc.path.display()))?;
         reports.push(r);
+    }
+    if let Some(path) = &junit {
+        output::write_atomic(path, output::junit(&reports).as_bytes())?;
     }
     if as_json {
         let rows: Vec<serde_json::Value> = reports.iter().map(output::summary).collect();
@@ -135,12 +154,34 @@ fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
     })
 }
 
+fn compare(file: PathBuf, csv: PathBuf) -> anyhow::Result<ExitCode> {
+    let sc = Scenario::from_path(&file)?;
+    let outside = pushval::outside::read_csv(&csv)?;
+    let (mut report, comparisons) = pushval::outside::compare_outside(&sc, &outside, &csv)?;
+    report.comparisons = comparisons;
+    print!("{}", output::table(std::slice::from_ref(&report)));
+    let failed: Vec<_> = report
+        .comparisons
+        .iter()
+        .filter(|c| c.pass == Some(false))
+        .collect();
+    for c in &failed {
+        eprintln!("FAIL {} / {}: {}", sc.name, c.model, c.failed.join("; "));
+    }
+    Ok(if failed.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => validate(Vec::new(), false),
-        Some(Command::Validate { files, json }) => validate(files, json),
+        None => validate(Vec::new(), false, None),
+        Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Compare { file, trajectory }) => compare(file, trajectory),
     };
     match result {
         Ok(code) => code,

@@ -282,3 +282,66 @@ pub fn table(reports: &[ScenarioReport]) -> String {
     }
     out
 }
+
+/// A JUnit XML report: one `<testsuite>` per scenario, one `<testcase>` per
+/// model. Gated models that fail carry a `<failure>` naming the figure;
+/// informational models pass with their figures in `<system-out>`; models
+/// this build cannot run are `<skipped>`.
+pub fn junit(reports: &[ScenarioReport]) -> String {
+    use quick_xml::escape::escape;
+    let mut cases = 0;
+    let mut failures = 0;
+    let mut body = String::new();
+    for r in reports {
+        let name = escape(r.scenario.name.as_str()).into_owned();
+        let n = r.comparisons.len();
+        let f = r
+            .comparisons
+            .iter()
+            .filter(|c| c.pass == Some(false))
+            .count();
+        cases += n;
+        failures += f;
+        body.push_str(&format!(
+            "  <testsuite name=\"{name}\" tests=\"{n}\" failures=\"{f}\" file=\"{}\">\n",
+            escape(r.scenario.path.display().to_string())
+        ));
+        for c in &r.comparisons {
+            let time = r
+                .runs
+                .iter()
+                .find(|run| run.kind.name() == c.model)
+                .map_or(0.0, |run| run.elapsed.as_secs_f64());
+            body.push_str(&format!(
+                "    <testcase classname=\"pushval.{name}\" name=\"{}\" time=\"{time:.6}\">\n",
+                escape(c.model.as_str())
+            ));
+            let figures = format!(
+                "position_max={} m theta_max={} rad omega_steady_rel_max={}",
+                fmt_e(c.position_max),
+                fmt_e(c.theta_max),
+                c.omega_steady_rel_max.map_or("-".into(), fmt_e)
+            );
+            match (&c.error, c.pass) {
+                (Some(e), None) => body.push_str(&format!(
+                    "      <skipped message=\"{}\"/>\n",
+                    escape(e.as_str())
+                )),
+                (_, Some(false)) => body.push_str(&format!(
+                    "      <failure type=\"tolerance\" message=\"{}\">{}</failure>\n",
+                    escape(c.failed.join("; ")),
+                    escape(figures.as_str())
+                )),
+                _ => body.push_str(&format!(
+                    "      <system-out>{}</system-out>\n",
+                    escape(figures.as_str())
+                )),
+            }
+            body.push_str("    </testcase>\n");
+        }
+        body.push_str("  </testsuite>\n");
+    }
+    format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"pushval\" tests=\"{cases}\" failures=\"{failures}\">\n{body}</testsuites>\n"
+    )
+}

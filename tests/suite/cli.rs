@@ -89,3 +89,89 @@ fn failing_tolerance_exits_1_and_names_the_figure() {
         "{err}"
     );
 }
+
+/// `compare` gates an outside trajectory: the dynamic model's own samples,
+/// renamed, pass; the kinematic model's samples fail with the figure named.
+#[test]
+fn compare_gates_an_outside_trajectory() {
+    let dir = tempfile::tempdir().unwrap();
+    let scen = root().join("scenarios/paper-square-v0.6.toml");
+    let out = dir.path().join("run");
+    assert!(pushval()
+        .arg("run")
+        .arg(&scen)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap()
+        .status
+        .success());
+    let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    let pick = |model: &str| {
+        let mut s = String::from("model,t,x,y,theta,omega\n");
+        for l in csv.lines().filter(|l| l.starts_with(&format!("{model},"))) {
+            s.push_str(&l.replacen(model, "mine", 1));
+            s.push('\n');
+        }
+        s
+    };
+    let good = dir.path().join("good.csv");
+    std::fs::write(&good, pick("dynamic")).unwrap();
+    let st = pushval()
+        .arg("compare")
+        .arg(&scen)
+        .arg("--trajectory")
+        .arg(&good)
+        .output()
+        .unwrap();
+    assert_eq!(
+        st.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&st.stdout)
+    );
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, pick("kinematic")).unwrap();
+    let st = pushval()
+        .arg("compare")
+        .arg(&scen)
+        .arg("--trajectory")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&st.stderr).contains("mine vs dynamic: position_max"));
+    let broken = dir.path().join("broken.csv");
+    std::fs::write(&broken, "model,t,x,y,theta,omega\nmine,0,0,0,zero,0\n").unwrap();
+    let st = pushval()
+        .arg("compare")
+        .arg(&scen)
+        .arg("--trajectory")
+        .arg(&broken)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&st.stderr).contains("line 2: column `theta`"));
+}
+
+/// `--junit` writes one testcase per scenario and model, failures named.
+#[test]
+fn junit_report_names_the_failing_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("scenarios/paper-square-v0.2.toml")).unwrap();
+    let tight = dir.path().join("tight.toml");
+    std::fs::write(&tight, format!("{text}\n[tolerance]\ntheta_max = 1e-9\n")).unwrap();
+    let xml = dir.path().join("report.xml");
+    let st = pushval()
+        .arg("validate")
+        .arg(&tight)
+        .arg("--junit")
+        .arg(&xml)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    let x = std::fs::read_to_string(&xml).unwrap();
+    assert_eq!(x.matches("<testcase ").count(), 4, "{x}");
+    assert_eq!(x.matches("<failure ").count(), 1);
+    assert!(x.contains("name=\"rapier2d\"") && x.contains("theta_max"));
+}
