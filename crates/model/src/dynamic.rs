@@ -160,19 +160,32 @@ impl SegmentDynamics {
     /// a support nearly stops and would misplace a pivot by ~1e-8 relative.
     #[inline]
     pub fn friction_moment_at(&self, v: f64, omega: f64) -> f64 {
-        let (f, rx, ry) = (&self.f[..], &self.rx[..], &self.ry[..]);
-        let n = f.len().min(rx.len()).min(ry.len());
         let (vx, vy) = (v * self.dir.x, v * self.dir.y);
-        let mut acc = 0.0;
-        for i in 0..n {
-            let ux = vx - omega * ry[i];
-            let uy = vy + omega * rx[i];
-            let u2 = ux * ux + uy * uy;
-            let num = rx[i] * uy - ry[i] * ux;
-            let inv = if u2 > 0.0 { u2.sqrt().recip() } else { 0.0 };
-            acc -= f[i] * num * inv;
+        // Branch-free body over four independent accumulators, so the loop
+        // vectorises (a single f64 sum would be a serial dependency chain).
+        // Where u_i = 0 its moment arm r_i × u_i is 0 too, and the clamp turns
+        // 0/0 into 0: a support at rest contributes nothing.
+        let term = |f: f64, rx: f64, ry: f64| {
+            let ux = vx - omega * ry;
+            let uy = vy + omega * rx;
+            let u2 = (ux * ux + uy * uy).max(f64::MIN_POSITIVE);
+            f * (rx * uy - ry * ux) / u2.sqrt()
+        };
+        let n = self.f.len();
+        let (f, rx, ry) = (&self.f[..n], &self.rx[..n], &self.ry[..n]);
+        let mut acc = [0.0f64; 4];
+        let chunks = n / 4;
+        for c in 0..chunks {
+            let k = 4 * c;
+            for l in 0..4 {
+                acc[l] += term(f[k + l], rx[k + l], ry[k + l]);
+            }
         }
-        acc
+        let mut tail = 0.0;
+        for i in 4 * chunks..n {
+            tail += term(f[i], rx[i], ry[i]);
+        }
+        -((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail)
     }
 
     /// `G(ω) = I_P ω̇` (N m).

@@ -174,6 +174,18 @@ pub fn next_step(h: f64, err: f64) -> f64 {
     h * fac
 }
 
+/// Next step size for the 8th-order pair: exponent 1/8, growth in [1/3, 6]
+/// (Hairer's DOP853 defaults).
+#[inline]
+pub fn next_step8(h: f64, err: f64) -> f64 {
+    let fac = if err == 0.0 {
+        6.0
+    } else {
+        (0.9 * err.powf(-0.125)).clamp(1.0 / 3.0, 6.0)
+    };
+    h * fac
+}
+
 /// Initial step size (Hairer, Nørsett & Wanner, Sec. II.4): from the size of
 /// the derivative, a trial Euler step and its second-derivative estimate.
 pub fn initial_step<F: FnMut(&State) -> State>(
@@ -284,5 +296,179 @@ mod tests {
         };
         let p = (run(20) / run(40)).log2();
         assert!((3.8..4.2).contains(&p), "order {p}");
+    }
+}
+
+/// Dormand & Prince's 8(5,3) pair (DOP853; Hairer, Nørsett & Wanner, Solving
+/// ODEs I, Sec. II.10) with its 7th-order continuous extension. Twelve stages
+/// per step (the thirteenth, f at the new point, is the next step's first);
+/// the dense output costs three more, taken only for steps that hold a sample.
+pub mod dop853 {
+    use super::{State, N};
+    use crate::dop853_tables::{A, D, E3_SUB, E5};
+
+    /// One attempted step.
+    pub struct Attempt {
+        pub y1: State,
+        /// f(y1): the next step's first stage.
+        pub k13: State,
+        /// Error norm; acceptable when ≤ 1.
+        pub err: f64,
+        k: [State; 13],
+    }
+
+    #[inline]
+    fn stage(y0: &State, h: f64, k: &[State], row: &[f64; 16], upto: usize) -> State {
+        let mut out = *y0;
+        for (j, kj) in k.iter().enumerate().take(upto) {
+            let a = row[j];
+            if a != 0.0 {
+                for i in 0..N {
+                    out[i] += h * a * kj[i];
+                }
+            }
+        }
+        out
+    }
+
+    /// One DOP853 step of size `h` from `y0` with derivative `k1`; error
+    /// weights `atol + rtol_i max(|y0_i|, |y1_i|)`, the combined 5th/3rd-order
+    /// estimate of Hairer's code.
+    pub fn attempt<F: FnMut(&State) -> State>(
+        f: &mut F,
+        y0: &State,
+        k1: &State,
+        h: f64,
+        atol: f64,
+        rtol: &State,
+    ) -> Attempt {
+        let mut k = [[0.0; N]; 13];
+        k[0] = *k1;
+        for s in 1..12 {
+            k[s] = f(&stage(y0, h, &k, &A[s], s));
+        }
+        let y1 = stage(y0, h, &k, &A[12], 12);
+        k[12] = f(&y1);
+        let (mut e5, mut e3) = (0.0, 0.0);
+        for i in 0..N {
+            let sc = atol + rtol[i] * y0[i].abs().max(y1[i].abs());
+            let mut d5 = 0.0;
+            let mut d3 = 0.0;
+            for s in 0..13 {
+                d5 += E5[s] * k[s][i];
+                let b = if s < 12 { A[12][s] } else { 0.0 };
+                d3 += b * k[s][i];
+            }
+            for (s, sub) in E3_SUB {
+                d3 -= sub * k[s][i];
+            }
+            e5 += (d5 / sc).powi(2);
+            e3 += (d3 / sc).powi(2);
+        }
+        let deno = e5 + 0.01 * e3;
+        let err = if deno > 0.0 {
+            h.abs() * e5 / (deno * N as f64).sqrt()
+        } else {
+            0.0
+        };
+        Attempt {
+            y1,
+            k13: k[12],
+            err: if err.is_nan() { f64::INFINITY } else { err },
+            k,
+        }
+    }
+
+    /// The 7th-order dense output over an accepted step.
+    #[derive(Debug, Clone, Copy)]
+    pub struct Dense {
+        pub t0: f64,
+        pub h: f64,
+        y0: State,
+        r: [State; 7],
+    }
+
+    impl Attempt {
+        /// Builds the dense output (three more evaluations of `f`).
+        pub fn dense<F: FnMut(&State) -> State>(&self, f: &mut F, t0: f64, y0: &State, h: f64) -> Dense {
+            let mut k = [[0.0; N]; 16];
+            k[..13].copy_from_slice(&self.k);
+            for s in 13..16 {
+                k[s] = f(&stage(y0, h, &k, &A[s], s));
+            }
+            let mut r = [[0.0; N]; 7];
+            for i in 0..N {
+                let dy = self.y1[i] - y0[i];
+                r[0][i] = dy;
+                r[1][i] = h * k[0][i] - dy;
+                r[2][i] = 2.0 * dy - h * (k[12][i] + k[0][i]);
+                for (row, d) in D.iter().enumerate() {
+                    let mut acc = 0.0;
+                    for s in 0..16 {
+                        acc += d[s] * k[s][i];
+                    }
+                    r[3 + row][i] = h * acc;
+                }
+            }
+            Dense { t0, h, y0: *y0, r }
+        }
+    }
+
+    impl Dense {
+        /// The state at time `t` within the step.
+        pub fn eval(&self, t: f64) -> State {
+            let s = (t - self.t0) / self.h;
+            let s1 = 1.0 - s;
+            let mut out = [0.0; N];
+            for (i, o) in out.iter_mut().enumerate() {
+                let r = &self.r;
+                // y0 + s(r0 + s1(r1 + s(r2 + s1(r3 + s(r4 + s1(r5 + s r6))))))
+                let mut acc = r[6][i];
+                acc = r[5][i] + s * acc;
+                acc = r[4][i] + s1 * acc;
+                acc = r[3][i] + s * acc;
+                acc = r[2][i] + s1 * acc;
+                acc = r[1][i] + s * acc;
+                acc = r[0][i] + s1 * acc;
+                *o = self.y0[i] + s * acc;
+            }
+            out
+        }
+    }
+}
+
+#[cfg(test)]
+mod dop853_tests {
+    use super::dop853;
+    use super::*;
+
+    fn f(y: &State) -> State {
+        [-0.5 * y[0] + y[1], -y[0] - 0.5 * y[1], -y[2], 2.0 * y[3]]
+    }
+    fn exact(t: f64) -> State {
+        let e = (-0.5 * t).exp();
+        [e * t.cos(), -e * t.sin(), (-t).exp(), (2.0 * t).exp()]
+    }
+
+    /// Local error O(h⁹) for the 8th-order step, O(h⁸) for the 7th-order interpolant.
+    #[test]
+    fn dop853_orders() {
+        let y0 = exact(0.0);
+        let mut g = |y: &State| f(y);
+        let k1 = g(&y0);
+        let (mut e, mut d) = (vec![], vec![]);
+        for h in [0.4, 0.2] {
+            let a = dop853::attempt(&mut g, &y0, &k1, h, 1.0, &[0.0; N]);
+            let ex = exact(h);
+            e.push((0..N).map(|i| (a.y1[i] - ex[i]).abs()).fold(0.0, f64::max));
+            let dn = a.dense(&mut g, 0.0, &y0, h);
+            let ym = dn.eval(0.37 * h);
+            let exm = exact(0.37 * h);
+            d.push((0..N).map(|i| (ym[i] - exm[i]).abs()).fold(0.0, f64::max));
+        }
+        let p = (e[0] / e[1]).log2();
+        let pd = (d[0] / d[1]).log2();
+        assert!((8.4..9.8).contains(&p), "local order {p} {e:?}");
+        assert!((7.4..8.8).contains(&pd), "dense local order {pd} {d:?}");
     }
 }

@@ -21,6 +21,8 @@
 
 mod arc;
 mod body;
+#[allow(clippy::excessive_precision, dead_code)]
+mod dop853_tables;
 pub mod dynamic;
 mod error;
 pub mod integrate;

@@ -154,9 +154,30 @@ pub enum Integrator {
     /// Dormand–Prince 5(4) with dense output; per-step error ≤ `tol` (m, rad)
     /// in θ and the position, and ≤ `tol (1 + |ω|)` in ω (RMS over the state).
     Adaptive { tol: f64 },
+    /// Dormand & Prince's 8(5,3) pair (DOP853) with its 7th-order dense
+    /// output; the same error measure as `Adaptive`.
+    Dop853 { tol: f64 },
     /// Classical RK4, fixed step at most `dt` (s), shortened so every switch
     /// falls on a step; samples by cubic Hermite interpolation.
     Rk4 { dt: f64 },
+}
+
+/// Dense output of either adaptive method over one accepted step.
+enum AnyDense {
+    Five(integrate::Dense),
+    Eight(integrate::dop853::Dense),
+    /// No sample in the step: nothing built.
+    None,
+}
+
+impl AnyDense {
+    fn eval(&self, t: f64) -> integrate::State {
+        match self {
+            AnyDense::Five(d) => d.eval(t),
+            AnyDense::Eight(d) => d.eval(t),
+            AnyDense::None => unreachable!("dense output is built for every step holding a sample"),
+        }
+    }
 }
 
 /// The dynamic model as a [`Simulator`] (name `"dynamic"`).
@@ -218,7 +239,7 @@ impl SettleRule {
         let dt = d * self.tau;
         let e_theta = self.q.abs() * dt * dt;
         let e_pos = 0.5 * dt * dt * self.speed * remaining;
-        !d.is_nan() && e_theta.max(e_pos) <= 0.1 * self.tol
+        !d.is_nan() && e_theta.max(e_pos) <= SETTLE_FRACTION * self.tol
     }
     fn tail(&self, t: f64, c: Vec2, theta: f64, w: f64, vel: Vec2) -> Tail {
         Tail {
@@ -232,6 +253,9 @@ impl SettleRule {
         }
     }
 }
+
+/// Share of the tolerance the settled tail may leave out.
+const SETTLE_FRACTION: f64 = 0.1;
 
 /// Closed-form motion after a segment has settled: ω relaxes exponentially
 /// onto ω*, `θ = θ_s + ω* s + δτ (1 − e^{−s/τ})`, and the contact point follows
@@ -411,7 +435,7 @@ impl Simulator for DynamicModel {
 
     fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
         problem.check()?;
-        if let Integrator::Adaptive { tol } = self.integrator {
+        if let Integrator::Adaptive { tol } | Integrator::Dop853 { tol } = self.integrator {
             if !(tol.is_finite() && tol > 0.0) {
                 return Err(ModelError::Parameter {
                     name: "tolerance",
@@ -504,7 +528,7 @@ impl Simulator for DynamicModel {
             }
             let vel = push.velocity();
             let tol = match self.integrator {
-                Integrator::Adaptive { tol } => tol,
+                Integrator::Adaptive { tol } | Integrator::Dop853 { tol } => tol,
                 Integrator::Rk4 { dt } => dt.powi(4),
             };
             let settle = match target {
@@ -604,7 +628,8 @@ impl Simulator for DynamicModel {
                 let mut k1 = rhs(&y);
                 out.stats.rhs_evals += 1;
                 match self.integrator {
-                    Integrator::Adaptive { tol } => {
+                    Integrator::Adaptive { tol } | Integrator::Dop853 { tol } => {
+                        let eighth = matches!(self.integrator, Integrator::Dop853 { .. });
                         // Relative tolerance on ω only: the angle and the
                         // position depend on the choice of frame, and their
                         // error must not (invariance under rigid motion).
@@ -624,11 +649,30 @@ impl Simulator for DynamicModel {
                                     landing = false;
                                 }
                             }
-                            let a = integrate::dp5_attempt(&mut rhs, &y, &k1, hh, tol, &rtol);
-                            out.stats.rhs_evals += 6;
-                            if a.err <= 1.0 {
+                            let (a5, a8) = if eighth {
+                                out.stats.rhs_evals += 12;
+                                (None, Some(integrate::dop853::attempt(&mut rhs, &y, &k1, hh, tol, &rtol)))
+                            } else {
+                                out.stats.rhs_evals += 6;
+                                (Some(integrate::dp5_attempt(&mut rhs, &y, &k1, hh, tol, &rtol)), None)
+                            };
+                            let (err, y1, k_next) = match (&a5, &a8) {
+                                (Some(a), _) => (a.err, a.y1, a.k7),
+                                (_, Some(a)) => (a.err, a.y1, a.k13),
+                                _ => unreachable!("one method ran"),
+                            };
+                            if err <= 1.0 {
                                 let t_new = if landing { t1 } else { t + hh };
-                                let dense = a.dense(t, &y, hh);
+                                // DOP853's interpolant costs three evaluations:
+                                // build it only for steps that hold a sample.
+                                let dense = match (&a5, &a8) {
+                                    (Some(a), _) => AnyDense::Five(a.dense(t, &y, hh)),
+                                    (_, Some(a)) if sampler.due(t_new, t1, last).is_some() => {
+                                        out.stats.rhs_evals += 3;
+                                        AnyDense::Eight(a.dense(&mut rhs, t, &y, hh))
+                                    }
+                                    _ => AnyDense::None,
+                                };
                                 while let Some(ts) = sampler.due(t_new, t1, last) {
                                     let ys = dense.eval(ts);
                                     out.samples.push(pose_sample(
@@ -642,8 +686,8 @@ impl Simulator for DynamicModel {
                                     sampler.next += 1;
                                 }
                                 let w_before = y[1];
-                                y = a.y1;
-                                k1 = a.k7;
+                                y = y1;
+                                k1 = k_next;
                                 t = t_new;
                                 out.stats.steps += 1;
                                 if t < t1
@@ -659,7 +703,7 @@ impl Simulator for DynamicModel {
                                         step: out.stats.steps,
                                     });
                                 }
-                                let hn = integrate::next_step(hh, a.err);
+                                let hn = if eighth { integrate::next_step8(hh, err) } else { integrate::next_step(hh, err) };
                                 if !landing || hn < h {
                                     h = hn;
                                 }
@@ -672,7 +716,7 @@ impl Simulator for DynamicModel {
                                 }
                             } else {
                                 out.stats.rejected += 1;
-                                h = integrate::next_step(hh, a.err);
+                                h = if eighth { integrate::next_step8(hh, err) } else { integrate::next_step(hh, err) };
                                 if !(h > 1e-14 * t.abs().max(1.0)) {
                                     return Err(ModelError::Integration {
                                         t,

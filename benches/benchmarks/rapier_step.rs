@@ -1,0 +1,42 @@
+//! The rapier2d pusher scene: a 1 s, one-segment run at dt = 1e-3 (1000 steps),
+//! by precision and friction-velocity mode.
+
+use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
+use pushval_model::{Initial, Problem, Push, Switching};
+use pushval_rapier::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
+use std::hint::black_box;
+
+fn rapier_step(c: &mut Criterion) {
+    let problem = Problem {
+        body: super::plate(4),
+        limits: Default::default(),
+        pushes: vec![Push {
+            duration: 1.0,
+            speed: 1.0,
+            phi: 1.0854,
+        }],
+        initial: Initial::default(),
+        switching: Switching::Impulsive,
+        sample_dt: 0.01,
+    };
+    let mut g = c.benchmark_group("rapier_step");
+    g.throughput(Throughput::Elements(1000));
+    for precision in [Precision::F64, Precision::F32] {
+        for mode in FrictionVelocity::ALL {
+            let settings = EngineSettings {
+                precision,
+                friction_velocity: mode,
+                ..Default::default()
+            };
+            let sim = RapierSimulator { settings };
+            g.bench_with_input(
+                BenchmarkId::new(precision.as_str(), mode.as_str()),
+                &sim,
+                |b, sim| b.iter(|| black_box(sim.run(&problem).unwrap())),
+            );
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, rapier_step);

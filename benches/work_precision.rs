@@ -1,0 +1,314 @@
+//! Work–precision on the 10 s paper trajectory (1 m/s, five segments):
+//! every method's median run time against its error, measured side by side in
+//! one process. Writes `results/work_precision.csv` (and the figure when the
+//! report's plotting is available).
+//!
+//! `cargo bench --bench work_precision` (add `-- --quick` for fewer repeats).
+//!
+//! Error is measured against a DOP853 run at 1e-13: the largest centre-of-mass
+//! distance over the samples (m) and the largest relative steady-ω error over
+//! the settled segments. Methods: pushval's DOP853 and Dormand–Prince 5(4)
+//! (with the settled-arc shortcut), fixed-step RK4, ode_solvers' Dopri5 and
+//! Dop853 on the same right-hand side, and rapier2d (f64, f32; friction
+//! velocity body / constraint / midpoint; plain and Richardson-extrapolated).
+
+use std::time::{Duration, Instant};
+
+use ode_solvers::{Dop853, Dopri5, System, Vector4};
+use pushval::harness::{analyse_segments, rel_err, tail_omega, SegmentInfo};
+use pushval_model::{
+    DynamicModel, Integrator, Problem, SegmentDynamics, Simulator, Switching, Trajectory, Vec2,
+};
+use pushval_rapier::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
+use pushval_scenario::Scenario;
+
+struct Row {
+    method: String,
+    family: String,
+    setting: String,
+    rhs_evals: Option<usize>,
+    median_s: f64,
+    position_err: f64,
+    omega_rel_err: Option<f64>,
+}
+
+/// Median wall time of `runs` calls (at least one), and the last result.
+fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
+    let mut times = Vec::with_capacity(runs);
+    let mut last = None;
+    for _ in 0..runs.max(1) {
+        let t0 = Instant::now();
+        let r = f();
+        times.push(t0.elapsed());
+        last = Some(r);
+    }
+    times.sort();
+    (times[times.len() / 2], last.expect("ran at least once"))
+}
+
+fn errors(
+    sc: &Scenario,
+    segs: &[SegmentInfo],
+    reference: &Trajectory,
+    tr: &Trajectory,
+    tail: bool,
+) -> (f64, Option<f64>) {
+    let pos = tr
+        .samples
+        .iter()
+        .zip(&reference.samples)
+        .map(|(p, q)| ((p.x - q.x).powi(2) + (p.y - q.y).powi(2)).sqrt())
+        .fold(0.0, f64::max);
+    // The same reading of the steady ω on the method and on the reference
+    // (a segment's ω need not have reached ω* exactly by its end).
+    let mut om: Option<f64> = None;
+    for s in segs.iter().filter(|s| s.settles()) {
+        let read = |tr: &Trajectory| {
+            if tail {
+                tail_omega(tr, s.t_start, s.t_end)
+            } else {
+                tr.segments.get(s.index).map(|r| r.omega_end)
+            }
+        };
+        if let (Some(w), Some(wr)) = (read(tr), read(reference)) {
+            let e = rel_err(w, wr, s.speed, sc.froude_length());
+            om = Some(om.map_or(e, |m: f64| m.max(e)));
+        }
+    }
+    (pos, om)
+}
+
+/// The pushing ODE for one segment in ode_solvers' terms: [θ, ω, c_x, c_y].
+struct Peer<'a> {
+    seg: &'a SegmentDynamics,
+    vel: Vec2,
+}
+
+impl System<f64, Vector4<f64>> for Peer<'_> {
+    fn system(&self, _t: f64, y: &Vector4<f64>, dy: &mut Vector4<f64>) {
+        let (s, c) = y[0].sin_cos();
+        dy[0] = y[1];
+        dy[1] = self.seg.omega_dot(y[1]);
+        dy[2] = c * self.vel.x - s * self.vel.y;
+        dy[3] = s * self.vel.x + c * self.vel.y;
+    }
+}
+
+/// Runs the problem segment by segment with an ode_solvers method, the same
+/// impulsive switches as the model, dense output at the sample times.
+fn peer(problem: &Problem, tol: f64, eighth: bool) -> (Trajectory, usize) {
+    let body = &problem.body;
+    let pc = body.contact();
+    let mut theta = problem.initial.theta;
+    let mut c = problem.initial.position + pushval_model::rotate(theta, &pc);
+    let mut omega = problem.initial.omega;
+    let mut evals = 0usize;
+    let mut tr = Trajectory {
+        model: "peer".into(),
+        ..Default::default()
+    };
+    let n = problem.pushes.len();
+    for (j, (push, (t0, t1))) in problem
+        .pushes
+        .iter()
+        .zip(problem.segment_times())
+        .enumerate()
+    {
+        if j > 0 {
+            omega = problem.omega_after_switch(Some(&problem.pushes[j - 1]), push, omega);
+        }
+        let seg = SegmentDynamics::new(body, push);
+        let sys = Peer {
+            seg: &seg,
+            vel: push.velocity(),
+        };
+        let y0 = Vector4::new(theta, omega, c.x, c.y);
+        let (xs, ys) = if eighth {
+            let mut s = Dop853::new(sys, t0, t1, problem.sample_dt, y0, tol, tol);
+            let st = s.integrate().expect("peer integration");
+            evals += st.num_eval as usize;
+            let (x, y) = s.results().get();
+            (x.clone(), y.clone())
+        } else {
+            let mut s = Dopri5::new(sys, t0, t1, problem.sample_dt, y0, tol, tol);
+            let st = s.integrate().expect("peer integration");
+            evals += st.num_eval as usize;
+            let (x, y) = s.results().get();
+            (x.clone(), y.clone())
+        };
+        for (t, y) in xs.iter().zip(&ys) {
+            if (*t < t1 - 1e-9 || j + 1 == n) && tr.samples.last().is_none_or(|s| *t > s.t + 1e-9) {
+                let p = Vec2::new(y[2], y[3]) - pushval_model::rotate(y[0], &pc);
+                tr.samples.push(pushval_model::Sample {
+                    t: *t,
+                    x: p.x,
+                    y: p.y,
+                    theta: y[0],
+                    omega: y[1],
+                });
+            }
+        }
+        let last = ys.last().expect("at least the end point");
+        theta = last[0];
+        omega = last[1];
+        c = Vec2::new(last[2], last[3]);
+        tr.segments.push(pushval_model::SegmentReport {
+            index: j,
+            t_start: t0,
+            t_end: t1,
+            omega_end: omega,
+            ..Default::default()
+        });
+    }
+    (tr, evals)
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let reps = if quick { 3 } else { 15 };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sc = Scenario::from_path(root.join("scenarios/paper-square-v1.0.toml")).unwrap();
+    let problem = sc.problem();
+    assert_eq!(problem.switching, Switching::Impulsive);
+    let reference = DynamicModel {
+        integrator: Integrator::Dop853 { tol: 1e-13 },
+        ..Default::default()
+    }
+    .simulate(&problem)
+    .unwrap();
+    let segs = analyse_segments(&sc, &problem, &reference);
+    let mut rows: Vec<Row> = Vec::new();
+    let tols = [
+        1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12,
+    ];
+    for tol in tols {
+        for (name, integrator) in [
+            ("pushval DOP853", Integrator::Dop853 { tol }),
+            ("pushval DP5(4)", Integrator::Adaptive { tol }),
+        ] {
+            let m = DynamicModel {
+                integrator,
+                check_assumptions: false,
+                ..Default::default()
+            };
+            let (d, tr) = time(reps, || m.simulate(&problem).unwrap());
+            let (pe, oe) = errors(&sc, &segs, &reference, &tr, false);
+            rows.push(Row {
+                method: name.into(),
+                family: "model".into(),
+                setting: format!("tol={tol:e}"),
+                rhs_evals: Some(tr.stats.rhs_evals),
+                median_s: d.as_secs_f64(),
+                position_err: pe,
+                omega_rel_err: oe,
+            });
+        }
+        for (name, eighth) in [("ode_solvers Dop853", true), ("ode_solvers Dopri5", false)] {
+            let (d, (tr, ev)) = time(reps, || peer(&problem, tol, eighth));
+            let (pe, oe) = errors(&sc, &segs, &reference, &tr, false);
+            rows.push(Row {
+                method: name.into(),
+                family: "peer".into(),
+                setting: format!("tol={tol:e}"),
+                rhs_evals: Some(ev),
+                median_s: d.as_secs_f64(),
+                position_err: pe,
+                omega_rel_err: oe,
+            });
+        }
+        eprint!(".");
+    }
+    for dt in [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4] {
+        let m = DynamicModel {
+            integrator: Integrator::Rk4 { dt },
+            skip_settled: false,
+            check_assumptions: false,
+            ..Default::default()
+        };
+        let (d, tr) = time(reps, || m.simulate(&problem).unwrap());
+        let (pe, oe) = errors(&sc, &segs, &reference, &tr, false);
+        rows.push(Row {
+            method: "pushval RK4".into(),
+            family: "model".into(),
+            setting: format!("dt={dt:e}"),
+            rhs_evals: Some(tr.stats.rhs_evals),
+            median_s: d.as_secs_f64(),
+            position_err: pe,
+            omega_rel_err: oe,
+        });
+    }
+    let dts: &[f64] = if quick {
+        &[1.0 / 60.0, 1e-3]
+    } else {
+        &[1.0 / 60.0, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5]
+    };
+    for precision in [Precision::F64, Precision::F32] {
+        for mode in FrictionVelocity::ALL {
+            for &dt in dts {
+                let run = |dt: f64| {
+                    let settings = EngineSettings {
+                        dt,
+                        precision,
+                        friction_velocity: mode,
+                        ..Default::default()
+                    };
+                    RapierSimulator { settings }.simulate(&problem).unwrap()
+                };
+                let r = if dt < 2e-4 { 1 } else { reps.min(5) };
+                let (d, tr) = time(r, || run(dt));
+                let (pe, oe) = errors(&sc, &segs, &reference, &tr, true);
+                let name = format!("rapier2d {} {}", precision.as_str(), mode.as_str());
+                rows.push(Row {
+                    method: name.clone(),
+                    family: "engine".into(),
+                    setting: format!("dt={dt:e}"),
+                    rhs_evals: None,
+                    median_s: d.as_secs_f64(),
+                    position_err: pe,
+                    omega_rel_err: oe,
+                });
+                // Richardson: 2 x(h) − x(2h) on the common samples, cost of both runs.
+                let (d2, tr2) = time(r, || run(2.0 * dt));
+                let mut rich = tr.clone();
+                for (s, c) in rich.samples.iter_mut().zip(&tr2.samples) {
+                    s.x = 2.0 * s.x - c.x;
+                    s.y = 2.0 * s.y - c.y;
+                    s.theta = 2.0 * s.theta - c.theta;
+                    s.omega = 2.0 * s.omega - c.omega;
+                }
+                let (pe, oe) = errors(&sc, &segs, &reference, &rich, true);
+                rows.push(Row {
+                    method: format!("{name} richardson"),
+                    family: "engine".into(),
+                    setting: format!("dt={dt:e}"),
+                    rhs_evals: None,
+                    median_s: (d + d2).as_secs_f64(),
+                    position_err: pe,
+                    omega_rel_err: oe,
+                });
+            }
+            eprint!(".");
+        }
+    }
+    eprintln!();
+    let mut csv = String::from(
+        "method,family,setting,rhs_evals,median_s,position_err_m,omega_steady_rel_err\n",
+    );
+    for r in &rows {
+        csv.push_str(&format!(
+            "{},{},{},{},{:.6e},{:.3e},{}\n",
+            r.method,
+            r.family,
+            r.setting,
+            r.rhs_evals.map_or(String::new(), |n| n.to_string()),
+            r.median_s,
+            r.position_err,
+            r.omega_rel_err
+                .map_or(String::new(), |e| format!("{e:.3e}"))
+        ));
+    }
+    let dir = root.join("results");
+    std::fs::create_dir_all(&dir).unwrap();
+    pushval::output::write_atomic(&dir.join("work_precision.csv"), csv.as_bytes()).unwrap();
+    print!("{csv}");
+}
