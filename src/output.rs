@@ -103,6 +103,7 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "diagnostics": run.map_or(Value::Null, |r| r.diagnostics.clone()),
                 "convergence": c.convergence.as_ref().map_or(Value::Null, |v| json!({
                     "dts": v.dts,
+                    "expected_order": v.expected_order,
                     "observed_order": opt(v.order()),
                     "orders": v.orders.iter().map(|(i, p)| json!({"segment": i, "order": num(*p)})).collect::<Vec<_>>(),
                     "omega_steady_rel_max_plain": num(v.plain_rel_max),

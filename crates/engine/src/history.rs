@@ -48,6 +48,11 @@ impl StepRecord {
 pub(crate) struct RawRun {
     pub history: Vec<StepRecord>,
     pub steps: usize,
+    /// Time spent inside rapier's `step()`.
+    pub step_time: std::time::Duration,
+    /// Time of the whole stepping loop (rapier's steps and the adapter's work
+    /// around them).
+    pub loop_time: std::time::Duration,
     pub max_drift: f64,
     pub min_support_speed: f64,
 }

@@ -7,8 +7,11 @@
 //!   mass are set directly (it has no collider: nothing collides);
 //! * the **pusher**, a kinematic velocity-based body pinned to the object at the
 //!   contact point by a revolute impulse joint. Every step its velocity is set to
-//!   `v_c R(θ) n_φ`, so the engine's joint solver prescribes the contact velocity
-//!   and produces, by itself, the contact force and the impulses at switches.
+//!   the commanded contact velocity `v_c R(θ) n_φ` (taken at a mode-dependent
+//!   angle and, in the default [`FrictionVelocity::Leapfrog`] mode, corrected
+//!   for rapier's step-start lever arm), so the engine's joint solver
+//!   prescribes the contact velocity and produces, by itself, the contact
+//!   force and the impulses at switches.
 //!
 //! Every step, each support point `i` receives the Coulomb force
 //! `−F_i u_i / |u_i|` through `add_force_at_point`, where `u_i` is the support's
@@ -68,26 +71,59 @@ pub enum FrictionVelocity {
     /// wants it: `ω` is extrapolated from the last two step velocities of the
     /// segment to the start of the step (the engine's step velocities live at
     /// mid-steps), and the pusher heading is taken at the mid-step angle
-    /// `θ + ω h / 2`. Measured the most accurate at a given `dt`; the default.
-    #[default]
+    /// `θ + ω h / 2`. First order: the joint's lever arm is taken at the
+    /// step start while the pusher velocity is a mid-step one, which leaves
+    /// an `O(h)` bias of order `m h ω³ |p_c|²` in the moment balance, and the
+    /// step velocities start and end each segment half a step out of phase.
     Midpoint,
+    /// Second order (the default). Reads rapier's symplectic Euler step as a
+    /// leapfrog (kick–drift) scheme, with the step velocities at mid-steps,
+    /// and makes every part of the step consistent with that reading:
+    ///
+    /// * friction as in [`FrictionVelocity::Midpoint`]: the constraint form
+    ///   at the step-start pose, with `ω` extrapolated to the step start;
+    /// * the pusher velocity is
+    ///   `v_c R(θ_m) n_φ + ω_m D (R(θ) − R(θ_m)) p_c`, with `ω_m` the
+    ///   extrapolated mid-step ω and `θ_m = θ + atan(h ω_m)/2` the mid-step
+    ///   angle (rapier turns a body by `atan(h ω)` per step). Since the joint
+    ///   holds the contact with the step-start lever arm `R(θ) p_c`, this
+    ///   gives the centre of mass the chord velocity
+    ///   `R(θ_m)(v_c n_φ − ω D p_c)` of the arc it should follow, and the
+    ///   joint impulse the moment of a centred difference of momenta;
+    /// * the pusher is re-pinned onto the object's contact point before each
+    ///   step, so the joint's position bias has nothing to correct and the
+    ///   body moves with exactly the velocity the joint solved for (the bias
+    ///   would otherwise push it off the chord by `h ω² p_c / 2`);
+    /// * each segment opens with a half kick (the first full step after the
+    ///   switch step applies half the friction impulse) and, when a switch
+    ///   follows, closes with one (an extra step of the switch-step length,
+    ///   taken off the last step, with the pusher velocity at the switch
+    ///   and the friction impulse of half a step), so the switch impulse
+    ///   acts on the velocity at the switch, not on a mid-step one.
+    ///
+    /// Requires `switch_step_fraction > 0` for the closing half kick. The
+    /// joint still produces every switch and start impulse: ω is never set.
+    #[default]
+    Leapfrog,
 }
 
 impl FrictionVelocity {
-    /// `"body"`, `"constraint"` or `"midpoint"`.
+    /// `"body"`, `"constraint"`, `"midpoint"` or `"leapfrog"`.
     pub fn as_str(&self) -> &'static str {
         match self {
             FrictionVelocity::Body => "body",
             FrictionVelocity::Constraint => "constraint",
             FrictionVelocity::Midpoint => "midpoint",
+            FrictionVelocity::Leapfrog => "leapfrog",
         }
     }
 
-    /// Every mode, in the order body, constraint, midpoint.
-    pub const ALL: [FrictionVelocity; 3] = [
+    /// Every mode, in the order body, constraint, midpoint, leapfrog.
+    pub const ALL: [FrictionVelocity; 4] = [
         FrictionVelocity::Body,
         FrictionVelocity::Constraint,
         FrictionVelocity::Midpoint,
+        FrictionVelocity::Leapfrog,
     ];
 }
 
@@ -100,8 +136,9 @@ pub struct EngineSettings {
     pub dt: f64,
     /// rapier's `num_solver_iterations` (its number of solver substeps per
     /// step), ≥ 1; default `1`. rapier's own default is 4, but here more
-    /// substeps *raise* the error: the steady-ω error at dt = 1e-3 grows from
-    /// 1.6e-5 (1 substep) to 1.4e-3 (4 substeps).
+    /// substeps *raise* the error (in `midpoint` mode the steady-ω error at
+    /// dt = 1e-3 grows from 1.6e-5 with 1 substep to 1.4e-3 with 4): the
+    /// friction forces are evaluated once per step, not per substep.
     pub solver_iterations: usize,
     /// rapier's `num_internal_pgs_iterations` (Gauss–Seidel sweeps per
     /// substep), ≥ 1; default `1` (rapier's). The lone pin joint is solved
@@ -109,8 +146,8 @@ pub struct EngineSettings {
     pub pgs_iterations: usize,
     /// Precision of the rapier build; default [`Precision::F64`].
     pub precision: Precision,
-    /// How the support sliding velocities are obtained; default
-    /// [`FrictionVelocity::Midpoint`].
+    /// How the support sliding velocities (and the pusher velocity) are
+    /// obtained; default [`FrictionVelocity::Leapfrog`].
     pub friction_velocity: FrictionVelocity,
     /// At the start and at every switch, first take a step of
     /// `switch_step_fraction · h` (h the segment's step) so that the joint
@@ -118,7 +155,10 @@ pub struct EngineSettings {
     /// full step are evaluated; that step's length is taken off the next one,
     /// so steps still land on the switch times. `0` turns this off (the
     /// friction of the first step then sees the angular velocity from before
-    /// the switch). Dimensionless, in `[0, 0.5)`; default `1e-3`.
+    /// the switch). In [`FrictionVelocity::Leapfrog`] mode a segment that
+    /// is followed by a switch also ends with a closing step of the same
+    /// length (taken off the step before it). Dimensionless, in `[0, 0.5)`;
+    /// default `1e-3`.
     pub switch_step_fraction: f64,
 }
 
@@ -129,14 +169,14 @@ impl Default for EngineSettings {
             solver_iterations: 1,
             pgs_iterations: 1,
             precision: Precision::F64,
-            friction_velocity: FrictionVelocity::Midpoint,
+            friction_velocity: FrictionVelocity::Leapfrog,
             switch_step_fraction: 1e-3,
         }
     }
 }
 
 impl EngineSettings {
-    /// A short label naming the variant, e.g. `rapier2d[f64,midpoint,dt=0.001]`.
+    /// A short label naming the variant, e.g. `rapier2d[f64,leapfrog,dt=0.001]`.
     pub fn label(&self) -> String {
         format!(
             "rapier2d[{},{},dt={}]",
@@ -195,6 +235,13 @@ pub struct EngineRun {
     pub settings: EngineSettings,
     /// Wall-clock time of the run (set-up, stepping and sampling).
     pub wall_time: Duration,
+    /// The part of `wall_time` spent inside rapier's `step()`.
+    pub rapier_step_time: Duration,
+    /// The part of `wall_time` spent in the stepping loop: rapier's steps plus
+    /// the adapter's per-step work (friction forces, pusher velocity, reading
+    /// and recording the state). `stepping_time − rapier_step_time` is the
+    /// adapter's overhead.
+    pub stepping_time: Duration,
     /// Per segment, the mean angular velocity (rad/s) over the segment's last
     /// 20 % of engine steps (time-weighted): a cheap steady-ω estimate.
     pub segment_tail_omega: Vec<f64>,
@@ -242,6 +289,8 @@ impl RapierSimulator {
             steps: raw.steps,
             settings: self.settings,
             wall_time: start.elapsed(),
+            rapier_step_time: raw.step_time,
+            stepping_time: raw.loop_time,
             segment_tail_omega,
             history: raw.history,
         })

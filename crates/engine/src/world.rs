@@ -6,11 +6,13 @@
 // `as Real` is a no-op in the f64 build and a narrowing in the f32 one.
 #![allow(clippy::unnecessary_cast)]
 
+use std::time::{Duration, Instant};
+
 use super::rapier::prelude::*;
 
 use crate::history::{RawRun, StepRecord};
 use crate::{EngineSettings, FrictionVelocity};
-use pushval_model::{ModelError, Problem, Push};
+use pushval_model::{ModelError, Problem};
 
 /// Sliding speeds (m/s) at or below this give no friction force (the direction
 /// is undefined there); it keeps every force finite.
@@ -28,8 +30,41 @@ fn v(x: f64, y: f64) -> Vector {
 
 /// `R(θ) a` in f64.
 fn rot(theta: f64, a: [f64; 2]) -> [f64; 2] {
-    let (s, c) = theta.sin_cos();
-    [c * a[0] - s * a[1], s * a[0] + c * a[1]]
+    Rot::new(theta).apply(a)
+}
+
+/// A rotation as `(cos, sin)`, so that a step's rotations cost no
+/// trigonometry.
+#[derive(Clone, Copy)]
+struct Rot {
+    c: f64,
+    s: f64,
+}
+
+impl Rot {
+    fn new(theta: f64) -> Self {
+        let (s, c) = theta.sin_cos();
+        Self { c, s }
+    }
+
+    /// The rotation by `atan(x)`: the one rapier applies over a step with
+    /// `x = h ω`.
+    fn atan(x: f64) -> Self {
+        let k = 1.0 / (1.0 + x * x).sqrt();
+        Self { c: k, s: x * k }
+    }
+
+    /// This rotation followed by `other`.
+    fn then(self, other: Rot) -> Self {
+        Self {
+            c: self.c * other.c - self.s * other.s,
+            s: self.s * other.c + self.c * other.s,
+        }
+    }
+
+    fn apply(self, a: [f64; 2]) -> [f64; 2] {
+        [self.c * a[0] - self.s * a[1], self.s * a[0] + self.c * a[1]]
+    }
 }
 
 /// The object's state as read from the engine, in f64.
@@ -39,6 +74,8 @@ struct State {
     y: f64,
     /// Unwrapped angle.
     theta: f64,
+    /// The engine's rotation (its `cos θ`, `sin θ`).
+    rot: Rot,
     omega: f64,
 }
 
@@ -101,7 +138,8 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
     let read = |world: &PhysicsWorld, prev_theta: f64| -> State {
         let rb = &world.bodies[object];
         let t = rb.translation();
-        let a = rb.rotation().angle() as f64;
+        let r = rb.rotation();
+        let a = r.angle() as f64;
         // Unwrap: the engine's angle lives in (−π, π].
         let mut d = a - prev_theta.rem_euclid(std::f64::consts::TAU);
         d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
@@ -109,12 +147,21 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
             x: t.x as f64,
             y: t.y as f64,
             theta: prev_theta + d,
+            rot: Rot {
+                c: r.re as f64,
+                s: r.im as f64,
+            },
             omega: rb.angvel() as f64,
         }
     };
 
     let mut state = read(&world, init.theta);
-    let mut history = Vec::with_capacity(16);
+    let expected_steps: f64 = problem
+        .pushes
+        .iter()
+        .map(|p| (p.duration / settings.dt).ceil() + 2.0)
+        .sum();
+    let mut history = Vec::with_capacity(1 + expected_steps.min(1e7) as usize);
     history.push(StepRecord {
         segment: 0,
         t0: 0.0,
@@ -128,16 +175,24 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
     let mut max_drift = 0.0f64;
     let mut min_speed = f64::INFINITY;
     let mut t_seg = 0.0;
+    // Leapfrog: the time the object's current velocity stands for.
+    let mut v_time = 0.0;
+    let mut step_time = Duration::ZERO;
+    let loop_start = Instant::now();
 
     for (j, push) in problem.pushes.iter().enumerate() {
         let n = (push.duration / settings.dt * (1.0 - 1e-12))
             .ceil()
             .max(1.0) as usize;
         let h = push.duration / n as f64;
+        let leapfrog = settings.friction_velocity == FrictionVelocity::Leapfrog;
         // Step lengths of this segment: an optional switch step, then n steps
-        // whose first one is shortened by the switch step's length.
+        // whose first one is shortened by the switch step's length. In
+        // leapfrog mode, a segment followed by a switch also ends with a
+        // closing step of the same length, taken off the step before it.
         let eps = settings.switch_step_fraction * h;
-        let mut lengths: Vec<f64> = Vec::with_capacity(n + 1);
+        let closing = leapfrog && eps > 0.0 && j + 1 < problem.pushes.len();
+        let mut lengths: Vec<f64> = Vec::with_capacity(n + 2);
         if eps > 0.0 {
             lengths.push(eps);
             lengths.push(h - eps);
@@ -145,6 +200,15 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
             lengths.push(h);
         }
         lengths.extend(std::iter::repeat_n(h, n - 1));
+        if closing {
+            *lengths.last_mut().expect("n >= 1") -= eps;
+            lengths.push(eps);
+        }
+        let closing_step = if closing {
+            lengths.len() - 1
+        } else {
+            usize::MAX
+        };
 
         // Step velocities of this segment, placed at step middles, for the
         // midpoint extrapolation.
@@ -169,28 +233,77 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
                     }
                 }
             };
-            let (omega_f, heading) = match settings.friction_velocity {
-                FrictionVelocity::Body | FrictionVelocity::Constraint => (state.omega, state.theta),
+            let vc = push.velocity();
+            let vc = [vc.x, vc.y];
+            // ω the friction sees, the pusher velocity, and the factor on the
+            // friction forces.
+            let (omega_f, vp, friction_scale) = match settings.friction_velocity {
+                FrictionVelocity::Body | FrictionVelocity::Constraint => {
+                    (state.omega, state.rot.apply(vc), 1.0)
+                }
                 FrictionVelocity::Midpoint => {
                     let w_mid = omega_at(t + 0.5 * hk);
-                    (omega_at(t), state.theta + 0.5 * hk * w_mid)
+                    (omega_at(t), rot(state.theta + 0.5 * hk * w_mid, vc), 1.0)
+                }
+                FrictionVelocity::Leapfrog => {
+                    // The time the coming step's velocity stands for: the
+                    // switch time for the switch step (the velocity just
+                    // after the impulse) and for the closing step (the
+                    // velocity just before the next switch), the step's
+                    // middle otherwise.
+                    let (t_v, reach) = if k == 0 && eps > 0.0 {
+                        (t, 0.0)
+                    } else if k == closing_step {
+                        (t1, hk)
+                    } else {
+                        (t + 0.5 * hk, 0.5 * hk)
+                    };
+                    let w = omega_at(t_v);
+                    // rapier turns the body by atan(h ω) over a step.
+                    let rot_v = state.rot.then(Rot::atan(reach * w));
+                    let a = rot_v.apply(vc);
+                    let c0 = state.rot.apply(pc);
+                    let c1 = rot_v.apply(pc);
+                    // v_c R(θ_v) n_φ + ω D (R(θ) − R(θ_v)) p_c: the joint,
+                    // whose lever arm is R(θ) p_c, then gives the centre of
+                    // mass the velocity R(θ_v)(v_c n_φ − ω D p_c) it has at
+                    // t_v: for a mid-step t_v, the chord of the arc it
+                    // should follow over the step.
+                    let vp = [a[0] - w * (c0[1] - c1[1]), a[1] + w * (c0[0] - c1[0])];
+                    // The friction impulse takes the velocity from the time
+                    // the previous one stands for to t_v (a half kick at the
+                    // start of a segment, a full step's in its body).
+                    let scale = (t_v - v_time) / hk;
+                    v_time = t_v;
+                    (omega_at(t), vp, scale)
                 }
             };
+            let repin = leapfrog;
+            if repin {
+                // Pin the pusher on the object's contact point: no position
+                // error for the joint's bias to correct, so the body moves
+                // with the velocity the joint solved for.
+                let rc = state.rot.apply(pc);
+                world.bodies[pusher].set_translation(v(state.x + rc[0], state.y + rc[1]), true);
+            }
             apply_step_forces(
                 &mut world,
                 object,
                 pusher,
-                push,
+                vc,
+                vp,
                 &supports,
                 pc,
                 &state,
                 omega_f,
-                heading,
                 settings.friction_velocity,
+                friction_scale,
                 &mut min_speed,
             );
             world.integration_parameters.dt = hk as Real;
+            let before = Instant::now();
             world.step();
+            step_time += before.elapsed();
             steps += 1;
 
             state = read(&world, state.theta);
@@ -202,7 +315,7 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
                 return Err(ModelError::NonFinite { t: t1, step: steps });
             }
             let anchor = world.bodies[pusher].translation();
-            let rc = rot(state.theta, pc);
+            let rc = state.rot.apply(pc);
             let drift = ((anchor.x as f64 - state.x - rc[0]).powi(2)
                 + (anchor.y as f64 - state.y - rc[1]).powi(2))
             .sqrt();
@@ -217,7 +330,7 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
                 omega: state.omega,
             });
             nodes[0] = nodes[1];
-            nodes[1] = (0.5 * (t + t1), state.omega);
+            nodes[1] = (if leapfrog { v_time } else { 0.5 * (t + t1) }, state.omega);
             t = t1;
         }
         t_seg = seg_end;
@@ -225,6 +338,8 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
     Ok(RawRun {
         history,
         steps,
+        step_time,
+        loop_time: loop_start.elapsed(),
         max_drift,
         min_support_speed: if min_speed.is_finite() {
             min_speed
@@ -240,17 +355,16 @@ fn apply_step_forces(
     world: &mut PhysicsWorld,
     object: RigidBodyHandle,
     pusher: RigidBodyHandle,
-    push: &Push,
+    vc: [f64; 2],
+    vp: [f64; 2],
     supports: &[([f64; 2], f64)],
     pc: [f64; 2],
     state: &State,
     omega: f64,
-    heading: f64,
     mode: FrictionVelocity,
+    friction_scale: f64,
     min_speed: &mut f64,
 ) {
-    let vc = push.velocity();
-    let vp = rot(heading, [vc.x, vc.y]);
     {
         let p = &mut world.bodies[pusher];
         p.set_linvel(v(vp[0], vp[1]), true);
@@ -259,20 +373,21 @@ fn apply_step_forces(
     let rb = &mut world.bodies[object];
     rb.reset_forces(false);
     rb.reset_torques(false);
-    let rc = rot(state.theta, pc);
+    let rc = state.rot.apply(pc);
     // The contact velocity the friction sees: the commanded one at the
-    // object's current angle (equal to `vp` except in midpoint mode, where
-    // `vp` is taken at the mid-step angle).
-    let vf = rot(state.theta, [vc.x, vc.y]);
+    // object's current angle (equal to `vp` in body and constraint modes).
+    let vf = state.rot.apply(vc);
     for &(p, friction) in supports {
-        let r = rot(state.theta, p);
+        let r = state.rot.apply(p);
         let point = v(state.x + r[0], state.y + r[1]);
         let u = match mode {
             FrictionVelocity::Body => {
                 let u = rb.velocity_at_point(point);
                 [u.x as f64, u.y as f64]
             }
-            FrictionVelocity::Constraint | FrictionVelocity::Midpoint => {
+            FrictionVelocity::Constraint
+            | FrictionVelocity::Midpoint
+            | FrictionVelocity::Leapfrog => {
                 // commanded contact velocity + ω × (p_i − p_c), world frame
                 let d = [r[0] - rc[0], r[1] - rc[1]];
                 [vf[0] - omega * d[1], vf[1] + omega * d[0]]
@@ -281,7 +396,7 @@ fn apply_step_forces(
         let speed = (u[0] * u[0] + u[1] * u[1]).sqrt();
         *min_speed = min_speed.min(speed);
         if speed > MIN_SLIDING_SPEED && friction > 0.0 {
-            let k = -friction / speed;
+            let k = -friction_scale * friction / speed;
             rb.add_force_at_point(v(k * u[0], k * u[1]), point, true);
         }
     }

@@ -25,8 +25,14 @@ fn samples_at_problem_times_and_diagnostics() {
     assert!(finite(&run.trajectory));
     assert_eq!(run.trajectory.model, "rapier2d");
     assert_eq!(run.settings, EngineSettings::default());
-    // 1000 + 3000 steps plus one switch step per segment.
-    assert_eq!(run.steps, 4002);
+    // 1000 + 3000 steps plus one switch step per segment and (leapfrog, the
+    // default) one closing step before the switch.
+    assert_eq!(run.steps, 4003);
+    // Where the time went: rapier's steps are part of the stepping loop,
+    // which is part of the run.
+    assert!(run.rapier_step_time > std::time::Duration::ZERO);
+    assert!(run.rapier_step_time <= run.stepping_time);
+    assert!(run.stepping_time <= run.wall_time);
     assert!(run.max_joint_drift < 1e-5, "drift {}", run.max_joint_drift);
     assert_eq!(run.segment_tail_omega.len(), 2);
     assert_eq!(run.trajectory.segments.len(), 2);

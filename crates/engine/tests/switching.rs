@@ -26,8 +26,15 @@ fn omega_jump_at_switch_conserves_contact_momentum() {
             "{}: before {w0:.6} after {w1:.6} H-conserving {expect:.6}",
             mode.as_str()
         );
+        // The leapfrog mode closes the segment on the velocity at the
+        // switch, so the jump starts from ω(t_s−), not a mid-step ω.
+        let tol = if mode == FrictionVelocity::Leapfrog {
+            2e-5
+        } else {
+            2e-3
+        };
         assert!(
-            (w1 - expect).abs() < 2e-3 * expect.abs(),
+            (w1 - expect).abs() < tol * expect.abs(),
             "{}: {w1} vs {expect}",
             mode.as_str()
         );

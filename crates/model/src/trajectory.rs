@@ -198,7 +198,7 @@ pub struct DynamicModel {
 impl Default for DynamicModel {
     fn default() -> Self {
         Self {
-            integrator: Integrator::Adaptive { tol: 1e-10 },
+            integrator: Integrator::Dop853 { tol: 1e-10 },
             skip_settled: true,
             check_assumptions: true,
             inertial_term: crate::InertialTerm::Derived,
@@ -651,10 +651,18 @@ impl Simulator for DynamicModel {
                             }
                             let (a5, a8) = if eighth {
                                 out.stats.rhs_evals += 12;
-                                (None, Some(integrate::dop853::attempt(&mut rhs, &y, &k1, hh, tol, &rtol)))
+                                (
+                                    None,
+                                    Some(integrate::dop853::attempt(
+                                        &mut rhs, &y, &k1, hh, tol, &rtol,
+                                    )),
+                                )
                             } else {
                                 out.stats.rhs_evals += 6;
-                                (Some(integrate::dp5_attempt(&mut rhs, &y, &k1, hh, tol, &rtol)), None)
+                                (
+                                    Some(integrate::dp5_attempt(&mut rhs, &y, &k1, hh, tol, &rtol)),
+                                    None,
+                                )
                             };
                             let (err, y1, k_next) = match (&a5, &a8) {
                                 (Some(a), _) => (a.err, a.y1, a.k7),
@@ -703,7 +711,11 @@ impl Simulator for DynamicModel {
                                         step: out.stats.steps,
                                     });
                                 }
-                                let hn = if eighth { integrate::next_step8(hh, err) } else { integrate::next_step(hh, err) };
+                                let hn = if eighth {
+                                    integrate::next_step8(hh, err)
+                                } else {
+                                    integrate::next_step(hh, err)
+                                };
                                 if !landing || hn < h {
                                     h = hn;
                                 }
@@ -716,7 +728,11 @@ impl Simulator for DynamicModel {
                                 }
                             } else {
                                 out.stats.rejected += 1;
-                                h = if eighth { integrate::next_step8(hh, err) } else { integrate::next_step(hh, err) };
+                                h = if eighth {
+                                    integrate::next_step8(hh, err)
+                                } else {
+                                    integrate::next_step(hh, err)
+                                };
                                 if !(h > 1e-14 * t.abs().max(1.0)) {
                                     return Err(ModelError::Integration {
                                         t,

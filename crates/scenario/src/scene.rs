@@ -59,6 +59,8 @@ pub enum FrictionVelocity {
     Constraint,
     /// The constraint velocity evaluated at the middle of the step.
     Midpoint,
+    /// Second-order stepping (the engine adapter's default).
+    Leapfrog,
 }
 
 /// `[engine]`: settings for engine models; unset fields take the adapter's defaults.
@@ -656,10 +658,11 @@ impl Scenario {
                 Some("body") => Some(FrictionVelocity::Body),
                 Some("constraint") => Some(FrictionVelocity::Constraint),
                 Some("midpoint") => Some(FrictionVelocity::Midpoint),
+                Some("leapfrog") => Some(FrictionVelocity::Leapfrog),
                 Some(o) => return Err(err(
                     "engine.friction_velocity",
                     format!(
-                        "unknown value \"{o}\"; expected \"body\", \"constraint\" or \"midpoint\""
+                        "unknown value \"{o}\"; expected \"body\", \"constraint\", \"midpoint\" or \"leapfrog\""
                     ),
                 )),
             },
