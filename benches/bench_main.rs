@@ -9,5 +9,6 @@ criterion::criterion_main!(
     benchmarks::model_steady::benches,
     benchmarks::model_trajectory::benches,
     benchmarks::rapier_step::benches,
+    benchmarks::sweep::benches,
     benchmarks::validate::benches,
 );

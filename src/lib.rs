@@ -5,5 +5,7 @@
 pub mod harness;
 pub mod output;
 pub mod outside;
+pub mod report;
+pub mod stress;
 
 pub use harness::{run_scenario, Comparison, ModelRun, RunOptions, ScenarioReport, SegmentInfo};

@@ -45,6 +45,32 @@ enum Command {
         #[arg(long, value_name = "CSV")]
         trajectory: PathBuf,
     },
+    /// Sweep dt, speed, friction, supports, aspect ratio and horizon for the
+    /// adaptive integrator, RK4 and rapier2d; write DIR/stress.csv and
+    /// DIR/stability.csv (ok / degraded / unstable per case).
+    Stress {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "results/stress")]
+        out: PathBuf,
+        /// Run the small test grid instead of the full one.
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Regenerate the figures (SVG), their data (CSV) and README.md in OUT.
+    Report {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        /// Reduced sweep grids (for tests).
+        #[arg(long)]
+        quick: bool,
+        /// Compute only part K of N of the sweeps into OUT/parts/ (batch schedulers).
+        #[arg(long, value_name = "K/N", conflicts_with = "merge")]
+        shard: Option<pushval::report::Shard>,
+        /// Build the outputs from the parts in OUT/parts/ instead of computing the sweeps.
+        #[arg(long)]
+        merge: bool,
+    },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
         file: PathBuf,
@@ -175,6 +201,25 @@ fn compare(file: PathBuf, csv: PathBuf) -> anyhow::Result<ExitCode> {
     })
 }
 
+fn stress(out: PathBuf, quick: bool) -> anyhow::Result<ExitCode> {
+    let cases = if quick {
+        pushval::stress::quick_grid()
+    } else {
+        pushval::stress::full_grid()
+    };
+    let start = std::time::Instant::now();
+    let (outcomes, limits) = pushval::stress::write_sweep(&cases, &out)?;
+    print!("{}", pushval::stress::summary_text(&outcomes, &limits));
+    println!(
+        "{} runs in {:.1} s; wrote {} and {}",
+        outcomes.len(),
+        start.elapsed().as_secs_f64(),
+        out.join("stress.csv").display(),
+        out.join("stability.csv").display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -182,6 +227,13 @@ fn main() -> ExitCode {
         Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
         Some(Command::Run { file, out }) => run(file, out),
         Some(Command::Compare { file, trajectory }) => compare(file, trajectory),
+        Some(Command::Stress { out, quick }) => stress(out, quick),
+        Some(Command::Report {
+            out,
+            quick,
+            shard,
+            merge,
+        }) => pushval::report::cli(out, quick, shard, merge),
     };
     match result {
         Ok(code) => code,

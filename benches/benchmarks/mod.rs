@@ -2,6 +2,7 @@ pub mod model_rhs;
 pub mod model_steady;
 pub mod model_trajectory;
 pub mod rapier_step;
+pub mod sweep;
 pub mod validate;
 
 use pushval_model::{Body, Support, Vec2};

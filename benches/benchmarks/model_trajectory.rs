@@ -28,6 +28,28 @@ fn model_trajectory(c: &mut Criterion) {
             |b, m| b.iter(|| black_box(m.simulate(&problem).unwrap())),
         );
     }
+    // The skips, measured: the settled-arc shortcut (above, `adaptive_no_skip`)
+    // and the per-sample pusher-force and assumption work.
+    for (label, check) in [("with_checks", true), ("without_checks", false)] {
+        let m = DynamicModel {
+            check_assumptions: check,
+            ..Default::default()
+        };
+        g.bench_with_input(BenchmarkId::new("dop853_default", label), &m, |b, m| {
+            b.iter(|| black_box(m.simulate(&problem).unwrap()))
+        });
+    }
+    for tol in [1e-6, 1e-9, 1e-12] {
+        let m = DynamicModel {
+            integrator: Integrator::Dop853 { tol },
+            ..Default::default()
+        };
+        g.bench_with_input(
+            BenchmarkId::new("dop853", format!("{tol:e}")),
+            &m,
+            |b, m| b.iter(|| black_box(m.simulate(&problem).unwrap())),
+        );
+    }
     for dt in [1e-2, 1e-3] {
         let m = DynamicModel {
             integrator: Integrator::Rk4 { dt },

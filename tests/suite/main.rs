@@ -4,7 +4,11 @@
 mod bad_input;
 mod cli;
 mod common;
+mod corpus;
 mod gate;
 mod integrators;
 mod physics;
+mod properties;
+mod report;
 mod scenarios;
+mod stress;

@@ -85,6 +85,7 @@ fn main() {
                         .ok()
                         .and_then(|s| s.parse().ok())
                         .unwrap_or(1),
+                    ..Default::default()
                 });
                 let run = sim.run(&problem).unwrap();
                 let (mut pmax, mut tmax) = (0.0f64, 0.0f64);

@@ -32,8 +32,10 @@ mod f32_engine;
 /// The f64 build of the engine adapter (`rapier2d-f64`).
 mod f64_engine;
 mod history;
+pub mod idioms;
 
 pub use history::StepRecord;
+pub use idioms::FrictionModel;
 
 /// Floating-point precision of the rapier build that runs the problem.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -160,6 +162,10 @@ pub struct EngineSettings {
     /// length (taken off the step before it). Dimensionless, in `[0, 0.5)`;
     /// default `1e-3`.
     pub switch_step_fraction: f64,
+    /// The support-friction law; default [`FrictionModel::Coulomb`] (the
+    /// analytic model's). The others are game-engine idioms (see
+    /// [`idioms`]); their impulse cap uses the segment's nominal step.
+    pub friction_model: FrictionModel,
 }
 
 impl Default for EngineSettings {
@@ -171,18 +177,25 @@ impl Default for EngineSettings {
             precision: Precision::F64,
             friction_velocity: FrictionVelocity::Leapfrog,
             switch_step_fraction: 1e-3,
+            friction_model: FrictionModel::Coulomb,
         }
     }
 }
 
 impl EngineSettings {
-    /// A short label naming the variant, e.g. `rapier2d[f64,leapfrog,dt=0.001]`.
+    /// A short label naming the variant, e.g. `rapier2d[f64,leapfrog,dt=0.001]`
+    /// (with the friction model appended when it is not Coulomb).
     pub fn label(&self) -> String {
+        let model = match self.friction_model {
+            FrictionModel::Coulomb => String::new(),
+            m => format!(",{}", m.as_str()),
+        };
         format!(
-            "rapier2d[{},{},dt={}]",
+            "rapier2d[{},{},dt={}{}]",
             self.precision.as_str(),
             self.friction_velocity.as_str(),
-            self.dt
+            self.dt,
+            model
         )
     }
 
@@ -209,6 +222,7 @@ impl EngineSettings {
                 value: 0.0,
             });
         }
+        self.friction_model.check()?;
         if !(self.switch_step_fraction >= 0.0 && self.switch_step_fraction < 0.5) {
             return Err(ModelError::Parameter {
                 name: "engine switch_step_fraction",

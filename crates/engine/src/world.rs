@@ -11,7 +11,8 @@ use std::time::{Duration, Instant};
 use super::rapier::prelude::*;
 
 use crate::history::{RawRun, StepRecord};
-use crate::{EngineSettings, FrictionVelocity};
+use crate::idioms::{support_force, LawContext};
+use crate::{EngineSettings, FrictionModel, FrictionVelocity};
 use pushval_model::{ModelError, Problem};
 
 /// Sliding speeds (m/s) at or below this give no friction force (the direction
@@ -204,6 +205,12 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
             *lengths.last_mut().expect("n >= 1") -= eps;
             lengths.push(eps);
         }
+        // The friction law's constants; the impulse cap uses the nominal step.
+        let law = LawContext {
+            mass: body.mass(),
+            inertia_cm: body.inertia_cm(),
+            dt: h,
+        };
         let closing_step = if closing {
             lengths.len() - 1
         } else {
@@ -299,6 +306,7 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
                 settings.friction_velocity,
                 friction_scale,
                 &mut min_speed,
+                (settings.friction_model, &law),
             );
             world.integration_parameters.dt = hk as Real;
             let before = Instant::now();
@@ -364,6 +372,7 @@ fn apply_step_forces(
     mode: FrictionVelocity,
     friction_scale: f64,
     min_speed: &mut f64,
+    (model, law): (FrictionModel, &LawContext),
 ) {
     {
         let p = &mut world.bodies[pusher];
@@ -395,7 +404,14 @@ fn apply_step_forces(
         };
         let speed = (u[0] * u[0] + u[1] * u[1]).sqrt();
         *min_speed = min_speed.min(speed);
-        if speed > MIN_SLIDING_SPEED && friction > 0.0 {
+        if model != FrictionModel::Coulomb {
+            // A game-engine idiom (see `idioms`): r from the centre of mass.
+            let f = support_force(model, u, r, friction, law);
+            if f != [0.0, 0.0] {
+                let f = [friction_scale * f[0], friction_scale * f[1]];
+                rb.add_force_at_point(v(f[0], f[1]), point, true);
+            }
+        } else if speed > MIN_SLIDING_SPEED && friction > 0.0 {
             let k = -friction_scale * friction / speed;
             rb.add_force_at_point(v(k * u[0], k * u[1]), point, true);
         }

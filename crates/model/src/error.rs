@@ -23,4 +23,13 @@ pub enum ModelError {
     /// The state left the finite numbers (a blow-up).
     #[error("the state became non-finite at t = {t} s (step {step})")]
     NonFinite { t: f64, step: usize },
+    /// |ω| passed a thousand times the largest value a trajectory of the
+    /// segment can reach (its start and its steady states): ω runs away.
+    #[error("omega ran away at t = {t} s (step {step}): |{omega:.3e}| rad/s > {limit:.3e} rad/s")]
+    Runaway {
+        t: f64,
+        step: usize,
+        omega: f64,
+        limit: f64,
+    },
 }

@@ -390,7 +390,13 @@ pub mod dop853 {
 
     impl Attempt {
         /// Builds the dense output (three more evaluations of `f`).
-        pub fn dense<F: FnMut(&State) -> State>(&self, f: &mut F, t0: f64, y0: &State, h: f64) -> Dense {
+        pub fn dense<F: FnMut(&State) -> State>(
+            &self,
+            f: &mut F,
+            t0: f64,
+            y0: &State,
+            h: f64,
+        ) -> Dense {
             let mut k = [[0.0; N]; 16];
             k[..13].copy_from_slice(&self.k);
             for s in 13..16 {

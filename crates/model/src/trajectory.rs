@@ -468,6 +468,11 @@ impl Simulator for DynamicModel {
         let mut omega = if init.from_rest { 0.0 } else { init.omega };
         let mut prev: Option<Push> = (!init.from_rest).then(|| problem.pushes[0]);
         let mut h_carry: Option<f64> = None;
+        let r_min = body
+            .supports()
+            .map(|s| (s.position - pc).norm())
+            .filter(|r| *r > 0.0)
+            .fold(f64::INFINITY, f64::min);
         let n_seg = problem.pushes.len();
         for (j, (push, (t0, t1))) in problem
             .pushes
@@ -496,19 +501,26 @@ impl Simulator for DynamicModel {
                 Vec::new()
             };
             let target = seg.attractor(&roots, omega);
+            // For a constant input ω is a scalar autonomous ODE: it moves
+            // monotonically and never passes max(|ω_start|, |roots|). Far
+            // beyond that it is running away (or an integrator is unstable);
+            // stop there instead of grinding on ever shorter steps.
+            let omega_limit = 1e3
+                * roots
+                    .iter()
+                    .map(|r| r.omega.abs())
+                    .fold(omega.abs().max(push.speed / r_min), f64::max);
             if push.speed > 0.0 {
                 match target {
-                    None => {
-                        if checker.enabled {
-                            Violation::record(
-                                &mut checker.out.runaway,
-                                t0,
-                                omega.abs(),
-                                j,
-                                None,
-                                |a, b| a > b,
-                            );
-                        }
+                    None if checker.enabled => {
+                        Violation::record(
+                            &mut checker.out.runaway,
+                            t0,
+                            omega.abs(),
+                            j,
+                            None,
+                            |a, b| a > b,
+                        );
                     }
                     Some(SteadyState {
                         kind: crate::RootKind::Pivot { support, .. },
@@ -711,6 +723,14 @@ impl Simulator for DynamicModel {
                                         step: out.stats.steps,
                                     });
                                 }
+                                if y[1].abs() > omega_limit {
+                                    return Err(ModelError::Runaway {
+                                        t,
+                                        step: out.stats.steps,
+                                        omega: y[1],
+                                        limit: omega_limit,
+                                    });
+                                }
                                 let hn = if eighth {
                                     integrate::next_step8(hh, err)
                                 } else {
@@ -781,6 +801,14 @@ impl Simulator for DynamicModel {
                                 return Err(ModelError::NonFinite {
                                     t,
                                     step: out.stats.steps,
+                                });
+                            }
+                            if y[1].abs() > omega_limit {
+                                return Err(ModelError::Runaway {
+                                    t,
+                                    step: out.stats.steps,
+                                    omega: y[1],
+                                    limit: omega_limit,
                                 });
                             }
                             if t < t1 {

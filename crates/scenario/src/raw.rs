@@ -1,6 +1,39 @@
 //! The scenario file as written: one struct per TOML table, unknown keys refused.
 
-use serde::Deserialize;
+use serde::{Deserialize, Deserializer};
+
+/// A point `[x, y]`. serde's `[f64; 2]` reads the first two elements of a
+/// longer array and drops the rest silently; this refuses any other length.
+struct Xy([f64; 2]);
+
+impl<'de> Deserialize<'de> for Xy {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = Vec::<f64>::deserialize(d)?;
+        match v[..] {
+            [x, y] => Ok(Xy([x, y])),
+            _ => Err(serde::de::Error::invalid_length(
+                v.len(),
+                &"2 coordinates [x, y]",
+            )),
+        }
+    }
+}
+
+fn xy<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    Xy::deserialize(d).map(|p| p.0)
+}
+
+fn opt_xy<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+    Option::<Xy>::deserialize(d).map(|p| p.map(|p| p.0))
+}
+
+fn xys<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    Vec::<Xy>::deserialize(d).map(|v| v.into_iter().map(|p| p.0).collect())
+}
+
+fn opt_xys<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
+    Option::<Vec<Xy>>::deserialize(d).map(|v| v.map(|v| v.into_iter().map(|p| p.0).collect()))
+}
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -24,8 +57,10 @@ pub struct RawObject {
     /// kg
     pub mass: f64,
     /// m, object frame, counter-clockwise
+    #[serde(deserialize_with = "xys")]
     pub polygon: Vec<[f64; 2]>,
     /// m; default: the polygon's centroid
+    #[serde(default, deserialize_with = "opt_xy")]
     pub center_of_mass: Option<[f64; 2]>,
     /// kg m² about the centre of mass; default: uniform density over the polygon
     pub inertia_cm: Option<f64>,
@@ -53,6 +88,7 @@ pub enum RawLoad {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSupports {
+    #[serde(default, deserialize_with = "opt_xys")]
     pub points: Option<Vec<[f64; 2]>>,
     /// m spacing of a uniform-pressure grid, instead of `points`
     pub uniform_grid: Option<f64>,
@@ -65,6 +101,7 @@ pub struct RawSupports {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawContact {
+    #[serde(deserialize_with = "xy")]
     pub point: [f64; 2],
     pub mu: Option<f64>,
     pub max_force: Option<f64>,
@@ -75,6 +112,7 @@ pub struct RawContact {
 pub struct RawInitial {
     pub theta: Option<f64>,
     pub omega: Option<f64>,
+    #[serde(default, deserialize_with = "opt_xy")]
     pub position: Option<[f64; 2]>,
     pub from_rest: Option<bool>,
 }

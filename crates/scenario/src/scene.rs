@@ -811,6 +811,17 @@ fn key_of_toml_error(text: &str, span: Option<std::ops::Range<usize>>) -> String
     let start = span.start.min(text.len());
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let line = text[line_start..].lines().next().unwrap_or("");
+    let header = line.trim_start();
+    if header.starts_with('[') && start > line_start + (line.len() - header.len()) {
+        // Inside a table header (a duplicate table): that table is the key.
+        return header
+            .trim_start_matches('[')
+            .split(']')
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_string();
+    }
     let table = header_before(text, line_start);
     match line.split_once('=') {
         Some((k, _)) if !line.trim_start().starts_with('[') => {

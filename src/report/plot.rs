@@ -1,0 +1,405 @@
+//! Figure drawing: line panels and coloured-grid maps, rendered to SVG text
+//! with plotters (no system fonts needed: the SVG names a generic font family
+//! and the viewer renders the text).
+
+use anyhow::anyhow;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stroke {
+    Solid,
+    Dashed,
+    /// Small filled circles at the points (for the engine drawn over a model).
+    Dots,
+}
+
+/// One curve of a panel.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub label: String,
+    pub color: RGBColor,
+    pub stroke: Stroke,
+    pub width: u32,
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Series {
+    pub fn new(label: impl Into<String>, color: RGBColor, stroke: Stroke) -> Self {
+        Self {
+            label: label.into(),
+            color,
+            stroke,
+            width: 2,
+            points: Vec::new(),
+        }
+    }
+    #[must_use]
+    pub fn points(mut self, points: Vec<(f64, f64)>) -> Self {
+        self.points = points;
+        self
+    }
+    #[must_use]
+    pub fn width(mut self, width: u32) -> Self {
+        self.width = width;
+        self
+    }
+}
+
+/// One axis: its label (with the unit) and whether it is logarithmic.
+#[derive(Debug, Clone)]
+pub struct Axis {
+    pub label: String,
+    pub log: bool,
+    /// Fixed range; None: fitted to the data with a 4 % margin.
+    pub range: Option<(f64, f64)>,
+}
+
+impl Axis {
+    pub fn lin(label: impl Into<String>) -> Self {
+        Self {
+            label: label.into(),
+            log: false,
+            range: None,
+        }
+    }
+    pub fn log(label: impl Into<String>) -> Self {
+        Self {
+            label: label.into(),
+            log: true,
+            range: None,
+        }
+    }
+    #[must_use]
+    pub fn range(mut self, lo: f64, hi: f64) -> Self {
+        self.range = Some((lo, hi));
+        self
+    }
+}
+
+/// A filled rectangle of a map, in data coordinates.
+#[derive(Debug, Clone, Copy)]
+pub struct Cell {
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+    pub color: RGBColor,
+}
+
+/// Where the legend goes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Legend {
+    UpperRight,
+    UpperLeft,
+    LowerRight,
+    LowerLeft,
+    None,
+}
+
+/// One chart.
+#[derive(Debug, Clone)]
+pub struct Panel {
+    pub title: String,
+    pub x: Axis,
+    pub y: Axis,
+    pub series: Vec<Series>,
+    pub cells: Vec<Cell>,
+    pub legend: Legend,
+    /// Same scale on both axes (for x–y paths).
+    pub equal_aspect: bool,
+}
+
+impl Panel {
+    pub fn new(title: impl Into<String>, x: Axis, y: Axis) -> Self {
+        Self {
+            title: title.into(),
+            x,
+            y,
+            series: Vec::new(),
+            cells: Vec::new(),
+            legend: Legend::UpperRight,
+            equal_aspect: false,
+        }
+    }
+    #[must_use]
+    pub fn series(mut self, s: Series) -> Self {
+        self.series.push(s);
+        self
+    }
+    #[must_use]
+    pub fn legend(mut self, l: Legend) -> Self {
+        self.legend = l;
+        self
+    }
+    #[must_use]
+    pub fn equal_aspect(mut self) -> Self {
+        self.equal_aspect = true;
+        self
+    }
+}
+
+/// Colour classes drawn as a key beside a map.
+#[derive(Debug, Clone)]
+pub struct Key {
+    pub title: String,
+    pub entries: Vec<(String, RGBColor)>,
+}
+
+/// A figure: panels on a grid of `cols` columns, optionally a colour key on
+/// the right.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    pub size: (u32, u32),
+    pub cols: usize,
+    pub panels: Vec<Panel>,
+    pub key: Option<Key>,
+}
+
+pub const BLUE_: RGBColor = RGBColor(31, 119, 180);
+pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
+pub const GREEN_: RGBColor = RGBColor(44, 160, 44);
+pub const RED_: RGBColor = RGBColor(214, 39, 40);
+pub const PURPLE: RGBColor = RGBColor(148, 103, 189);
+pub const BROWN: RGBColor = RGBColor(140, 86, 75);
+pub const PINK: RGBColor = RGBColor(227, 119, 194);
+pub const GREY: RGBColor = RGBColor(110, 110, 110);
+pub const OLIVE: RGBColor = RGBColor(188, 189, 34);
+pub const CYAN_: RGBColor = RGBColor(23, 190, 207);
+pub const DARK: RGBColor = RGBColor(20, 20, 20);
+
+/// A fixed palette for numbered curves.
+pub const PALETTE: [RGBColor; 10] = [
+    BLUE_, ORANGE, GREEN_, RED_, PURPLE, BROWN, PINK, GREY, OLIVE, CYAN_,
+];
+
+const FONT: &str = "sans-serif";
+
+fn data_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return if log { (0.1, 1.0) } else { (0.0, 1.0) };
+    }
+    if log {
+        let (a, b) = (lo.log10(), hi.log10());
+        let m = ((b - a) * 0.04).max(0.05);
+        (10f64.powf(a - m), 10f64.powf(b + m))
+    } else {
+        let m = ((hi - lo) * 0.04).max(1e-9 * hi.abs().max(1.0));
+        (lo - m, hi + m)
+    }
+}
+
+fn ranges(p: &Panel, pixels: (u32, u32)) -> ((f64, f64), (f64, f64)) {
+    let xs = p
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|q| q.0))
+        .chain(p.cells.iter().flat_map(|c| [c.x.0, c.x.1]));
+    let ys = p
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|q| q.1))
+        .chain(p.cells.iter().flat_map(|c| [c.y.0, c.y.1]));
+    let mut xr = p.x.range.unwrap_or_else(|| data_range(xs, p.x.log));
+    let mut yr = p.y.range.unwrap_or_else(|| data_range(ys, p.y.log));
+    if p.equal_aspect {
+        // Plot area is roughly the panel less the label areas.
+        let w = pixels.0.saturating_sub(100).max(1) as f64;
+        let h = pixels.1.saturating_sub(90).max(1) as f64;
+        let (dx, dy) = (xr.1 - xr.0, yr.1 - yr.0);
+        let scale = (dx / w).max(dy / h);
+        let (cx, cy) = (0.5 * (xr.0 + xr.1), 0.5 * (yr.0 + yr.1));
+        xr = (cx - 0.5 * scale * w, cx + 0.5 * scale * w);
+        yr = (cy - 0.5 * scale * h, cy + 0.5 * scale * h);
+    }
+    (xr, yr)
+}
+
+/// Renders the figure to SVG text.
+pub fn render(fig: &Figure) -> anyhow::Result<String> {
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, fig.size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
+        let (main, key_area) = if fig.key.is_some() {
+            let (a, b) = root.split_horizontally(fig.size.0.saturating_sub(230));
+            (a, Some(b))
+        } else {
+            (root.clone(), None)
+        };
+        let rows = fig.panels.len().div_ceil(fig.cols.max(1));
+        let areas = main.split_evenly((rows, fig.cols.max(1)));
+        for (area, p) in areas.iter().zip(&fig.panels) {
+            panel(area, p).map_err(|e| anyhow!("panel '{}': {e:#}", p.title))?;
+        }
+        if let (Some(k), Some(a)) = (&fig.key, key_area) {
+            key(&a, k).map_err(|e| anyhow!("{e:?}"))?;
+        }
+        root.present().map_err(|e| anyhow!("{e:?}"))?;
+    }
+    Ok(buf)
+}
+
+fn key<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    k: &Key,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let title = (FONT, 17).into_font().color(&BLACK);
+    let text = (FONT, 15).into_font().color(&BLACK);
+    area.draw(&Text::new(k.title.clone(), (10, 60), title))?;
+    for (i, (label, color)) in k.entries.iter().enumerate() {
+        let y = 95 + 32 * i as i32;
+        area.draw(&Rectangle::new([(12, y), (36, y + 20)], color.filled()))?;
+        area.draw(&Rectangle::new(
+            [(12, y), (36, y + 20)],
+            BLACK.stroke_width(1),
+        ))?;
+        area.draw(&Text::new(label.clone(), (44, y + 3), text.clone()))?;
+    }
+    Ok(())
+}
+
+fn panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let ((x0, x1), (y0, y1)) = ranges(p, area.dim_in_pixel());
+    match (p.x.log, p.y.log) {
+        (false, false) => draw_in(area, p, x0..x1, y0..y1),
+        (true, false) => draw_in(area, p, (x0..x1).log_scale(), y0..y1),
+        (false, true) => draw_in(area, p, x0..x1, (y0..y1).log_scale()),
+        (true, true) => draw_in(area, p, (x0..x1).log_scale(), (y0..y1).log_scale()),
+    }
+}
+
+fn short(v: f64) -> String {
+    if v.abs() < 1e-12 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if !(1e-3..1e4).contains(&a) {
+        return format!("{v:.0e}");
+    }
+    let s = format!("{v:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+fn draw_in<DB: DrawingBackend, X, Y>(
+    area: &DrawingArea<DB, Shift>,
+    p: &Panel,
+    x: X,
+    y: Y,
+) -> anyhow::Result<()>
+where
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("{e:?}");
+    let mut chart = ChartBuilder::on(area)
+        .caption(&p.title, (FONT, 19))
+        .margin(12)
+        .margin_right(22)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(x, y)
+        .map_err(err)?;
+    let fmt = |v: &f64| short(*v);
+    chart
+        .configure_mesh()
+        .x_desc(p.x.label.as_str())
+        .y_desc(p.y.label.as_str())
+        .x_label_formatter(&fmt)
+        .y_label_formatter(&fmt)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 16))
+        .bold_line_style(RGBColor(225, 225, 225))
+        .light_line_style(RGBColor(244, 244, 244))
+        .draw()
+        .map_err(err)?;
+    if !p.cells.is_empty() {
+        chart
+            .draw_series(
+                p.cells
+                    .iter()
+                    .map(|c| Rectangle::new([(c.x.0, c.y.0), (c.x.1, c.y.1)], c.color.filled())),
+            )
+            .map_err(err)?;
+    }
+    let mut labelled = false;
+    for s in &p.series {
+        let style = ShapeStyle {
+            color: s.color.to_rgba(),
+            filled: false,
+            stroke_width: s.width,
+        };
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|q| q.0.is_finite() && q.1.is_finite())
+            .collect();
+        let anno = match s.stroke {
+            Stroke::Solid => chart
+                .draw_series(LineSeries::new(pts, style))
+                .map_err(err)?,
+            Stroke::Dashed => chart
+                .draw_series(DashedLineSeries::new(pts, 9, 6, style))
+                .map_err(err)?,
+            Stroke::Dots => {
+                let c = s.color;
+                let r = s.width;
+                chart
+                    .draw_series(pts.into_iter().map(move |q| Circle::new(q, r, c.filled())))
+                    .map_err(err)?
+            }
+        };
+        if !s.label.is_empty() {
+            labelled = true;
+            let c = s.color;
+            match s.stroke {
+                Stroke::Dots => {
+                    anno.label(s.label.as_str())
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 3, c.filled()));
+                }
+                Stroke::Dashed => {
+                    anno.label(s.label.as_str()).legend(move |(x, y)| {
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (8, 0)], style)
+                            + PathElement::new(vec![(13, 0), (21, 0)], style)
+                    });
+                }
+                Stroke::Solid => {
+                    anno.label(s.label.as_str())
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 21, y)], style));
+                }
+            }
+        }
+    }
+    let pos = match p.legend {
+        Legend::UpperRight => Some(SeriesLabelPosition::UpperRight),
+        Legend::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
+        Legend::LowerRight => Some(SeriesLabelPosition::LowerRight),
+        Legend::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
+        Legend::None => None,
+    };
+    if let (true, Some(pos)) = (labelled, pos) {
+        chart
+            .configure_series_labels()
+            .position(pos)
+            .background_style(WHITE.mix(0.88))
+            .border_style(RGBColor(150, 150, 150))
+            .label_font((FONT, 14))
+            .draw()
+            .map_err(err)?;
+    }
+    Ok(())
+}

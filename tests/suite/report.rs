@@ -1,0 +1,322 @@
+//! `pushval report` (issue 4): the quick report writes files that parse, a
+//! sharded run merges into the same bytes as a single run, and the sweep
+//! figures agree with independent evaluations of the model: κ and the
+//! validity map's error recomputed by integrating the dynamic model's
+//! trajectory (not from the root finder or the report's RK4), κ → 1 as Fr → 0.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use pushval::report::{self, Options, Shard};
+use pushval_model::{DynamicModel, Initial, KinematicModel, Problem, Push, Simulator, Switching};
+
+use crate::common::{load, root};
+
+/// One quick report, shared by the tests that read it.
+fn quick_dir() -> &'static Path {
+    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_pushval"))
+            .current_dir(root())
+            .args(["report", "--quick", "--out"])
+            .arg(dir.path())
+            .env("CI", "1")
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "pushval report failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        dir
+    })
+    .path()
+}
+
+/// A CSV file as rows of named fields.
+fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    lines
+        .enumerate()
+        .map(|(n, l)| {
+            let f: Vec<&str> = l.split(',').collect();
+            assert_eq!(
+                f.len(),
+                header.len(),
+                "{}: line {} has {} fields",
+                path.display(),
+                n + 2,
+                f.len()
+            );
+            header
+                .iter()
+                .zip(f)
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+fn val(row: &BTreeMap<String, String>, key: &str) -> f64 {
+    row[key]
+        .parse()
+        .unwrap_or_else(|_| panic!("{key} = {} is not a number", row[key]))
+}
+
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .collect();
+    v.sort();
+    v
+}
+
+const LABEL_COLUMNS: [&str; 5] = ["model", "geometry", "contact", "inertia", "switching"];
+
+#[test]
+fn quick_report_writes_files_that_parse() {
+    let dir = quick_dir();
+    let all = files(dir);
+    let svgs: Vec<&PathBuf> = all
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "svg"))
+        .collect();
+    assert!(svgs.len() >= 12, "only {} figures", svgs.len());
+    let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+    for svg in &svgs {
+        let text = std::fs::read_to_string(svg).unwrap();
+        assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
+        assert!(text.matches("<text").count() >= 10, "{}", svg.display());
+        let name = svg.file_name().unwrap().to_str().unwrap();
+        assert!(readme.contains(name), "README misses {name}");
+        let csv = svg.with_extension("csv");
+        assert!(csv.is_file(), "no data beside {name}");
+        let rows = read_csv(&csv);
+        assert!(!rows.is_empty(), "{} is empty", csv.display());
+        for row in &rows {
+            for (k, v) in row {
+                if !LABEL_COLUMNS.contains(&k.as_str()) {
+                    v.parse::<f64>()
+                        .unwrap_or_else(|_| panic!("{}: {k} = {v}", csv.display()));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn shards_merged_equal_a_single_run_byte_for_byte() {
+    let single = tempfile::tempdir().unwrap();
+    let sharded = tempfile::tempdir().unwrap();
+    let opts = |out: &Path| Options {
+        quick: true,
+        progress: false,
+        scenarios: root().join("scenarios"),
+        ..Options::new(out)
+    };
+    report::run(&opts(single.path())).unwrap();
+    for k in 1..=3 {
+        let s = report::run(&Options {
+            shard: Some(Shard { k, n: 3 }),
+            ..opts(sharded.path())
+        })
+        .unwrap();
+        assert!(s.cells > 0);
+    }
+    // A merge with a part missing is refused.
+    let part3 = sharded.path().join("parts/sweep-3-of-3.csv");
+    let saved = std::fs::read(&part3).unwrap();
+    std::fs::remove_file(&part3).unwrap();
+    assert!(report::run(&Options {
+        merge: true,
+        ..opts(sharded.path())
+    })
+    .is_err());
+    std::fs::write(&part3, saved).unwrap();
+    report::run(&Options {
+        merge: true,
+        ..opts(sharded.path())
+    })
+    .unwrap();
+    let a = files(single.path());
+    let b = files(sharded.path());
+    let names = |v: &[PathBuf]| -> Vec<String> {
+        v.iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect()
+    };
+    assert_eq!(names(&a), names(&b));
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            std::fs::read(x).unwrap() == std::fs::read(y).unwrap(),
+            "{} differs between the single and the merged run",
+            x.display()
+        );
+    }
+    // And the single run is deterministic.
+    let again = tempfile::tempdir().unwrap();
+    report::run(&opts(again.path())).unwrap();
+    for x in &a {
+        let y = again.path().join(x.file_name().unwrap());
+        assert!(std::fs::read(x).unwrap() == std::fs::read(&y).unwrap());
+    }
+}
+
+/// A single push from ω = 0 (the object moving straight with the pusher).
+fn one_push(sc: &pushval_scenario::Scenario, speed: f64, phi: f64, duration: f64) -> Problem {
+    Problem {
+        body: sc.body(),
+        limits: sc.contact_limits,
+        pushes: vec![Push {
+            duration,
+            speed,
+            phi,
+        }],
+        initial: Initial::default(),
+        switching: Switching::Impulsive,
+        sample_dt: duration / 100.0,
+    }
+}
+
+fn geometry_file(name: &str) -> &'static str {
+    match name {
+        "square corner" => "paper-square-v1.0.toml",
+        "triangle edge" => "triangle-statics.toml",
+        "square uniform pressure" => "uniform-pressure-square.toml",
+        _ => "",
+    }
+}
+
+#[test]
+fn kappa_matches_integrated_trajectories_and_tends_to_one() {
+    let rows = read_csv(&quick_dir().join("kappa.csv"));
+    let fr_min = rows
+        .iter()
+        .map(|r| val(r, "froude"))
+        .fold(f64::INFINITY, f64::min);
+    assert!((fr_min - 1e-3).abs() < 1e-12);
+    // κ → 1 as Fr → 0, linearly: |1 − κ| ≤ Fr at the smallest Fr for every curve.
+    for r in rows.iter().filter(|r| val(r, "froude") == fr_min) {
+        let k = val(r, "kappa");
+        assert!((1.0 - k).abs() <= fr_min, "{}: κ = {k}", r["geometry"]);
+        assert!(k < 1.0);
+    }
+    // Recompute a few cells: ω* as the end of a long dynamic run from ω = 0
+    // (many relaxation times), ψ from the kinematic model's ω / v.
+    let mut checked = 0;
+    for r in &rows {
+        let file = geometry_file(&r["geometry"]);
+        let fr = val(r, "froude");
+        if file.is_empty() || !(fr == 0.01 || fr == 1.0) {
+            continue;
+        }
+        let sc = load(&root().join("scenarios").join(file));
+        let (v, phi) = (val(r, "speed"), val(r, "phi"));
+        assert!((sc.froude(v) - fr).abs() <= 1e-12 * fr);
+        let tau = val(r, "tau");
+        let p = one_push(&sc, v, phi, 60.0 * tau);
+        let dynamic = DynamicModel::default().simulate(&p).unwrap();
+        let kinematic = KinematicModel.simulate(&p).unwrap();
+        let w_end = dynamic.samples.last().unwrap().omega;
+        let w_kin = kinematic.samples.last().unwrap().omega;
+        let kappa = w_end / w_kin;
+        assert!(
+            (kappa - val(r, "kappa")).abs() < 1e-8,
+            "{} φ = {phi} Fr = {fr}: integrated κ = {kappa}, report {}",
+            r["geometry"],
+            r["kappa"]
+        );
+        checked += 1;
+    }
+    assert!(checked >= 12, "checked {checked} cells");
+}
+
+#[test]
+fn validity_map_cells_match_an_independent_integration() {
+    let rows = read_csv(&quick_dir().join("validity.csv"));
+    let sc = load(&root().join("scenarios/paper-square-v1.0.toml"));
+    let levels = [0.01, 0.05, 0.10];
+    let class = |e: f64| levels.iter().filter(|&&l| e >= l).count();
+    let mut classes = std::collections::BTreeSet::new();
+    for (n, r) in rows.iter().enumerate() {
+        // Every third cell, plus every cell whose error lies near a class boundary.
+        let eps = val(r, "error");
+        let near = levels.iter().any(|l| (eps / l - 1.0).abs() < 0.5);
+        if n % 3 != 0 && !near {
+            continue;
+        }
+        let (v, phi, t) = (val(r, "speed"), val(r, "phi"), val(r, "duration"));
+        // The report's segment: d = 10 L at speed v.
+        assert!((v * t - 10.0 * sc.froude_length()).abs() < 1e-9);
+        let p = one_push(&sc, v, phi, t);
+        let th_dyn = DynamicModel::default()
+            .simulate(&p)
+            .unwrap()
+            .samples
+            .last()
+            .unwrap()
+            .theta;
+        let th_kin = KinematicModel
+            .simulate(&p)
+            .unwrap()
+            .samples
+            .last()
+            .unwrap()
+            .theta;
+        let e = (th_dyn - th_kin).abs() / th_kin.abs();
+        assert!(
+            (e - eps).abs() <= 1e-7 + 1e-6 * eps,
+            "Fr {} φ {phi}: ε = {e}, report {eps}",
+            r["froude"]
+        );
+        assert_eq!(class(e), class(eps));
+        classes.insert(class(e));
+    }
+    // The quick grid spans every class: the boundary is inside the map.
+    assert_eq!(classes.len(), 4, "classes seen: {classes:?}");
+}
+
+#[test]
+fn assumptions_map_flags_slip_where_the_model_run_does() {
+    let rows = read_csv(&quick_dir().join("assumptions.csv"));
+    let paper = load(&root().join("scenarios/paper-square-v1.0.toml"));
+    let mut edge = paper.clone();
+    edge.contact = pushval_model::Vec2::new(0.0, -0.125);
+    edge.contact_limits.normals = (
+        pushval_model::Vec2::new(0.0, 1.0),
+        pushval_model::Vec2::new(0.0, 1.0),
+    );
+    let mut slipping = 0;
+    for r in &rows {
+        let mu = val(r, "mu_required");
+        // Stay clear of the boundary: the run samples the transient at other ω.
+        if (mu / 0.8 - 1.0).abs() < 0.1 {
+            continue;
+        }
+        let sc = if r["contact"] == "corner" {
+            &paper
+        } else {
+            &edge
+        };
+        let (v, phi) = (val(r, "speed"), val(r, "phi"));
+        let p = one_push(sc, v, phi, 1.0);
+        let run = DynamicModel::default().simulate(&p).unwrap();
+        let slips = run.assumptions.contact_slip.is_some();
+        assert_eq!(
+            slips,
+            mu > 0.8,
+            "{} v {v} φ {phi}: μ_req {mu}",
+            r["contact"]
+        );
+        assert_eq!(run.assumptions.pulling.is_some(), mu.is_infinite());
+        slipping += usize::from(slips);
+    }
+    assert!(slipping > 0);
+}
