@@ -270,7 +270,11 @@ fn main() {
                 // Richardson at the scheme's order p: x(h) + (x(h) − x(2h)) / (2^p − 1)
                 // on the common samples; its cost is both runs.
                 let (d2, tr2) = time(r, || run(2.0 * dt));
-                let k = if mode == FrictionVelocity::Leapfrog { 3.0 } else { 1.0 };
+                let k = if mode == FrictionVelocity::Leapfrog {
+                    3.0
+                } else {
+                    1.0
+                };
                 let mut rich = tr.clone();
                 for (s, c) in rich.samples.iter_mut().zip(&tr2.samples) {
                     s.x += (s.x - c.x) / k;
@@ -312,12 +316,14 @@ fn main() {
     let dir = root.join("results");
     std::fs::create_dir_all(&dir).unwrap();
     pushval::output::write_atomic(&dir.join("work_precision.csv"), csv.as_bytes()).unwrap();
-    pushval::output::write_atomic(&dir.join("work_precision.svg"), figure(&rows).as_bytes()).unwrap();
+    pushval::output::write_atomic(&dir.join("work_precision.svg"), figure(&rows).as_bytes())
+        .unwrap();
     print!("{csv}");
 }
 
 /// Log–log work–precision figure: error against median run time, one line per
-/// method (position error left, steady-ω error right).
+/// method (position error left, steady-ω error right). Errors below 1e-12
+/// are round-off and drawn at 1e-12.
 fn figure(rows: &[Row]) -> String {
     use pushval::report::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
     let shown = [
@@ -334,12 +340,17 @@ fn figure(rows: &[Row]) -> String {
         ("rapier2d f32 leapfrog", Stroke::Dots),
     ];
     let panel = |title: &str, ylabel: &str, pick: &dyn Fn(&Row) -> Option<f64>| {
-        let mut p = Panel::new(title, Axis::log("median run time (s)"), Axis::log(ylabel)).legend(Legend::UpperRight);
+        let mut p = Panel::new(title, Axis::log("median run time (s)"), Axis::log(ylabel))
+            .legend(Legend::UpperRight);
         for (k, (name, stroke)) in shown.iter().enumerate() {
             let mut pts: Vec<(f64, f64)> = rows
                 .iter()
                 .filter(|r| r.method == *name)
-                .filter_map(|r| pick(r).filter(|e| *e > 0.0 && e.is_finite()).map(|e| (r.median_s, e.max(1e-16))))
+                .filter_map(|r| {
+                    pick(r)
+                        .filter(|e| *e > 0.0 && e.is_finite())
+                        .map(|e| (r.median_s, e.max(1e-12)))
+                })
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             if !pts.is_empty() {
@@ -352,8 +363,16 @@ fn figure(rows: &[Row]) -> String {
         size: (1400, 620),
         cols: 2,
         panels: vec![
-            panel("Work–precision, 10 s paper trajectory: position", "max CM position error (m)", &|r| Some(r.position_err)),
-            panel("Work–precision: steady ω", "max relative steady-ω error", &|r| r.omega_rel_err),
+            panel(
+                "Work–precision, 10 s paper trajectory: position",
+                "max CM position error (m)",
+                &|r| Some(r.position_err),
+            ),
+            panel(
+                "Work–precision: steady ω",
+                "max relative steady-ω error",
+                &|r| r.omega_rel_err,
+            ),
         ],
         key: None,
     };
