@@ -299,7 +299,6 @@ fn contact_on_top_of_a_support() {
 /// them with alternating stability; started between two, model and engine
 /// settle on the same stable one, whichever side they start from.
 #[test]
-#[ignore = "open: from ω₀ = −11.47 (v = 4, φ = −2.6) SegmentDynamics::attractor names ω = −12.12 but the integrated model moves to −7.18; to investigate"]
 fn several_steady_states_model_and_engine_pick_the_same_attractor() {
     let body = paper_plate();
     let phi = -2.6;
@@ -335,21 +334,27 @@ fn several_steady_states_model_and_engine_pick_the_same_attractor() {
             };
             checked += 1;
             assert!(target.is_stable());
-            let mut p = one_push(body.clone(), 1.0, v, phi);
+            // Far from the attractor the relaxation is slow (ω̇ is small near
+            // the unstable root): give it 30 s.
+            let mut p = one_push(body.clone(), 30.0, v, phi);
             p.initial.omega = w0;
             let m = run(&adaptive(1e-10, true), &p);
             all_finite(&m);
             let wm = m.samples.last().unwrap().omega;
-            // Headed for the attractor: nearer to it than to any other root.
-            let nearest = roots
-                .iter()
-                .min_by(|a, b| (a.omega - wm).abs().total_cmp(&(b.omega - wm).abs()))
-                .unwrap();
-            assert_eq!(
-                nearest.omega, target.omega,
-                "start {w0}: model ends at {wm}"
+            // ω moves monotonically from the start to the attractor.
+            let dir = (target.omega - w0).signum();
+            for pair in m.samples.windows(2) {
+                assert!(
+                    (pair[1].omega - pair[0].omega) * dir >= -1e-9,
+                    "start {w0}: not monotone"
+                );
+            }
+            assert!(
+                (wm - target.omega).abs() < 1e-6 * (1.0 + target.omega.abs()),
+                "start {w0}: model ends at {wm}, attractor {}",
+                target.omega
             );
-            let e = engine(1e-4).simulate(&p).unwrap();
+            let e = engine(1e-3).simulate(&p).unwrap();
             let we = tail_mean_omega(&p, &e, 0.2)[0].unwrap();
             assert!(
                 (we - wm).abs() < 0.01 * (1.0 + wm.abs()),
