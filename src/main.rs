@@ -211,11 +211,12 @@ fn stress(out: PathBuf, quick: bool) -> anyhow::Result<ExitCode> {
     let (outcomes, limits) = pushval::stress::write_sweep(&cases, &out)?;
     print!("{}", pushval::stress::summary_text(&outcomes, &limits));
     println!(
-        "{} runs in {:.1} s; wrote {} and {}",
+        "{} runs in {:.1} s; wrote {}, {} and {}",
         outcomes.len(),
         start.elapsed().as_secs_f64(),
         out.join("stress.csv").display(),
-        out.join("stability.csv").display()
+        out.join("stability.csv").display(),
+        out.join("stress_map.svg").display()
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -693,5 +693,99 @@ pub fn write_sweep(cases: &[Case], out: &Path) -> anyhow::Result<(Vec<Outcome>, 
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     crate::output::write_atomic(&out.join("stress.csv"), csv(&outcomes).as_bytes())?;
     crate::output::write_atomic(&out.join("stability.csv"), limits_csv(&lim).as_bytes())?;
+    if let Some(svg) = map_figure(&outcomes)? {
+        crate::output::write_atomic(&out.join("stress_map.svg"), svg.as_bytes())?;
+    }
     Ok((outcomes, lim))
+}
+
+/// Cell edges for a sorted log-spaced grid: geometric midpoints, extended
+/// by half a step at both ends.
+fn log_edges(v: &[f64]) -> Vec<(f64, f64)> {
+    (0..v.len())
+        .map(|i| {
+            let lo = if i == 0 {
+                v[0] * (v[0] / v[1.min(v.len() - 1)]).abs().sqrt().max(1e-300)
+            } else {
+                (v[i - 1] * v[i]).sqrt()
+            };
+            let hi = if i + 1 == v.len() {
+                v[i] * (v[i] / v[i.saturating_sub(1)]).abs().sqrt()
+            } else {
+                (v[i] * v[i + 1]).sqrt()
+            };
+            (lo.min(hi), lo.max(hi))
+        })
+        .collect()
+}
+
+/// The stability map: for RK4 and rapier2d, one panel per μ of the map
+/// sweep, cells over (v_c, dt) coloured ok / degraded / unstable. None when
+/// the outcomes hold no map sweep.
+pub fn map_figure(outcomes: &[Outcome]) -> anyhow::Result<Option<String>> {
+    use crate::report::plot::{Axis, Cell, Figure, Key, Legend, Panel};
+    use plotters::style::RGBColor;
+    let map: Vec<&Outcome> = outcomes
+        .iter()
+        .filter(|o| o.case.sweep == "map" && o.case.solver != Solver::Adaptive)
+        .collect();
+    if map.is_empty() {
+        return Ok(None);
+    }
+    let uniq = |f: &dyn Fn(&Case) -> f64| {
+        let mut v: Vec<f64> = map.iter().map(|o| f(&o.case)).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    };
+    let (dts, speeds, mus) = (uniq(&|c| c.dt), uniq(&|c| c.speed), uniq(&|c| c.mu));
+    if dts.len() < 2 || speeds.len() < 2 {
+        return Ok(None);
+    }
+    let (de, se) = (log_edges(&dts), log_edges(&speeds));
+    let ok = RGBColor(120, 190, 120);
+    let degraded = RGBColor(240, 180, 80);
+    let unstable = RGBColor(210, 60, 60);
+    let mut panels = Vec::new();
+    for solver in [Solver::Rk4, Solver::Engine] {
+        for &mu in &mus {
+            let mut p = Panel::new(
+                format!("{} — μ = {mu}", solver.name()),
+                Axis::log("pusher speed v_c (m/s)").range(se[0].0, se[se.len() - 1].1),
+                Axis::log("time step dt (s)").range(de[0].0, de[de.len() - 1].1),
+            )
+            .legend(Legend::None);
+            for o in map
+                .iter()
+                .filter(|o| o.case.solver == solver && o.case.mu == mu)
+            {
+                let i = speeds.iter().position(|v| *v == o.case.speed).unwrap_or(0);
+                let j = dts.iter().position(|v| *v == o.case.dt).unwrap_or(0);
+                p.cells.push(Cell {
+                    x: se[i],
+                    y: de[j],
+                    color: match o.status {
+                        Status::Ok => ok,
+                        Status::Degraded => degraded,
+                        Status::Unstable => unstable,
+                    },
+                });
+            }
+            panels.push(p);
+        }
+    }
+    let fig = Figure {
+        size: (420 * mus.len() as u32 + 120, 820),
+        cols: mus.len(),
+        panels,
+        key: Some(Key {
+            title: "vs a tight model run".into(),
+            entries: vec![
+                ("ok".into(), ok),
+                ("degraded".into(), degraded),
+                ("unstable (blew up)".into(), unstable),
+            ],
+        }),
+    };
+    crate::report::plot::render(&fig).map(Some)
 }

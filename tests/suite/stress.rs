@@ -165,7 +165,12 @@ fn stress_command_writes_finite_csvs_and_nothing_else() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
-    assert_eq!(names, ["stability.csv", "stress.csv"]);
+    assert_eq!(names, ["stability.csv", "stress.csv", "stress_map.svg"]);
+    let svg = std::fs::read_to_string(out.join("stress_map.svg")).unwrap();
+    assert!(
+        svg.starts_with("<svg") && svg.contains("rapier2d"),
+        "the map figure renders"
+    );
     let text = std::fs::read_to_string(out.join("stress.csv")).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), stress::quick_grid().len() + 1);
