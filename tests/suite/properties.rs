@@ -280,9 +280,19 @@ proptest! {
         // A sticking support makes friction set-valued: the balance below uses
         // the sliding law, so such scenes are outside this property.
         prop_assume!(tr.assumptions.sticking.is_none() && tr.assumptions.runaway.is_none());
+        // Simpson's rule needs the fastest transient resolved: keep scenes
+        // whose relaxation times are at least 40 samples long.
+        let tau_min = p
+            .pushes
+            .iter()
+            .filter(|q| q.speed > 0.0)
+            .flat_map(|q| SegmentDynamics::new(&p.body, q).steady_states())
+            .filter_map(|r| r.tau)
+            .fold(f64::INFINITY, f64::min);
+        prop_assume!(tau_min >= 40.0 * dt);
         let b = energy_books(&p, &tr);
         let scale = b.work.abs().max(b.dissipation).max(1e-12);
-        prop_assert!((b.work - b.dissipation - b.kinetic).abs() <= 1e-3 * scale, "{b:?}");
+        prop_assert!((b.work - b.dissipation - b.kinetic).abs() <= 1e-6 * scale, "{b:?}");
     }
 }
 
