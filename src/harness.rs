@@ -7,7 +7,7 @@ use pushval_model::{
     LimitSurfaceModel, ModelError, Problem, RootKind, SegmentDynamics, Simulator, SteadyState,
     Trajectory,
 };
-use pushval_rapier::{EngineRun, EngineSettings, RapierSimulator};
+use pushval_rapier::{EngineRun, EngineSettings, FrictionModel, RapierSimulator};
 use pushval_scenario::{ModelKind, Scenario};
 
 /// Settings of a harness run.
@@ -237,6 +237,26 @@ fn simulator(
                 engine_settings_json(&settings),
             ))
         }
+        idiom => {
+            // The 2-D friction idioms (informational): the scenario's engine
+            // settings with the idiom's friction law; slip speed 0.01 m/s for
+            // the regularised laws (see results/friction_models/).
+            let friction_model = match idiom {
+                ModelKind::Rapier2dImpulseDisk => FrictionModel::ImpulseDisk,
+                ModelKind::Rapier2dImpulseBox => FrictionModel::ImpulseBox,
+                ModelKind::Rapier2dRegularisedLinear => {
+                    FrictionModel::RegularisedLinear { slip_speed: 0.01 }
+                }
+                _ => FrictionModel::RegularisedTanh { slip_speed: 0.01 },
+            };
+            let settings = EngineSettings {
+                friction_model,
+                ..engine_settings(sc)
+            };
+            let mut json = engine_settings_json(&settings);
+            json["friction_model"] = serde_json::json!(friction_model.as_str());
+            Some((Box::new(RapierSimulator { settings }), json))
+        }
     }
 }
 
@@ -402,7 +422,7 @@ pub fn compare(
         ModelKind::Dynamic | ModelKind::Kinematic | ModelKind::LimitSurface => {
             SteadyRead::SegmentEnd
         }
-        ModelKind::Rapier2d => SteadyRead::TailMean,
+        _ => SteadyRead::TailMean,
     };
     compare_trajectory(
         sc,

@@ -130,3 +130,40 @@ fn engine_meets_steady_target(#[files("scenarios/*.toml")] path: PathBuf) {
         assert!(e <= 1e-4, "steady-ω error {e:e}");
     }
 }
+
+/// The 2-D friction idioms run from a scenario as informational rows of the
+/// table, and show what results/friction_models/ explains: the capped
+/// friction joint over-turns by about half (its force follows −K⁻¹u, not −u),
+/// the per-axis box stops turning, the regularised laws (slip speed 0.01 m/s,
+/// below every support's sliding speed here) equal Coulomb.
+#[test]
+fn friction_idioms_are_informational_rows_with_their_findings() {
+    let sc = load(&root().join("scenarios/friction-idioms.toml"));
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let row = |name: &str| {
+        report
+            .comparisons
+            .iter()
+            .find(|c| c.model == name)
+            .unwrap_or_else(|| panic!("{name} missing"))
+    };
+    for name in [
+        "rapier2d_impulse_disk",
+        "rapier2d_impulse_box",
+        "rapier2d_regularised_linear",
+        "rapier2d_regularised_tanh",
+    ] {
+        assert_eq!(row(name).pass, None, "{name} must not be gated");
+    }
+    let disk = row("rapier2d_impulse_disk").omega_steady_rel_max.unwrap();
+    assert!((0.4..0.6).contains(&disk), "impulse_disk: {disk}");
+    let boxed = row("rapier2d_impulse_box").omega_steady_rel_max.unwrap();
+    assert!(
+        (boxed - 1.0).abs() < 0.05,
+        "impulse_box should stop turning: {boxed}"
+    );
+    for name in ["rapier2d_regularised_linear", "rapier2d_regularised_tanh"] {
+        let e = row(name).omega_steady_rel_max.unwrap();
+        assert!(e < 1e-6, "{name}: {e}");
+    }
+}

@@ -18,15 +18,35 @@ pub enum ModelKind {
     Kinematic,
     LimitSurface,
     Rapier2d,
+    /// rapier2d with a 2-D game engine's friction joint at each support
+    /// (impulse capped in length at μ N Δt); informational.
+    Rapier2dImpulseDisk,
+    /// The same capped per world axis; informational.
+    Rapier2dImpulseBox,
+    /// rapier2d with Coulomb regularised linearly below 0.01 m/s; informational.
+    Rapier2dRegularisedLinear,
+    /// rapier2d with Coulomb regularised by tanh(|u| / 0.01 m/s); informational.
+    Rapier2dRegularisedTanh,
 }
 
 impl ModelKind {
-    /// Every model, in output order.
+    /// The models a scenario runs when it does not list any, in output order.
     pub const ALL: [ModelKind; 4] = [
         ModelKind::Dynamic,
         ModelKind::Kinematic,
         ModelKind::LimitSurface,
         ModelKind::Rapier2d,
+    ];
+    /// Every model a scenario can list.
+    pub const KNOWN: [ModelKind; 8] = [
+        ModelKind::Dynamic,
+        ModelKind::Kinematic,
+        ModelKind::LimitSurface,
+        ModelKind::Rapier2d,
+        ModelKind::Rapier2dImpulseDisk,
+        ModelKind::Rapier2dImpulseBox,
+        ModelKind::Rapier2dRegularisedLinear,
+        ModelKind::Rapier2dRegularisedTanh,
     ];
     /// The name used in files and outputs.
     pub fn name(self) -> &'static str {
@@ -35,11 +55,15 @@ impl ModelKind {
             ModelKind::Kinematic => "kinematic",
             ModelKind::LimitSurface => "limit_surface",
             ModelKind::Rapier2d => "rapier2d",
+            ModelKind::Rapier2dImpulseDisk => "rapier2d_impulse_disk",
+            ModelKind::Rapier2dImpulseBox => "rapier2d_impulse_box",
+            ModelKind::Rapier2dRegularisedLinear => "rapier2d_regularised_linear",
+            ModelKind::Rapier2dRegularisedTanh => "rapier2d_regularised_tanh",
         }
     }
     /// Parses a model name.
     pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == s)
+        Self::KNOWN.into_iter().find(|m| m.name() == s)
     }
 }
 
@@ -597,7 +621,7 @@ impl Scenario {
                             &format!("run.models[{i}]"),
                             format!(
                                 "unknown model \"{m}\"; known: {}",
-                                ModelKind::ALL.map(|k| k.name()).join(", ")
+                                ModelKind::KNOWN.map(|k| k.name()).join(", ")
                             ),
                         )
                     })?;
