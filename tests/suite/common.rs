@@ -93,3 +93,19 @@ pub fn root() -> PathBuf {
 pub fn load(p: &Path) -> Scenario {
     Scenario::from_path(p).unwrap_or_else(|e| panic!("{e}"))
 }
+
+/// The paper plate with one heavily loaded corner (−a, a) on the line through
+/// the contact perpendicular to a push along +x: the object pivots on it.
+pub fn pivot_body() -> Body {
+    let a = 0.125;
+    let f = [0.05, 0.05, 0.05, 20.0];
+    let sup: Vec<Support> = [(-a, -a), (a, -a), (a, a), (-a, a)]
+        .iter()
+        .zip(f)
+        .map(|(&(x, y), friction)| Support {
+            position: Vec2::new(x, y),
+            friction,
+        })
+        .collect();
+    Body::new(1.0, 0.25f64.powi(2) / 6.0, Vec2::new(-a, -a), &sup).unwrap()
+}

@@ -413,18 +413,8 @@ fn zero_speed_segment_stops_in_closed_form_time() {
 /// flags the sticking support, and no NaN appears.
 #[test]
 fn pivoting_support_is_reported_not_hidden() {
-    use pushval_model::{Body, Support};
     let a = 0.125;
-    let f = [0.05, 0.05, 0.05, 20.0];
-    let sup: Vec<Support> = [(-a, -a), (a, -a), (a, a), (-a, a)]
-        .iter()
-        .zip(f)
-        .map(|(&(x, y), friction)| Support {
-            position: Vec2::new(x, y),
-            friction,
-        })
-        .collect();
-    let body = Body::new(1.0, 0.25f64.powi(2) / 6.0, Vec2::new(-a, -a), &sup).unwrap();
+    let body = pivot_body();
     let v = 0.2;
     let push = Push {
         duration: 2.0,

@@ -194,22 +194,6 @@ fn stress_command_writes_finite_csvs_and_nothing_else() {
 
 // ------------------------------------------------------ near-singular physics
 
-/// The paper plate with one heavily loaded corner on the line through the
-/// contact perpendicular to the push: the object pivots on that support.
-fn pivot_body() -> Body {
-    let a = 0.125;
-    let f = [0.05, 0.05, 0.05, 20.0];
-    let sup: Vec<Support> = [(-a, -a), (a, -a), (a, a), (-a, a)]
-        .iter()
-        .zip(f)
-        .map(|(&(x, y), friction)| Support {
-            position: Vec2::new(x, y),
-            friction,
-        })
-        .collect();
-    Body::new(1.0, 0.25f64.powi(2) / 6.0, Vec2::new(-a, -a), &sup).unwrap()
-}
-
 /// The model reports the pivot (RootKind::Pivot, assumptions.sticking); the
 /// engine, whose friction at the stuck support chatters, turns at the same
 /// ω = v / |r| on average and stays finite, its slowest support nearly at rest.

@@ -297,6 +297,28 @@ mod tests {
         let p = (run(20) / run(40)).log2();
         assert!((3.8..4.2).contains(&p), "order {p}");
     }
+
+    /// Local error O(h⁹) for the 8th-order step, O(h⁸) for the 7th-order interpolant.
+    #[test]
+    fn dop853_orders() {
+        let y0 = exact(0.0);
+        let mut g = |y: &State| f(y);
+        let k1 = g(&y0);
+        let (mut e, mut d) = (vec![], vec![]);
+        for h in [0.4, 0.2] {
+            let a = dop853::attempt(&mut g, &y0, &k1, h, 1.0, &[0.0; N]);
+            let ex = exact(h);
+            e.push((0..N).map(|i| (a.y1[i] - ex[i]).abs()).fold(0.0, f64::max));
+            let dn = a.dense(&mut g, 0.0, &y0, h);
+            let ym = dn.eval(0.37 * h);
+            let exm = exact(0.37 * h);
+            d.push((0..N).map(|i| (ym[i] - exm[i]).abs()).fold(0.0, f64::max));
+        }
+        let p = (e[0] / e[1]).log2();
+        let pd = (d[0] / d[1]).log2();
+        assert!((8.4..9.8).contains(&p), "local order {p} {e:?}");
+        assert!((7.4..8.8).contains(&pd), "dense local order {pd} {d:?}");
+    }
 }
 
 /// Dormand & Prince's 8(5,3) pair (DOP853; Hairer, Nørsett & Wanner, Solving
@@ -440,41 +462,5 @@ pub mod dop853 {
             }
             out
         }
-    }
-}
-
-#[cfg(test)]
-mod dop853_tests {
-    use super::dop853;
-    use super::*;
-
-    fn f(y: &State) -> State {
-        [-0.5 * y[0] + y[1], -y[0] - 0.5 * y[1], -y[2], 2.0 * y[3]]
-    }
-    fn exact(t: f64) -> State {
-        let e = (-0.5 * t).exp();
-        [e * t.cos(), -e * t.sin(), (-t).exp(), (2.0 * t).exp()]
-    }
-
-    /// Local error O(h⁹) for the 8th-order step, O(h⁸) for the 7th-order interpolant.
-    #[test]
-    fn dop853_orders() {
-        let y0 = exact(0.0);
-        let mut g = |y: &State| f(y);
-        let k1 = g(&y0);
-        let (mut e, mut d) = (vec![], vec![]);
-        for h in [0.4, 0.2] {
-            let a = dop853::attempt(&mut g, &y0, &k1, h, 1.0, &[0.0; N]);
-            let ex = exact(h);
-            e.push((0..N).map(|i| (a.y1[i] - ex[i]).abs()).fold(0.0, f64::max));
-            let dn = a.dense(&mut g, 0.0, &y0, h);
-            let ym = dn.eval(0.37 * h);
-            let exm = exact(0.37 * h);
-            d.push((0..N).map(|i| (ym[i] - exm[i]).abs()).fold(0.0, f64::max));
-        }
-        let p = (e[0] / e[1]).log2();
-        let pd = (d[0] / d[1]).log2();
-        assert!((8.4..9.8).contains(&p), "local order {p} {e:?}");
-        assert!((7.4..8.8).contains(&pd), "dense local order {pd} {d:?}");
     }
 }
