@@ -1,0 +1,1 @@
+//! The pushing problem as a 3-D rapier scene (skeleton; see the crate description).
