@@ -1,1 +1,369 @@
-//! The pushing problem as a 3-D rapier scene (skeleton; see the crate description).
+//! The pushing problem of `pushval-model` as a 3-D scene in rapier3d (f64),
+//! with rapier's **own** contact friction: no friction force is applied by hand.
+//!
+//! The scene (z up, gravity `(0, 0, −g)`, g = [`Rapier3dSettings::gravity`]):
+//!
+//! * **Ground**: a fixed body with a large cuboid collider whose top face is
+//!   the plane z = 0; friction coefficient 1 with
+//!   [`CoefficientCombineRule::Multiply`](rapier3d_f64::prelude::CoefficientCombineRule),
+//!   restitution 0.
+//! * **Object**: a dynamic body with its origin at the centre of mass, at
+//!   height `cm_height` above the ground. Mass `m` and inertia are set
+//!   explicitly: the vertical-axis inertia is the problem's `I_cm`, the two
+//!   tilt inertias are `I_cm/2 + m t²/12` (a thin plate of thickness
+//!   `plate_thickness` t, perpendicular-axis theorem;
+//!   [`predict::tilt_inertia`]). One small ball ("foot", radius
+//!   `foot_radius`) per support, its lowest point at the support's `(x_i, y_i)`
+//!   on the ground; the feet have density 0 (no mass of their own). Each
+//!   foot's friction is `μ_i` with `Multiply`, so the effective coefficient
+//!   against the ground is `μ_i · 1 = μ_i`; restitution 0.
+//! * **Pusher**: a kinematic velocity-based body without collider, joined to
+//!   the object at the contact point `p_c`, at height `push_height` above the
+//!   ground, by a [`GenericJoint`](rapier3d_f64::prelude::GenericJoint) that
+//!   locks only `LIN_X` and `LIN_Y` of the pusher's (world-aligned) frame: it
+//!   transmits only a horizontal force, carries no weight, and leaves the
+//!   object free to rise, tilt and turn. Every step the pusher is re-pinned
+//!   onto the object's contact point and given the commanded contact velocity
+//!   `v_c R(θ_m) n_φ`, θ_m the object's yaw at mid-step (`θ + ω h/2`).
+//!
+//! The friction comes from rapier's contact solver, in one of its two 3-D
+//! friction models ([`ContactFriction`]). How the feet are grouped into
+//! colliders decides what `Simplified` does ([`FeetColliders`]): rapier builds
+//! contact manifolds per *collider pair* (and merges a compound collider's
+//! per-ball manifolds that share a normal into one "cluster" manifold of at
+//! most 4 points), and `Simplified` replaces a manifold's per-point friction
+//! by one friction constraint at the manifold's friction centre plus a twist
+//! constraint — see [`predict`] for the closed forms.
+//!
+//! **Start.** The object is placed with its feet exactly touching the ground
+//! and first settles for `settle_time` with the pusher at rest (the normal
+//! loads build up in rapier's soft contacts). Then the clock is reset to 0 and
+//! the push schedule starts: unless `initial.from_rest`, the object is given
+//! the velocity of a body moving with the first push at ω = `initial.omega`
+//! (the seed paper's start); with `from_rest` it is left at rest and the joint
+//! delivers the start impulse. Switches between push segments need nothing
+//! special: the pusher velocity changes and the joint delivers the impulse.
+//! `Problem::switching` is ignored (the engine is what shows which reading a
+//! rigid body obeys), as in the 2-D adapter.
+//!
+//! **Friction coefficients.** The model's supports carry only `F_i = μ_i N_i`;
+//! in 3-D the loads come out of the contact solver. The adapter takes the
+//! loads the scene has at rest ([`predict::Scene::rest_loads`]: statics for
+//! up to three supports, springs ∝ effective mass for more — equal loads for
+//! symmetric layouts) and sets `μ_i = F_i / N_i^rest`, so that at rest each
+//! support has the friction the problem asks for. A problem whose loads the
+//! rest loads cannot give (a non-positive rest load where `F_i > 0`) is
+//! refused.
+//!
+//! Units are SI throughout (m, s, rad, kg, N).
+
+use std::time::{Duration, Instant};
+
+use pushval_model::{ModelError, Problem, Simulator, Trajectory};
+
+pub mod predict;
+mod world;
+
+/// Which of rapier3d's friction models the contact solver uses
+/// (`IntegrationParameters::friction_model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum ContactFriction {
+    /// `FrictionModel::Coulomb`: one friction constraint (a 2-D impulse capped
+    /// by a disk of radius `μ λ_n`) per contact point. The default here.
+    #[default]
+    Coulomb,
+    /// `FrictionModel::Simplified` (rapier's default): per contact manifold,
+    /// one friction constraint at the friction centre (mean of the points),
+    /// capped by `μ Σ λ_n`, plus one twist constraint about the normal capped
+    /// by `μ Σ λ_n,k |p_k − c|`. A manifold with one point gets no twist.
+    Simplified,
+}
+
+impl ContactFriction {
+    /// `"coulomb"` or `"simplified"`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            ContactFriction::Coulomb => "coulomb",
+            ContactFriction::Simplified => "simplified",
+        }
+    }
+
+    /// Both, Coulomb first.
+    pub const ALL: [ContactFriction; 2] = [ContactFriction::Coulomb, ContactFriction::Simplified];
+}
+
+/// How the feet are made into colliders. This decides how many contact
+/// manifolds rapier builds, and so what [`ContactFriction::Simplified`] does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum FeetColliders {
+    /// One compound collider holding every foot (one collider per body, as a
+    /// game would build it): rapier clusters the feet's manifolds (same normal)
+    /// into **one** manifold of up to 4 points, so `Simplified` friction acts
+    /// on the feet together. Needs at most 4 supports (rapier keeps at most 4
+    /// points of a cluster) and one friction coefficient (friction is per
+    /// collider pair). The default.
+    #[default]
+    Compound,
+    /// One ball collider per foot: one manifold of one point per foot, so
+    /// `Simplified` has no twist and acts like `Coulomb`. Any number of
+    /// supports and a coefficient per support.
+    Separate,
+}
+
+impl FeetColliders {
+    /// `"compound"` or `"separate"`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            FeetColliders::Compound => "compound",
+            FeetColliders::Separate => "separate",
+        }
+    }
+}
+
+/// How the 3-D engine runs a problem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rapier3dSettings {
+    /// Largest time step (s); default `1e-3`. Each push segment is cut into
+    /// `ceil(duration / dt)` equal steps, so steps land on the switch times.
+    pub dt: f64,
+    /// rapier's friction model; default [`ContactFriction::Coulomb`].
+    pub friction: ContactFriction,
+    /// Radius of the ball feet (m); default `0.003`.
+    pub foot_radius: f64,
+    /// Height of the centre of mass above the ground (m); default `0.01`.
+    pub cm_height: f64,
+    /// Height above the ground at which the pusher joint holds the object (m);
+    /// default `0.01` (the centre of mass's height).
+    pub push_height: f64,
+    /// rapier's `num_solver_iterations` (substeps per step), ≥ 1; default 4
+    /// (rapier's).
+    pub solver_iterations: usize,
+    /// rapier's `num_internal_pgs_iterations`, ≥ 1; default 1 (rapier's).
+    pub pgs_iterations: usize,
+    /// Gravity (m/s²); default 9.81. The problem's friction magnitudes are
+    /// divided by the rest loads under this gravity to give the μ_i.
+    pub gravity: f64,
+    /// Plate thickness (m) for the tilt inertias; default `0.005`.
+    pub plate_thickness: f64,
+    /// How the feet are made into colliders; default [`FeetColliders::Compound`].
+    pub feet: FeetColliders,
+    /// rapier's `contact_recycling` (rapier's default: true). When on, a
+    /// contact pair that moved less than 5 cm (translation plus rotation
+    /// chord) since its last full update keeps its points **and the solver's
+    /// world-space lever arms** (`ContactData::solver_dp1`) frozen. Default
+    /// false here: the lever arms then follow the turning body every step.
+    pub contact_recycling: bool,
+    /// Duration (s) of the settle phase before the push starts; default 0.3
+    /// (the soft contacts' slow time constant is about 0.05 s).
+    pub settle_time: f64,
+}
+
+impl Default for Rapier3dSettings {
+    fn default() -> Self {
+        Self {
+            dt: 1e-3,
+            friction: ContactFriction::Coulomb,
+            foot_radius: 0.003,
+            cm_height: 0.01,
+            push_height: 0.01,
+            solver_iterations: 4,
+            pgs_iterations: 1,
+            gravity: 9.81,
+            plate_thickness: 0.005,
+            feet: FeetColliders::Compound,
+            contact_recycling: false,
+            settle_time: 0.3,
+        }
+    }
+}
+
+impl Rapier3dSettings {
+    /// A short description, e.g.
+    /// `rapier3d[coulomb,compound,dt=0.001,h_cm=0.01,h_push=0.01]`
+    /// (`,recycling` appended when contact recycling is on).
+    pub fn label(&self) -> String {
+        format!(
+            "rapier3d[{},{},dt={},h_cm={},h_push={}{}]",
+            self.friction.as_str(),
+            self.feet.as_str(),
+            self.dt,
+            self.cm_height,
+            self.push_height,
+            if self.contact_recycling {
+                ",recycling"
+            } else {
+                ""
+            }
+        )
+    }
+
+    /// Checks the settings; errors name the field.
+    pub fn check(&self) -> Result<(), ModelError> {
+        let positive = |name: &'static str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(ModelError::Parameter {
+                    name,
+                    requirement: "finite and > 0",
+                    value: v,
+                })
+            }
+        };
+        positive("rapier3d dt", self.dt)?;
+        positive("rapier3d foot_radius", self.foot_radius)?;
+        positive("rapier3d cm_height", self.cm_height)?;
+        positive("rapier3d gravity", self.gravity)?;
+        positive("rapier3d plate_thickness", self.plate_thickness)?;
+        if !(self.push_height.is_finite() && self.push_height >= 0.0) {
+            return Err(ModelError::Parameter {
+                name: "rapier3d push_height",
+                requirement: "finite and >= 0",
+                value: self.push_height,
+            });
+        }
+        if !(self.settle_time.is_finite() && self.settle_time >= 0.0) {
+            return Err(ModelError::Parameter {
+                name: "rapier3d settle_time",
+                requirement: "finite and >= 0",
+                value: self.settle_time,
+            });
+        }
+        if self.solver_iterations == 0 {
+            return Err(ModelError::Parameter {
+                name: "rapier3d solver_iterations",
+                requirement: ">= 1",
+                value: 0.0,
+            });
+        }
+        if self.pgs_iterations == 0 {
+            return Err(ModelError::Parameter {
+                name: "rapier3d pgs_iterations",
+                requirement: ">= 1",
+                value: 0.0,
+            });
+        }
+        Ok(())
+    }
+
+    /// The [`predict::Scene`] of `problem` under these settings (μ_i from the
+    /// rest loads, see the crate docs).
+    pub fn scene(&self, problem: &Problem) -> Result<predict::Scene, ModelError> {
+        world::scene_of(problem, self)
+    }
+}
+
+/// One engine step: time, pose at its end, the angular velocity held over it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Step3d {
+    /// Push segment of the step.
+    pub segment: usize,
+    /// Start and end time (s); equal for the initial record.
+    pub t0: f64,
+    pub t1: f64,
+    /// World position of the centre of mass at `t1` (m).
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    /// Yaw at `t1`, unwrapped (rad).
+    pub theta: f64,
+    /// Vertical angular velocity over the step (rad/s).
+    pub omega: f64,
+    /// Tilt of the body's z axis from the vertical at `t1` (rad).
+    pub tilt: f64,
+}
+
+/// A 3-D run: the sampled trajectory and what the engine did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rapier3dRun {
+    /// The trajectory sampled at [`Problem::sample_times`].
+    pub trajectory: Trajectory,
+    /// The settings used.
+    pub settings: Rapier3dSettings,
+    /// Engine steps of the push (settle steps excluded).
+    pub steps: usize,
+    /// Wall-clock time of the run (set-up, settling, stepping, sampling).
+    pub wall_time: Duration,
+    /// Friction coefficient given to each foot.
+    pub mu: Vec<f64>,
+    /// The loads (N) μ_i was computed from ([`predict::Scene::rest_loads`]).
+    pub nominal_loads: Vec<f64>,
+    /// Measured normal force (N) of each foot at the end of the settle phase.
+    pub rest_loads: Vec<f64>,
+    /// Per segment, the mean ω (rad/s) over its last 20 % of steps.
+    pub segment_tail_omega: Vec<f64>,
+    /// Per segment, each foot's mean normal force (N) over the last 20 %.
+    pub segment_tail_loads: Vec<Vec<f64>>,
+    /// Per segment, each foot's mean friction force magnitude (N) over the
+    /// last 20 % (compare with `μ_i N_i`: below it, the foot sticks).
+    pub segment_tail_friction: Vec<Vec<f64>>,
+    /// Per segment, each foot's smallest horizontal slip speed (m/s) over the
+    /// last 20 %.
+    pub segment_tail_min_slip: Vec<Vec<f64>>,
+    /// Smallest normal force (N) of each foot over the push.
+    pub min_loads: Vec<f64>,
+    /// Largest tilt (rad) over the push.
+    pub max_tilt: f64,
+    /// Largest vertical displacement of the centre of mass from its height at
+    /// the end of the settle phase (m).
+    pub max_lift: f64,
+    /// Largest horizontal distance (m) between the pusher and the object's
+    /// contact point after a step (before re-pinning).
+    pub max_joint_drift: f64,
+    /// Contact manifolds (and their points) the solver saw between the object
+    /// and the ground at the end of the settle phase.
+    pub manifolds: usize,
+    pub manifold_points: usize,
+    /// Every step of the push, after an initial record at t = 0.
+    pub history: Vec<Step3d>,
+}
+
+impl Rapier3dRun {
+    /// Whether a foot lost its contact (normal force below 1e-3 of its rest
+    /// load at some step): the object tipped or hopped.
+    pub fn lost_contact(&self) -> Vec<bool> {
+        self.min_loads
+            .iter()
+            .zip(&self.nominal_loads)
+            .map(|(&n, &n0)| n < 1e-3 * n0)
+            .collect()
+    }
+}
+
+/// The rapier3d engine as a [`Simulator`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Rapier3dSimulator {
+    pub settings: Rapier3dSettings,
+}
+
+impl Rapier3dSimulator {
+    /// A simulator with the given settings.
+    pub fn new(settings: Rapier3dSettings) -> Self {
+        Self { settings }
+    }
+
+    /// Runs the problem and returns the trajectory with the engine's diagnostics.
+    pub fn run(&self, problem: &Problem) -> Result<Rapier3dRun, ModelError> {
+        let start = Instant::now();
+        problem.check()?;
+        self.settings.check()?;
+        let mut run = world::simulate(problem, &self.settings)?;
+        run.trajectory.model = self.name();
+        run.wall_time = start.elapsed();
+        Ok(run)
+    }
+}
+
+impl Simulator for Rapier3dSimulator {
+    /// `"rapier3d"` (Coulomb) or `"rapier3d_simplified"`.
+    fn name(&self) -> String {
+        match self.settings.friction {
+            ContactFriction::Coulomb => "rapier3d".to_string(),
+            ContactFriction::Simplified => "rapier3d_simplified".to_string(),
+        }
+    }
+
+    fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
+        self.run(problem).map(|r| r.trajectory)
+    }
+}
