@@ -1,0 +1,209 @@
+//! Closed forms that explain where MuJoCo departs from the Coulomb model
+//! (no MuJoCo needed; they use only `pushval-model`).
+
+use pushval_model::{cross, Body, Push, SegmentDynamics, Vec2};
+
+/// A support-friction law: the force (N, object frame) on support `i`
+/// sliding with velocity `u` (m/s, object frame), given its Coulomb
+/// magnitude `f = μ_i N_i` (N).
+pub trait FrictionLaw {
+    fn force(&self, i: usize, u: Vec2, f: f64) -> Vec2;
+}
+
+/// Coulomb friction, `−f u/|u|`.
+pub struct Coulomb;
+
+impl FrictionLaw for Coulomb {
+    fn force(&self, _i: usize, u: Vec2, f: f64) -> Vec2 {
+        let n = u.norm();
+        if n > 0.0 {
+            -u * (f / n)
+        } else {
+            Vec2::zeros()
+        }
+    }
+}
+
+/// Coulomb friction made viscous below the slip speed `v_s` (m/s):
+/// `−f u / max(|u|, v_s)`. The force of a soft (regularised) contact.
+pub struct Regularised {
+    pub slip_speed: f64,
+}
+
+impl FrictionLaw for Regularised {
+    fn force(&self, _i: usize, u: Vec2, f: f64) -> Vec2 {
+        -u * (f / u.norm().max(self.slip_speed))
+    }
+}
+
+/// `G(ω) = I_P ω̇` (N m) for `law`: the friction moment about the contact
+/// point plus the inertial term `m v_c ω (p_c · n_φ)`, with the support
+/// friction magnitudes `forces` (N; default the body's).
+pub fn moment(body: &Body, push: &Push, omega: f64, law: &dyn FrictionLaw, forces: &[f64]) -> f64 {
+    let pc = body.contact();
+    let v = push.velocity();
+    let mut m = body.mass() * push.speed * omega * pc.dot(&push.direction());
+    for (i, s) in body.supports().enumerate() {
+        let r = s.position - pc;
+        let u = v + Vec2::new(-r.y, r.x) * omega;
+        m += cross(&r, &law.force(i, u, forces[i]));
+    }
+    m
+}
+
+/// Steady ω (rad/s) under `law` with support friction magnitudes `forces`:
+/// the root of [`moment`] nearest `guess`, found by bracketing and bisection.
+pub fn steady_omega(
+    body: &Body,
+    push: &Push,
+    law: &dyn FrictionLaw,
+    forces: &[f64],
+    guess: f64,
+) -> Option<f64> {
+    let g = |w: f64| moment(body, push, w, law, forces);
+    let mut d = 1e-3 * guess.abs().max(1e-3);
+    let (mut lo, mut hi) = (guess - d, guess + d);
+    for _ in 0..80 {
+        if g(lo) * g(hi) <= 0.0 {
+            break;
+        }
+        d *= 1.6;
+        lo = guess - d;
+        hi = guess + d;
+    }
+    if g(lo) * g(hi) > 0.0 {
+        return None;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if g(lo) * g(mid) <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// The Coulomb model's stable steady ω nearest `omega0` (rad/s).
+pub fn coulomb_steady(body: &Body, push: &Push, omega0: f64) -> Option<f64> {
+    let seg = SegmentDynamics::new(body, push);
+    let roots = seg.steady_states();
+    seg.attractor(&roots, omega0).map(|r| r.omega)
+}
+
+/// Normal loads (N) of the supports when the horizontal forces act at
+/// heights that are not the centre of mass's: quasi-static tilt balance with
+/// the supports' friction forces `friction` (N, object frame, at the floor),
+/// the pusher force `f_c` at height `h_push` and the centre of mass at
+/// `h_cm` (m); `rest` are the loads at rest. The extra moment
+/// `Σ p_i ΔN_i = (h_push − h_cm) f_c·… ` is spread over the supports by the
+/// least-norm (elastic-foundation) rule, which is how equal soft contacts
+/// share it: `ΔN_i = c_0 + c · p_i`.
+///
+/// Moment balance about the centre of mass for horizontal axes gives
+/// `Σ p_i N_i = Σ p_i N_i^rest + (h_push − h_cm) m a − h_push Σ f_i`, with
+/// `m a = f_c + Σ f_i`.
+pub fn transferred_loads(
+    body: &Body,
+    rest: &[f64],
+    friction: &[Vec2],
+    f_c: Vec2,
+    h_cm: f64,
+    h_push: f64,
+) -> Vec<f64> {
+    let sum_f: Vec2 = friction.iter().fold(Vec2::zeros(), |a, b| a + b);
+    // Required change of the load moment Σ p_i ΔN_i (object frame).
+    let dm = f_c * (h_push - h_cm) - sum_f * h_cm;
+    let pts: Vec<Vec2> = body.supports().map(|s| s.position).collect();
+    least_norm_loads(&pts, dm)
+        .iter()
+        .zip(rest)
+        .map(|(d, r)| r + d)
+        .collect()
+}
+
+/// The least-norm ΔN with `Σ ΔN_i = 0` and `Σ p_i ΔN_i = dm`.
+fn least_norm_loads(pts: &[Vec2], dm: Vec2) -> Vec<f64> {
+    // ΔN_i = a + b·p_i; solve the 3×3 normal equations.
+    let n = pts.len() as f64;
+    let sx: f64 = pts.iter().map(|p| p.x).sum();
+    let sy: f64 = pts.iter().map(|p| p.y).sum();
+    let sxx: f64 = pts.iter().map(|p| p.x * p.x).sum();
+    let syy: f64 = pts.iter().map(|p| p.y * p.y).sum();
+    let sxy: f64 = pts.iter().map(|p| p.x * p.y).sum();
+    let a = nalgebra_free_solve3(
+        [[n, sx, sy], [sx, sxx, sxy], [sy, sxy, syy]],
+        [0.0, dm.x, dm.y],
+    );
+    pts.iter().map(|p| a[0] + a[1] * p.x + a[2] * p.y).collect()
+}
+
+/// Cramer's rule for a 3×3 system (singular: zeros).
+fn nalgebra_free_solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(&m);
+    if d.abs() < 1e-300 {
+        return [0.0; 3];
+    }
+    let mut out = [0.0; 3];
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut mk = m;
+        for r in 0..3 {
+            mk[r][k] = b[r];
+        }
+        *o = det(&mk) / d;
+    }
+    out
+}
+
+/// Steady ω with load transfer: iterate `ω → forces(ω) → loads → ω` from
+/// the Coulomb steady state. `mu` are the support friction coefficients and
+/// `rest` the loads at rest (N).
+pub fn steady_omega_load_transfer(
+    body: &Body,
+    push: &Push,
+    mu: &[f64],
+    rest: &[f64],
+    h_cm: f64,
+    h_push: f64,
+) -> Option<(f64, Vec<f64>)> {
+    let mut w = coulomb_steady(body, push, 0.0)?;
+    let mut forces: Vec<f64> = body.supports().map(|s| s.friction).collect();
+    let pc = body.contact();
+    let dir = push.direction();
+    let mut loads = rest.to_vec();
+    for _ in 0..50 {
+        // Friction forces at the steady state (object frame).
+        let fr: Vec<Vec2> = body
+            .supports()
+            .enumerate()
+            .map(|(i, s)| {
+                let r = s.position - pc;
+                let u = push.velocity() + Vec2::new(-r.y, r.x) * w;
+                Coulomb.force(i, u, forces[i])
+            })
+            .collect();
+        let sum: Vec2 = fr.iter().fold(Vec2::zeros(), |a, b| a + b);
+        // Steady: ω̇ = 0, a_cm = v_c ω D n_φ + ω² p_c.
+        let a = Vec2::new(-dir.y, dir.x) * (push.speed * w) + pc * (w * w);
+        let f_c = a * body.mass() - sum;
+        loads = transferred_loads(body, rest, &fr, f_c, h_cm, h_push);
+        forces = loads
+            .iter()
+            .zip(mu)
+            .map(|(n, m)| (n * m).max(0.0))
+            .collect();
+        let w_new = steady_omega(body, push, &Coulomb, &forces, w)?;
+        if (w_new - w).abs() < 1e-12 * w.abs().max(1.0) {
+            w = w_new;
+            break;
+        }
+        w = w_new;
+    }
+    Some((w, loads))
+}
