@@ -188,23 +188,33 @@ pub fn next_step8(h: f64, err: f64) -> f64 {
 
 /// Initial step size (Hairer, Nørsett & Wanner, Sec. II.4): from the size of
 /// the derivative, a trial Euler step and its second-derivative estimate.
+///
+/// `atol`/`rtol` are the error weights the integrator uses and `order` its
+/// order; the state's own size is measured only over the components with a
+/// relative tolerance (the step aims at a local error of 1% of the tolerance, which scales
+/// as `h^(order + 1)`).
 pub fn initial_step<F: FnMut(&State) -> State>(
     f: &mut F,
     y0: &State,
     k1: &State,
     atol: f64,
-    rtol: f64,
+    rtol: &State,
+    order: i32,
     hmax: f64,
 ) -> f64 {
     let norm = |v: &State, y: &State| {
         let mut s = 0.0;
         for i in 0..N {
-            let sc = atol + rtol * y[i].abs();
+            let sc = atol + rtol[i] * y[i].abs();
             s += (v[i] / sc).powi(2);
         }
         (s / N as f64).sqrt()
     };
-    let d0 = norm(y0, y0);
+    // The size of the state itself counts only where the tolerance is
+    // relative: absolute components (angle, position) depend on the frame,
+    // and so would the step.
+    let relative: State = std::array::from_fn(|i| if rtol[i] > 0.0 { y0[i] } else { 0.0 });
+    let d0 = norm(&relative, y0);
     let d1 = norm(k1, y0);
     let h0 = if d0 < 1e-5 || d1 < 1e-5 {
         1e-6
@@ -219,7 +229,7 @@ pub fn initial_step<F: FnMut(&State) -> State>(
     let h1 = if d1.max(d2) <= 1e-15 {
         (h0 * 1e-3).max(1e-6)
     } else {
-        (0.01 / d1.max(d2)).powf(0.2)
+        (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
     };
     (100.0 * h0).min(h1).min(hmax)
 }

@@ -29,6 +29,7 @@ pub mod integrate;
 pub mod kinematic;
 pub mod limit_surface;
 mod problem;
+mod tail;
 mod trajectory;
 
 pub use arc::{arc_advance, sinc_versc};

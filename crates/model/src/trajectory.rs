@@ -1,6 +1,7 @@
 //! Sampled trajectories, the per-run assumption report, and the three analytic
 //! models as [`Simulator`]s.
 
+use crate::tail::{SettleRule, Tail, TailCursor};
 use crate::{
     arc_advance, dynamic::SegmentDynamics, dynamic::SteadyState, integrate, kinematic,
     limit_surface, perp, rotate, Body, ModelError, Problem, Push, Simulator, Vec2,
@@ -206,99 +207,6 @@ impl Default for DynamicModel {
     }
 }
 
-/// When a transient may be handed over to the closed-form tail.
-///
-/// Near a stable root, `ω − ω* = δ e^{−s/τ}` to first order in δ. The tail
-/// ([`Tail`]) integrates that exactly, so what it leaves out is second order:
-/// the curvature of ω̇ (angle error about `|q| δ² τ²` with `q = G''/(2 I_P)`)
-/// and the linearised rotation (position error at most `½ (δτ)² v_c T` over the
-/// remaining time T). Hand over once both are below a tenth of the tolerance.
-#[derive(Debug, Clone, Copy)]
-struct SettleRule {
-    omega: f64,
-    tau: f64,
-    q: f64,
-    speed: f64,
-    tol: f64,
-}
-
-impl SettleRule {
-    fn new(seg: &SegmentDynamics, omega: f64, tau: f64, tol: f64) -> Self {
-        let h = 1e-4 * (omega.abs() + 1.0 / tau);
-        let g2 = (seg.moment_slope(omega + h) - seg.moment_slope(omega - h)) / (2.0 * h);
-        Self {
-            omega,
-            tau,
-            q: g2 / (2.0 * seg.inertia_contact()),
-            speed: seg.speed(),
-            tol,
-        }
-    }
-    fn holds(&self, w: f64, remaining: f64) -> bool {
-        let d = w - self.omega;
-        let dt = d * self.tau;
-        let e_theta = self.q.abs() * dt * dt;
-        let e_pos = 0.5 * dt * dt * self.speed * remaining;
-        !d.is_nan() && e_theta.max(e_pos) <= SETTLE_FRACTION * self.tol
-    }
-    fn tail(&self, t: f64, c: Vec2, theta: f64, w: f64, vel: Vec2) -> Tail {
-        Tail {
-            t,
-            c,
-            theta,
-            omega: self.omega,
-            delta: w - self.omega,
-            tau: self.tau,
-            vel,
-        }
-    }
-}
-
-/// Share of the tolerance the settled tail may leave out.
-const SETTLE_FRACTION: f64 = 0.1;
-
-/// Closed-form motion after a segment has settled: ω relaxes exponentially
-/// onto ω*, `θ = θ_s + ω* s + δτ (1 − e^{−s/τ})`, and the contact point follows
-/// the steady arc plus the first-order effect of the angle deficit,
-/// `∫ ε(u) R(θ_s + ω* u) D v du` with `ε(u) = δτ (1 − e^{−u/τ})`, done with
-/// complex exponentials.
-#[derive(Debug, Clone, Copy)]
-struct Tail {
-    t: f64,
-    c: Vec2,
-    theta: f64,
-    omega: f64,
-    delta: f64,
-    tau: f64,
-    vel: Vec2,
-}
-
-impl Tail {
-    fn eval(&self, t: f64) -> (Vec2, f64, f64) {
-        let s = t - self.t;
-        let e = (-s / self.tau).exp();
-        let dt = self.delta * self.tau;
-        let (c_arc, _) = arc_advance(self.c, self.theta, self.omega, &self.vel, s);
-        let theta = self.theta + self.omega * s + dt * (1.0 - e);
-        let omega = self.omega + self.delta * e;
-        if dt == 0.0 {
-            return (c_arc, theta, omega);
-        }
-        // ∫_0^s e^{iω*u} du = s (S + iV);  ∫_0^s e^{z u} du = (e^{z s} − 1)/z, z = −1/τ + iω*.
-        let (sn, vs) = crate::sinc_versc(self.omega * s);
-        let (ar, ai) = (s * sn, s * vs);
-        let (zr, zi) = (-1.0 / self.tau, self.omega);
-        let (ws, wc) = (self.omega * s).sin_cos();
-        let (nr, ni) = (e * wc - 1.0, e * ws);
-        let den = zr * zr + zi * zi;
-        let (br, bi) = ((nr * zr + ni * zi) / den, (ni * zr - nr * zi) / den);
-        let (kr, ki) = (ar - br, ai - bi);
-        let dv = perp(&self.vel);
-        let local = Vec2::new(kr * dv.x - ki * dv.y, ki * dv.x + kr * dv.y) * dt;
-        (c_arc + rotate(self.theta, &local), theta, omega)
-    }
-}
-
 /// Accumulates the assumption checks over a run.
 struct Checker<'a> {
     problem: &'a Problem,
@@ -467,7 +375,7 @@ impl Simulator for DynamicModel {
         let mut c = init.position + rotate(theta, &pc);
         let mut omega = if init.from_rest { 0.0 } else { init.omega };
         let mut prev: Option<Push> = (!init.from_rest).then(|| problem.pushes[0]);
-        let mut h_carry: Option<f64> = None;
+        let mut h_carry: Option<(f64, f64)> = None;
         let r_min = body
             .supports()
             .map(|s| (s.position - pc).norm())
@@ -577,6 +485,7 @@ impl Simulator for DynamicModel {
                 omega: pivot.unwrap_or(0.0),
                 delta: 0.0,
                 tau: 1.0,
+                q: 0.0,
                 vel,
             };
 
@@ -646,10 +555,33 @@ impl Simulator for DynamicModel {
                         // position depend on the choice of frame, and their
                         // error must not (invariance under rigid motion).
                         let rtol = [0.0, tol, 0.0, 0.0];
-                        let mut h = h_carry.unwrap_or_else(|| {
-                            out.stats.rhs_evals += 1;
-                            integrate::initial_step(&mut rhs, &y, &k1, tol, tol, t1 - t0)
-                        });
+                        // A switch changes ω̇ by orders of magnitude: the step
+                        // carried over from a settled segment would be
+                        // rejected (12 evaluations), a fresh estimate costs one.
+                        let order = if eighth { 7 } else { 4 };
+                        // On a relaxation the local error is proportional to the
+                        // distance from the steady state, so the step carried
+                        // over shrinks by (distance then / distance now)^(1/8);
+                        // otherwise the usual starting-step estimate.
+                        let dev_new = settle.map(|r| (omega - r.omega).abs());
+                        let mut h = match (h_carry, dev_new) {
+                            (Some((hc, dev_old)), Some(dn)) if dev_old > 0.0 && dn > 0.0 => {
+                                hc * (dev_old / dn).powf(1.0 / (order as f64 + 2.0)).min(1.0)
+                            }
+                            _ => {
+                                out.stats.rhs_evals += 1;
+                                let h0 = integrate::initial_step(
+                                    &mut rhs,
+                                    &y,
+                                    &k1,
+                                    tol,
+                                    &rtol,
+                                    order,
+                                    t1 - t0,
+                                );
+                                h_carry.map_or(h0, |(hc, _)| hc.min(h0))
+                            }
+                        };
                         while t < t1 {
                             let mut landing = t + h >= t1 - 1e-12 * t1.abs().max(1.0);
                             let mut hh = if landing { t1 - t } else { h };
@@ -761,7 +693,8 @@ impl Simulator for DynamicModel {
                                 }
                             }
                         }
-                        h_carry = Some(h);
+                        let dev = settle.map_or(f64::NAN, |r| (y[1] - r.omega).abs());
+                        h_carry = Some((h, dev));
                     }
                     Integrator::Rk4 { dt } => {
                         let n = ((t1 - t0) / dt - 1e-9).ceil().max(1.0) as usize;
@@ -827,13 +760,23 @@ impl Simulator for DynamicModel {
             }
             if let Some(tail) = settle_state {
                 report.settled_at = Some(tail.t);
+                let mut cursor = TailCursor::new(tail);
                 while let Some(ts) = sampler.due(t1, t1, last) {
-                    let (cs, ths, ws) = tail.eval(ts);
-                    out.samples.push(pose_sample(ts, cs, ths, ws, &pc));
-                    checker.sample(&seg, ws, ts, j);
+                    let p = cursor.eval(ts);
+                    let cm =
+                        p.c - Vec2::new(p.cos * pc.x - p.sin * pc.y, p.sin * pc.x + p.cos * pc.y);
+                    out.samples.push(Sample {
+                        t: ts,
+                        x: cm.x,
+                        y: cm.y,
+                        theta: p.theta,
+                        omega: p.omega,
+                    });
+                    checker.sample(&seg, p.omega, ts, j);
                     sampler.next += 1;
                 }
-                (c, theta, omega) = tail.eval(t1);
+                let p = cursor.eval(t1);
+                (c, theta, omega) = (p.c, p.theta, p.omega);
             }
             report.omega_end = omega;
             out.segments.push(report);
