@@ -68,9 +68,6 @@ impl SettleRule {
         }
     }
 
-    /// Evaluations of the friction moment [`SettleRule::new`] makes.
-    pub(crate) const EVALS: usize = 5;
-
     /// True when the tail started at deviation `w − ω*` leaves out less than
     /// [`SETTLE_FRACTION`] of the tolerance over the `remaining` time (s):
     ///
