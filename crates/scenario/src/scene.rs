@@ -27,6 +27,16 @@ pub enum ModelKind {
     Rapier2dRegularisedLinear,
     /// rapier2d with Coulomb regularised by tanh(|u| / 0.01 m/s); informational.
     Rapier2dRegularisedTanh,
+    /// rapier3d-f64: the object on ball feet on a ground plane, rapier's own
+    /// contact friction (`FrictionModel::Coulomb`); informational.
+    Rapier3d,
+    /// The same with rapier's default `FrictionModel::Simplified`; informational.
+    Rapier3dSimplified,
+    /// MuJoCo 3.17, feet on a floor, pyramidal friction cone (needs the
+    /// `mujoco` feature); informational.
+    MujocoPyramidal,
+    /// MuJoCo with the elliptic friction cone; informational.
+    MujocoElliptic,
 }
 
 impl ModelKind {
@@ -38,7 +48,7 @@ impl ModelKind {
         ModelKind::Rapier2d,
     ];
     /// Every model a scenario can list.
-    pub const KNOWN: [ModelKind; 8] = [
+    pub const KNOWN: [ModelKind; 12] = [
         ModelKind::Dynamic,
         ModelKind::Kinematic,
         ModelKind::LimitSurface,
@@ -47,6 +57,10 @@ impl ModelKind {
         ModelKind::Rapier2dImpulseBox,
         ModelKind::Rapier2dRegularisedLinear,
         ModelKind::Rapier2dRegularisedTanh,
+        ModelKind::Rapier3d,
+        ModelKind::Rapier3dSimplified,
+        ModelKind::MujocoPyramidal,
+        ModelKind::MujocoElliptic,
     ];
     /// The name used in files and outputs.
     pub fn name(self) -> &'static str {
@@ -59,6 +73,10 @@ impl ModelKind {
             ModelKind::Rapier2dImpulseBox => "rapier2d_impulse_box",
             ModelKind::Rapier2dRegularisedLinear => "rapier2d_regularised_linear",
             ModelKind::Rapier2dRegularisedTanh => "rapier2d_regularised_tanh",
+            ModelKind::Rapier3d => "rapier3d",
+            ModelKind::Rapier3dSimplified => "rapier3d_simplified",
+            ModelKind::MujocoPyramidal => "mujoco_pyramidal",
+            ModelKind::MujocoElliptic => "mujoco_elliptic",
         }
     }
     /// Parses a model name.
