@@ -89,8 +89,9 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> [f64; 3] {
         }
         for r in col + 1..3 {
             let f = a[r][col] / d;
-            for s in col..3 {
-                a[r][s] -= f * a[col][s];
+            let pivot_row = a[col];
+            for (x, p) in a[r].iter_mut().zip(pivot_row).skip(col) {
+                *x -= f * p;
             }
             b[r] -= f * b[col];
         }
@@ -139,14 +140,23 @@ impl Scene {
             .collect()
     }
 
-    /// Loads (N) under the moment `moment` (N m, `Σ N_i p_i`).
+    /// Loads (N) under the moment `moment` (N m, `Σ N_i p_i`). A support
+    /// whose load would be negative lifts off: it is dropped and the rest
+    /// re-solved (its load is 0).
     pub fn loads(&self, moment: [f64; 2]) -> Vec<f64> {
-        distribute(
-            &self.points,
-            &self.stiffness(),
-            self.mass * self.gravity,
-            moment,
-        )
+        let mut k = self.stiffness();
+        let w = self.mass * self.gravity;
+        for _ in 0..self.points.len() {
+            let n = distribute(&self.points, &k, w, moment);
+            match (0..n.len())
+                .filter(|&i| n[i] < 0.0)
+                .min_by(|&a, &b| n[a].total_cmp(&n[b]))
+            {
+                Some(i) => k[i] = 0.0,
+                None => return n,
+            }
+        }
+        distribute(&self.points, &k, w, moment)
     }
 
     /// Loads at rest (N).
@@ -195,6 +205,12 @@ pub enum Law {
     Coulomb,
     /// rapier's `Simplified` friction with every foot in one manifold.
     SimplifiedOneManifold,
+    /// What rapier's per-contact friction converges to while a contact
+    /// slides: its 2×2 tangent solve `Δλ = −K⁻¹ Δv` followed by a cap of the
+    /// impulse's length at `μ λ_n` has, at a sliding fixed point, the impulse
+    /// along `−K⁻¹ u` (not `−u`), `K` the contact's tangent inverse effective
+    /// mass ([`tangent_k`]): `f_i = −μ_i N_i K_i⁻¹u_i / |K_i⁻¹u_i|`.
+    EffectiveMassDisk,
 }
 
 /// A steady state with the loads that go with it.
@@ -249,6 +265,10 @@ pub fn predict_steady(
                     w,
                     simplified_friction(&scene.points, &loads, mu, push, &body, w),
                 )
+            }
+            Law::EffectiveMassDisk => {
+                let w = effective_mass_steady(scene, &loads, push);
+                (w, effective_mass_forces(scene, &loads, push, w).1)
             }
         };
         omega = w;
@@ -382,6 +402,72 @@ pub fn simplified_steady(
     let mut lo = dir * 1e-12;
     let mut step = 1e-3 * (push.speed + 1e-3);
     let mut hi = lo + dir * step;
+    let mut n = 0;
+    while g(hi) * dir > 0.0 && n < 200 {
+        lo = hi;
+        step *= 1.5;
+        hi += dir * step;
+        n += 1;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if g(mid) * dir > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The tangent block `K = J M⁻¹ Jᵀ` (1/kg, object frame `[k_xx, k_yy, k_xy]`)
+/// of a ground contact at `p` (the contact point is `(x, y, −h_cm)` from the
+/// centre of mass) of a body with mass `m` and principal inertias
+/// `(I_xx, I_yy, I_z)`: `k_xx = 1/m + h²/I_yy + y²/I_z`,
+/// `k_yy = 1/m + h²/I_xx + x²/I_z`, `k_xy = −x y / I_z`.
+pub fn tangent_k(scene: &Scene, p: [f64; 2]) -> [f64; 3] {
+    let h = scene.cm_height;
+    let im = 1.0 / scene.mass;
+    [
+        im + h * h / scene.iyy + p[1] * p[1] / scene.inertia_z,
+        im + h * h / scene.ixx + p[0] * p[0] / scene.inertia_z,
+        -p[0] * p[1] / scene.inertia_z,
+    ]
+}
+
+/// `(I_P ω̇, Σ f_i)` (N m, N; object frame) under [`Law::EffectiveMassDisk`].
+pub fn effective_mass_forces(scene: &Scene, loads: &[f64], push: &Push, omega: f64) -> (f64, Vec2) {
+    let pc = Vec2::new(scene.contact[0], scene.contact[1]);
+    let vc = push.velocity();
+    let mut moment = scene.mass * push.speed * pc.dot(&push.direction()) * omega;
+    let mut total = Vec2::zeros();
+    for ((p, &mu), &n) in scene.points.iter().zip(&scene.mu).zip(loads) {
+        let d = Vec2::new(p[0], p[1]) - pc;
+        let u = Vec2::new(vc.x - omega * d.y, vc.y + omega * d.x);
+        let k = tangent_k(scene, *p);
+        let det = k[0] * k[1] - k[2] * k[2];
+        let w = Vec2::new(k[1] * u.x - k[2] * u.y, k[0] * u.y - k[2] * u.x) / det;
+        let wn = w.norm();
+        if wn > 0.0 && n > 0.0 {
+            let f = -w * (mu * n / wn);
+            moment += cross(&d, &f);
+            total += f;
+        }
+    }
+    (moment, total)
+}
+
+/// The steady ω (rad/s) of [`Law::EffectiveMassDisk`] reached from ω = 0.
+pub fn effective_mass_steady(scene: &Scene, loads: &[f64], push: &Push) -> f64 {
+    let g = |w: f64| effective_mass_forces(scene, loads, push, w).0;
+    let g0 = g(0.0);
+    if g0 == 0.0 {
+        return 0.0;
+    }
+    let dir = g0.signum();
+    let mut lo = 0.0;
+    let mut step = 1e-3 * (push.speed + 1e-3);
+    let mut hi = dir * step;
     let mut n = 0;
     while g(hi) * dir > 0.0 && n < 200 {
         lo = hi;
