@@ -96,10 +96,9 @@ pub fn coulomb_steady(body: &Body, push: &Push, omega0: f64) -> Option<f64> {
 /// heights that are not the centre of mass's: quasi-static tilt balance with
 /// the supports' friction forces `friction` (N, object frame, at the floor),
 /// the pusher force `f_c` at height `h_push` and the centre of mass at
-/// `h_cm` (m); `rest` are the loads at rest. The extra moment
-/// `Σ p_i ΔN_i = (h_push − h_cm) f_c·… ` is spread over the supports by the
-/// least-norm (elastic-foundation) rule, which is how equal soft contacts
-/// share it: `ΔN_i = c_0 + c · p_i`.
+/// `h_cm` (m); `rest` are the loads at rest (N). The extra load moment is
+/// spread over the supports by the least-norm (elastic-foundation) rule,
+/// `ΔN_i = c_0 + c · p_i`.
 ///
 /// Moment balance about the centre of mass for horizontal axes gives
 /// `Σ p_i N_i = Σ p_i N_i^rest + (h_push − h_cm) m a − h_push Σ f_i`, with
@@ -132,7 +131,7 @@ fn least_norm_loads(pts: &[Vec2], dm: Vec2) -> Vec<f64> {
     let sxx: f64 = pts.iter().map(|p| p.x * p.x).sum();
     let syy: f64 = pts.iter().map(|p| p.y * p.y).sum();
     let sxy: f64 = pts.iter().map(|p| p.x * p.y).sum();
-    let a = nalgebra_free_solve3(
+    let a = solve3(
         [[n, sx, sy], [sx, sxx, sxy], [sy, sxy, syy]],
         [0.0, dm.x, dm.y],
     );
@@ -140,7 +139,7 @@ fn least_norm_loads(pts: &[Vec2], dm: Vec2) -> Vec<f64> {
 }
 
 /// Cramer's rule for a 3×3 system (singular: zeros).
-fn nalgebra_free_solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
+fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
     let det = |m: &[[f64; 3]; 3]| {
         m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
             - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
