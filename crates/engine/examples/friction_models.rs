@@ -633,8 +633,133 @@ fn main() {
     writeln!(readme, "## Box locks\n\n{md_lock}").unwrap();
     writeln!(readme, "## Stopping (1 s at 0.5 m/s, then the pusher at rest for 1 s)\n\n{md_stop}\nData: `stop.csv`.\n").unwrap();
     writeln!(readme, "## Angle dependence\n\nω after 0.5 s for several starting angles θ₀ (v_c = 0.5 m/s, φ = π/4 + 0.3):\n\n{md_theta}\nThe box law's frozen steady ω*(θ) at Δt = 1/60 ranges over [{fmin:.4}, {fmax:.4}] rad/s (period π/2; `box_frozen_omega_vs_theta.csv`); the engine's ω along a run is in `box_engine_history_game_dt.csv`.\n").unwrap();
+    readme.push_str(&other_engines(&out));
     write(&out.join("README.md"), &readme);
     println!("{readme}");
+}
+
+/// Rows of a CSV file as header → value maps (None when the file is missing).
+fn read_csv(path: &Path) -> Option<Vec<std::collections::HashMap<String, String>>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next()?.split(',').collect();
+    Some(
+        lines
+            .map(|l| {
+                head.iter()
+                    .zip(l.split(','))
+                    .map(|(h, v)| (h.to_string(), v.to_string()))
+                    .collect()
+            })
+            .collect(),
+    )
+}
+
+/// The summary over every engine at φ = π/4 + 0.3 (from this run's table and
+/// the CSVs of the rapier3d and MuJoCo studies, which
+/// scripts/friction-models.sh regenerates first), followed by those studies'
+/// own READMEs.
+fn other_engines(out: &Path) -> String {
+    let mut md = String::new();
+    let mut rows: Vec<(String, Vec<(f64, f64, f64)>)> = Vec::new();
+    let mut push_rows =
+        |file: &str,
+         label: &dyn Fn(&std::collections::HashMap<String, String>) -> Option<String>,
+         speed: &str,
+         engine: &str,
+         star: &str| {
+            let Some(table) = read_csv(&out.join(file)) else {
+                return;
+            };
+            for r in &table {
+                let Some(name) = label(r) else { continue };
+                let num = |k: &str| {
+                    r.get(k)
+                        .and_then(|v| v.parse::<f64>().ok())
+                        .unwrap_or(f64::NAN)
+                };
+                let entry = (num(speed), num(engine), num(star));
+                match rows.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, v)) => v.push(entry),
+                    None => rows.push((name, vec![entry])),
+                }
+            }
+        };
+    let at_1e3 = |r: &std::collections::HashMap<String, String>| {
+        r.get("dt").and_then(|v| v.parse::<f64>().ok()) == Some(1e-3)
+    };
+    push_rows(
+        "table_phi_pi4+0.3.csv",
+        &|r| at_1e3(r).then(|| format!("rapier2d, {}", r["idiom"])),
+        "speed",
+        "omega_engine",
+        "omega_star",
+    );
+    push_rows(
+        "rapier3d/paper_table.csv",
+        &|r| at_1e3(r).then(|| format!("rapier3d, {}", r["friction"])),
+        "speed",
+        "omega_engine",
+        "omega_star",
+    );
+    push_rows(
+        "mujoco/paper_plate.csv",
+        &|r| (r["variant"] == "default").then(|| format!("MuJoCo, {} cone", r["cone"])),
+        "v_c",
+        "omega_mujoco",
+        "omega_star",
+    );
+    md.push_str(
+        "## Every engine on the paper plate at φ = π/4 + 0.3
+
+",
+    );
+    md.push_str("Steady ω in rad/s (relative error against the Coulomb model's ω*); rapier at Δt = 1e-3, MuJoCo at its defaults (Δt = 1e-3). Sources: `table_phi_pi4+0.3.csv`, `rapier3d/paper_table.csv`, `mujoco/paper_plate.csv` (regenerate all with `scripts/friction-models.sh`).\n\n");
+    md.push_str("| engine, friction | v_c = 0.2 m/s | 0.5 m/s | 1.0 m/s |\n|---|---:|---:|---:|\n");
+    if let Some((_, v)) = rows.first() {
+        let stars: Vec<String> = [0.2, 0.5, 1.0]
+            .iter()
+            .map(|s| {
+                v.iter()
+                    .find(|e| (e.0 - s).abs() < 1e-9)
+                    .map_or("—".into(), |e| format!("{:.4}", e.2))
+            })
+            .collect();
+        md.push_str(&format!("| Coulomb model ω* | {} |\n", stars.join(" | ")));
+    }
+    for (name, v) in &rows {
+        let cells: Vec<String> = [0.2, 0.5, 1.0]
+            .iter()
+            .map(|s| {
+                v.iter()
+                    .find(|e| (e.0 - s).abs() < 1e-9)
+                    .map_or("—".into(), |e| {
+                        format!("{:.4} ({:+.1} %)", e.1, 100.0 * (e.1 - e.2) / e.2)
+                    })
+            })
+            .collect();
+        md.push_str(&format!("| {name} | {} |\n", cells.join(" | ")));
+    }
+    md.push('\n');
+    for (dir, title) in [("rapier3d", "rapier3d"), ("mujoco", "MuJoCo")] {
+        match std::fs::read_to_string(out.join(dir).join("README.md")) {
+            Ok(text) => {
+                md.push_str(&format!("---\n\n(From `{dir}/README.md`: {title}.)\n\n"));
+                for line in text.lines() {
+                    if line.starts_with('#') {
+                        md.push('#');
+                    }
+                    md.push_str(line);
+                    md.push('\n');
+                }
+                md.push('\n');
+            }
+            Err(_) => md.push_str(&format!(
+                "({title}: `{dir}/README.md` not generated yet.)\n\n"
+            )),
+        }
+    }
+    md
 }
 
 fn draw_map(
