@@ -661,7 +661,9 @@ fn read_csv(path: &Path) -> Option<Vec<std::collections::HashMap<String, String>
 /// own READMEs.
 fn other_engines(out: &Path) -> String {
     let mut md = String::new();
-    let mut rows: Vec<(String, Vec<(f64, f64, f64)>)> = Vec::new();
+    // Per row label: (v_c, ω engine, ω*) for each speed.
+    type Cells = Vec<(f64, f64, f64)>;
+    let mut rows: Vec<(String, Cells)> = Vec::new();
     let mut push_rows =
         |file: &str,
          label: &dyn Fn(&std::collections::HashMap<String, String>) -> Option<String>,
