@@ -199,36 +199,14 @@ impl Rapier3dSettings {
 
     /// Checks the settings; errors name the field.
     pub fn check(&self) -> Result<(), ModelError> {
-        let positive = |name: &'static str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(ModelError::Parameter {
-                    name,
-                    requirement: "finite and > 0",
-                    value: v,
-                })
-            }
-        };
+        let positive = ModelError::require_positive;
         positive("rapier3d dt", self.dt)?;
         positive("rapier3d foot_radius", self.foot_radius)?;
         positive("rapier3d cm_height", self.cm_height)?;
         positive("rapier3d gravity", self.gravity)?;
         positive("rapier3d plate_thickness", self.plate_thickness)?;
-        if !(self.push_height.is_finite() && self.push_height >= 0.0) {
-            return Err(ModelError::Parameter {
-                name: "rapier3d push_height",
-                requirement: "finite and >= 0",
-                value: self.push_height,
-            });
-        }
-        if !(self.settle_time.is_finite() && self.settle_time >= 0.0) {
-            return Err(ModelError::Parameter {
-                name: "rapier3d settle_time",
-                requirement: "finite and >= 0",
-                value: self.settle_time,
-            });
-        }
+        ModelError::require_non_negative("rapier3d push_height", self.push_height)?;
+        ModelError::require_non_negative("rapier3d settle_time", self.settle_time)?;
         if self.solver_iterations == 0 {
             return Err(ModelError::Parameter {
                 name: "rapier3d solver_iterations",

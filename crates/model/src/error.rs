@@ -33,3 +33,32 @@ pub enum ModelError {
         limit: f64,
     },
 }
+
+impl ModelError {
+    /// `Ok` when `value` is finite and > 0, else a [`ModelError::Parameter`]
+    /// naming `name`.
+    pub fn require_positive(name: &'static str, value: f64) -> Result<(), ModelError> {
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(ModelError::Parameter {
+                name,
+                requirement: "finite and > 0",
+                value,
+            })
+        }
+    }
+    /// `Ok` when `value` is finite and ≥ 0, else a [`ModelError::Parameter`]
+    /// naming `name`.
+    pub fn require_non_negative(name: &'static str, value: f64) -> Result<(), ModelError> {
+        if value.is_finite() && value >= 0.0 {
+            Ok(())
+        } else {
+            Err(ModelError::Parameter {
+                name,
+                requirement: "finite and >= 0",
+                value,
+            })
+        }
+    }
+}

@@ -185,28 +185,8 @@ impl MujocoSettings {
 
     /// Checks the settings; errors name the field.
     pub fn check(&self) -> Result<(), ModelError> {
-        let positive = |name: &'static str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(ModelError::Parameter {
-                    name,
-                    requirement: "finite and > 0",
-                    value: v,
-                })
-            }
-        };
-        let non_negative = |name: &'static str, v: f64| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(ModelError::Parameter {
-                    name,
-                    requirement: "finite and >= 0",
-                    value: v,
-                })
-            }
-        };
+        let positive = ModelError::require_positive;
+        let non_negative = ModelError::require_non_negative;
         positive("mujoco timestep", self.timestep)?;
         positive("mujoco impratio", self.impratio)?;
         positive("mujoco foot_radius", self.foot_radius)?;
