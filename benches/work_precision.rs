@@ -12,12 +12,14 @@
 //! Dop853 on the same right-hand side, and rapier2d (f64, f32; friction
 //! velocity body / constraint / midpoint; plain and Richardson-extrapolated).
 
+use std::cell::Cell;
 use std::time::{Duration, Instant};
 
 use ode_solvers::{Dop853, Dopri5, System, Vector4};
 use pushval::harness::{analyse_segments, rel_err, tail_omega, SegmentInfo};
 use pushval_model::{
-    DynamicModel, Integrator, Problem, SegmentDynamics, Simulator, Switching, Trajectory, Vec2,
+    DynamicModel, Integrator, Problem, Rotor, SegmentDynamics, Simulator, Switching, Trajectory,
+    Vec2,
 };
 use pushval_rapier::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
 use pushval_scenario::Scenario;
@@ -79,14 +81,19 @@ fn errors(
 }
 
 /// The pushing ODE for one segment in ode_solvers' terms: [θ, ω, c_x, c_y].
+/// The same right-hand side as pushval's: `R(θ)` from a [`Rotor`] (in a
+/// `Cell`, since ode_solvers passes `&self`).
 struct Peer<'a> {
     seg: &'a SegmentDynamics,
     vel: Vec2,
+    rotor: Cell<Rotor>,
 }
 
 impl System<f64, Vector4<f64>> for Peer<'_> {
     fn system(&self, _t: f64, y: &Vector4<f64>, dy: &mut Vector4<f64>) {
-        let (s, c) = y[0].sin_cos();
+        let mut rotor = self.rotor.get();
+        let (s, c) = rotor.sin_cos(y[0]);
+        self.rotor.set(rotor);
         dy[0] = y[1];
         dy[1] = self.seg.omega_dot(y[1]);
         dy[2] = c * self.vel.x - s * self.vel.y;
@@ -121,6 +128,7 @@ fn peer(problem: &Problem, tol: f64, eighth: bool) -> (Trajectory, usize) {
         let sys = Peer {
             seg: &seg,
             vel: push.velocity(),
+            rotor: Cell::new(Rotor::new()),
         };
         let y0 = Vector4::new(theta, omega, c.x, c.y);
         let (xs, ys) = if eighth {
@@ -165,6 +173,8 @@ fn peer(problem: &Problem, tol: f64, eighth: bool) -> (Trajectory, usize) {
 
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
+    // `--model-only`: the adaptive methods and the peer only, printed, no files.
+    let model_only = std::env::args().any(|a| a == "--model-only");
     let reps = if quick { 3 } else { 15 };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let sc = Scenario::from_path(root.join("scenarios/paper-square-v1.0.toml")).unwrap();
@@ -217,6 +227,20 @@ fn main() {
             });
         }
         eprint!(".");
+    }
+    if model_only {
+        eprintln!();
+        for r in &rows {
+            println!(
+                "{:20} {:10} evals {:5} median {:8.2} us  pos err {:.2e}",
+                r.method,
+                r.setting,
+                r.rhs_evals.unwrap_or(0),
+                r.median_s * 1e6,
+                r.position_err
+            );
+        }
+        return;
     }
     for dt in [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4] {
         let m = DynamicModel {

@@ -29,6 +29,7 @@ pub mod integrate;
 pub mod kinematic;
 pub mod limit_surface;
 mod problem;
+mod rotor;
 mod tail;
 mod trajectory;
 
@@ -37,6 +38,7 @@ pub use body::{Body, Push, Support};
 pub use dynamic::{InertialTerm, RootKind, SegmentDynamics, SteadyState};
 pub use error::ModelError;
 pub use problem::{ContactLimits, Initial, Problem, Simulator, Switching};
+pub use rotor::Rotor;
 pub use trajectory::{
     Assumptions, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel, Sample,
     SegmentReport, SolverStats, Trajectory, Violation,

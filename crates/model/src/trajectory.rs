@@ -4,7 +4,7 @@
 use crate::tail::{SettleRule, Tail, TailCursor};
 use crate::{
     arc_advance, dynamic::SegmentDynamics, dynamic::SteadyState, integrate, kinematic,
-    limit_surface, perp, rotate, Body, ModelError, Problem, Push, Simulator, Vec2,
+    limit_surface, perp, rotate, Body, ModelError, Problem, Push, Rotor, Simulator, Vec2,
 };
 
 /// One output sample. At a switch time, the state just after the switch.
@@ -226,10 +226,14 @@ impl<'a> Checker<'a> {
         }
     }
 
+    #[inline(always)]
     fn sample(&mut self, seg: &SegmentDynamics, omega: f64, t: f64, segment: usize) {
-        if !self.enabled {
-            return;
+        if self.enabled {
+            self.check(seg, omega, t, segment);
         }
+    }
+
+    fn check(&mut self, seg: &SegmentDynamics, omega: f64, t: f64, segment: usize) {
         let lim = &self.problem.limits;
         let f = seg.pusher_force(omega);
         let fm = f.norm();
@@ -325,8 +329,11 @@ impl Sampler {
     }
 }
 
-fn pose_sample(t: f64, c: Vec2, theta: f64, omega: f64, pc: &Vec2) -> Sample {
-    let p = c - rotate(theta, pc);
+/// The sample at time `t` from the contact point `c` and the angle; `rotor`
+/// serves `R(θ)` (samples come in order, so θ moves little between them).
+fn pose_sample(rotor: &mut Rotor, t: f64, c: Vec2, theta: f64, omega: f64, pc: &Vec2) -> Sample {
+    let (s, co) = rotor.sin_cos(theta);
+    let p = c - Vec2::new(co * pc.x - s * pc.y, s * pc.x + co * pc.y);
     Sample {
         t,
         x: p.x,
@@ -370,6 +377,7 @@ impl Simulator for DynamicModel {
             ..Default::default()
         };
         let mut checker = Checker::new(problem, self.check_assumptions);
+        let mut sample_rotor = Rotor::new();
         let init = problem.initial;
         let mut theta = init.theta;
         let mut c = init.position + rotate(theta, &pc);
@@ -491,7 +499,8 @@ impl Simulator for DynamicModel {
 
             // Segment start: the state just after the switch.
             while let Some(ts) = sampler.due(t0, t1, last) {
-                out.samples.push(pose_sample(ts, c, theta, omega, &pc));
+                out.samples
+                    .push(pose_sample(&mut sample_rotor, ts, c, theta, omega, &pc));
                 checker.sample(&seg, omega, ts, j);
                 sampler.next += 1;
             }
@@ -525,7 +534,8 @@ impl Simulator for DynamicModel {
                 };
                 while let Some(ts) = sampler.due(t1, t1, last) {
                     let (th, w) = state_at(ts - t0);
-                    out.samples.push(pose_sample(ts, c, th, w, &pc));
+                    out.samples
+                        .push(pose_sample(&mut sample_rotor, ts, c, th, w, &pc));
                     checker.sample(&seg, w, ts, j);
                     sampler.next += 1;
                 }
@@ -536,8 +546,9 @@ impl Simulator for DynamicModel {
                     report.settled_at = Some(t0 + t_stop);
                 }
             } else if settle_state.is_none() {
+                let mut rotor = Rotor::new();
                 let mut rhs = |y: &integrate::State| {
-                    let (s, co) = y[0].sin_cos();
+                    let (s, co) = rotor.sin_cos(y[0]);
                     [
                         y[1],
                         seg.omega_dot(y[1]),
@@ -628,6 +639,7 @@ impl Simulator for DynamicModel {
                                 while let Some(ts) = sampler.due(t_new, t1, last) {
                                     let ys = dense.eval(ts);
                                     out.samples.push(pose_sample(
+                                        &mut sample_rotor,
                                         ts,
                                         Vec2::new(ys[2], ys[3]),
                                         ys[0],
@@ -711,6 +723,7 @@ impl Simulator for DynamicModel {
                             while let Some(ts) = sampler.due(t_new, t1, last) {
                                 let ys = integrate::hermite(t, t_new - t, &y, &k1, &y1, &k2, ts);
                                 out.samples.push(pose_sample(
+                                    &mut sample_rotor,
                                     ts,
                                     Vec2::new(ys[2], ys[3]),
                                     ys[0],
@@ -761,19 +774,17 @@ impl Simulator for DynamicModel {
             if let Some(tail) = settle_state {
                 report.settled_at = Some(tail.t);
                 let mut cursor = TailCursor::new(tail);
-                while let Some(ts) = sampler.due(t1, t1, last) {
-                    let p = cursor.eval(ts);
-                    let cm =
-                        p.c - Vec2::new(p.cos * pc.x - p.sin * pc.y, p.sin * pc.x + p.cos * pc.y);
-                    out.samples.push(Sample {
-                        t: ts,
-                        x: cm.x,
-                        y: cm.y,
-                        theta: p.theta,
-                        omega: p.omega,
-                    });
-                    checker.sample(&seg, p.omega, ts, j);
+                let first = sampler.next;
+                while sampler.due(t1, t1, last).is_some() {
                     sampler.next += 1;
+                }
+                let from = out.samples.len();
+                cursor.fill(&sampler.times[first..sampler.next], pc, &mut out.samples);
+                if checker.enabled {
+                    for k in from..out.samples.len() {
+                        let smp = out.samples[k];
+                        checker.sample(&seg, smp.omega, smp.t, j);
+                    }
                 }
                 let p = cursor.eval(t1);
                 (c, theta, omega) = (p.c, p.theta, p.omega);
@@ -803,6 +814,7 @@ fn constant_omega_run(
     };
     let mut theta = problem.initial.theta;
     let mut c = problem.initial.position + rotate(theta, &pc);
+    let mut sample_rotor = Rotor::new();
     let n_seg = problem.pushes.len();
     for (j, (push, (t0, t1))) in problem
         .pushes
@@ -815,7 +827,8 @@ fn constant_omega_run(
         let vel = push.velocity();
         while let Some(ts) = sampler.due(t1, t1, last) {
             let (cs, ths) = arc_advance(c, theta, w, &vel, ts - t0);
-            out.samples.push(pose_sample(ts, cs, ths, w, &pc));
+            out.samples
+                .push(pose_sample(&mut sample_rotor, ts, cs, ths, w, &pc));
             sampler.next += 1;
         }
         (c, theta) = arc_advance(c, theta, w, &vel, t1 - t0);
