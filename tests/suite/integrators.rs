@@ -131,3 +131,37 @@ fn paper_trajectory_reaches_1e_9_m_in_600_evaluations() {
     assert!(fast.segments.iter().all(|s| s.settled_at.is_some()));
     assert!(fast.stats.rhs_evals <= 600, "{:?}", fast.stats);
 }
+
+/// The closed-form models sample their arcs through the tail cursor (phasor
+/// recurrences); every sample must match `arc_advance` (the sinc/versine
+/// form, evaluated afresh from the segment start) to rounding, including the
+/// segment pushed through the centre of mass (ω = 0, a straight line).
+#[test]
+fn kinematic_samples_follow_the_closed_form_arc() {
+    use pushval_model::{arc_advance, kinematic, rotate, KinematicModel, Vec2};
+    let p = paper_problem();
+    let tr = KinematicModel.simulate(&p).unwrap();
+    let pc = p.body.contact();
+    let mut theta = p.initial.theta;
+    let mut c = p.initial.position + rotate(theta, &pc);
+    let mut worst: f64 = 0.0;
+    let mut k = 0;
+    let n = p.pushes.len();
+    for (j, (push, (t0, t1))) in p.pushes.iter().zip(p.segment_times()).enumerate() {
+        let w = kinematic::omega(&p.body, push).unwrap_or(0.0);
+        let vel = push.velocity();
+        while k < tr.samples.len() && (tr.samples[k].t < t1 - 1e-9 || j + 1 == n) {
+            let s = tr.samples[k];
+            let (cs, ths) = arc_advance(c, theta, w, &vel, s.t - t0);
+            let cm = cs - rotate(ths, &pc);
+            worst = worst
+                .max((Vec2::new(s.x, s.y) - cm).norm())
+                .max((s.theta - ths).abs());
+            assert_eq!(s.omega, w);
+            k += 1;
+        }
+        (c, theta) = arc_advance(c, theta, w, &vel, t1 - t0);
+    }
+    assert_eq!(k, tr.samples.len());
+    assert!(worst < 1e-12, "largest difference {worst:e}");
+}

@@ -1,10 +1,10 @@
 //! Sampled trajectories, the per-run assumption report, and the three analytic
 //! models as [`Simulator`]s.
 
-use crate::tail::{SettleRule, Tail, TailCursor};
+use crate::tail::{SettleRule, Tail, TailCursor, TailPose};
 use crate::{
-    arc_advance, dynamic::SegmentDynamics, dynamic::SteadyState, integrate, kinematic,
-    limit_surface, perp, rotate, Body, ModelError, Problem, Push, Rotor, Simulator, Vec2,
+    dynamic::SegmentDynamics, dynamic::SteadyState, integrate, kinematic, limit_surface, perp,
+    rotate, Body, ModelError, Problem, Push, Rotor, Simulator, Vec2,
 };
 
 /// One output sample. At a switch time, the state just after the switch.
@@ -773,20 +773,14 @@ impl Simulator for DynamicModel {
             }
             if let Some(tail) = settle_state {
                 report.settled_at = Some(tail.t);
-                let mut cursor = TailCursor::new(tail);
-                let first = sampler.next;
-                while sampler.due(t1, t1, last).is_some() {
-                    sampler.next += 1;
-                }
                 let from = out.samples.len();
-                cursor.fill(&sampler.times[first..sampler.next], pc, &mut out.samples);
+                let p = sample_tail(tail, &mut sampler, t1, last, pc, &mut out.samples);
                 if checker.enabled {
                     for k in from..out.samples.len() {
                         let smp = out.samples[k];
                         checker.sample(&seg, smp.omega, smp.t, j);
                     }
                 }
-                let p = cursor.eval(t1);
                 (c, theta, omega) = (p.c, p.theta, p.omega);
             }
             report.omega_end = omega;
@@ -795,6 +789,26 @@ impl Simulator for DynamicModel {
         out.assumptions = checker.finish();
         Ok(out)
     }
+}
+
+/// Samples a closed-form tail at the sample times due up to `t1` (the end of
+/// its segment; `last` for the last segment, which owns its end time) and
+/// returns its pose at `t1`.
+fn sample_tail(
+    tail: Tail,
+    sampler: &mut Sampler,
+    t1: f64,
+    last: bool,
+    pc: Vec2,
+    out: &mut Vec<Sample>,
+) -> TailPose {
+    let mut cursor = TailCursor::new(tail);
+    let first = sampler.next;
+    while sampler.due(t1, t1, last).is_some() {
+        sampler.next += 1;
+    }
+    cursor.fill(&sampler.times[first..sampler.next], pc, out);
+    cursor.eval(t1)
 }
 
 /// Runs a model whose ω is constant over each segment: the pose follows
@@ -814,7 +828,6 @@ fn constant_omega_run(
     };
     let mut theta = problem.initial.theta;
     let mut c = problem.initial.position + rotate(theta, &pc);
-    let mut sample_rotor = Rotor::new();
     let n_seg = problem.pushes.len();
     for (j, (push, (t0, t1))) in problem
         .pushes
@@ -825,13 +838,18 @@ fn constant_omega_run(
         let last = j + 1 == n_seg;
         let w = omega_of(&problem.body, push);
         let vel = push.velocity();
-        while let Some(ts) = sampler.due(t1, t1, last) {
-            let (cs, ths) = arc_advance(c, theta, w, &vel, ts - t0);
-            out.samples
-                .push(pose_sample(&mut sample_rotor, ts, cs, ths, w, &pc));
-            sampler.next += 1;
-        }
-        (c, theta) = arc_advance(c, theta, w, &vel, t1 - t0);
+        let arc = Tail {
+            t: t0,
+            c,
+            theta,
+            omega: w,
+            delta: 0.0,
+            tau: 1.0,
+            q: 0.0,
+            vel,
+        };
+        let p = sample_tail(arc, &mut sampler, t1, last, pc, &mut out.samples);
+        (c, theta) = (p.c, p.theta);
         out.segments.push(SegmentReport {
             index: j,
             t_start: t0,
