@@ -1,5 +1,9 @@
 //! The rapier2d pusher scene: a 1 s, one-segment run at dt = 1e-3 (1000 steps),
-//! by precision and friction-velocity mode.
+//! by precision and friction-velocity mode; and, beside the default scene
+//! (no colliders: friction is applied as forces, rapier's broad and narrow
+//! phases have nothing to do), the same run with massless, non-interacting
+//! colliders on the object and the pusher (`EngineSettings::colliders`), to
+//! measure what skipping the collision stages saves.
 
 use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use pushval_model::{Initial, Problem, Push, Switching};
@@ -35,6 +39,18 @@ fn rapier_step(c: &mut Criterion) {
                 |b, sim| b.iter(|| black_box(sim.run(&problem).unwrap())),
             );
         }
+    }
+    // Default settings (f64, leapfrog) without and with colliders, side by
+    // side: the ratio of the two medians is the cost of the collision stages.
+    for colliders in [false, true] {
+        let sim = RapierSimulator::new(EngineSettings {
+            colliders,
+            ..Default::default()
+        });
+        let name = if colliders { "with" } else { "without" };
+        g.bench_with_input(BenchmarkId::new("colliders", name), &sim, |b, sim| {
+            b.iter(|| black_box(sim.run(&problem).unwrap()))
+        });
     }
     g.finish();
 }

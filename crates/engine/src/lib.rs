@@ -4,7 +4,9 @@
 //! [`Problem`], a rapier world seen from above (gravity zero) with two bodies:
 //!
 //! * the **object**, a dynamic body whose mass and inertia about its centre of
-//!   mass are set directly (it has no collider: nothing collides);
+//!   mass are set directly (it has no collider by default: nothing collides,
+//!   so rapier's broad and narrow phases have nothing to do; see
+//!   [`EngineSettings::colliders`] for the scene with colliders);
 //! * the **pusher**, a kinematic velocity-based body pinned to the object at the
 //!   contact point by a revolute impulse joint. Every step its velocity is set to
 //!   the commanded contact velocity `v_c R(θ) n_φ` (taken at a mode-dependent
@@ -166,6 +168,15 @@ pub struct EngineSettings {
     /// analytic model's). The others are game-engine idioms (see
     /// [`idioms`]); their impulse cap uses the segment's nominal step.
     pub friction_model: FrictionModel,
+    /// Attach colliders (default `false`): a convex polygon on the object
+    /// (the outline given to [`RapierSimulator::run_with_outline`], else the
+    /// convex hull of the supports and the contact point) and a 5 mm ball on
+    /// the pusher. They are massless (density 0: the body's mass and inertia
+    /// stay the ones set directly), in collision groups that exclude each
+    /// other and in no solver group, so the motion is the same to rounding;
+    /// only rapier's broad and narrow phases get work. Exists to measure what
+    /// the collider-free scene saves (bench `rapier_step`).
+    pub colliders: bool,
 }
 
 impl Default for EngineSettings {
@@ -178,6 +189,7 @@ impl Default for EngineSettings {
             friction_velocity: FrictionVelocity::Leapfrog,
             switch_step_fraction: 1e-3,
             friction_model: FrictionModel::Coulomb,
+            colliders: false,
         }
     }
 }
@@ -278,12 +290,25 @@ impl RapierSimulator {
 
     /// Runs the problem and returns the trajectory with the engine's diagnostics.
     pub fn run(&self, problem: &Problem) -> Result<EngineRun, ModelError> {
+        self.run_with_outline(problem, &[])
+    }
+
+    /// [`RapierSimulator::run`] with the object's outline (m, object frame
+    /// with the origin at the centre of mass) for the object's collider when
+    /// [`EngineSettings::colliders`] is set: the collider is the outline's
+    /// convex hull. An empty outline means the convex hull of the supports
+    /// and the contact point. Without colliders the outline is not used.
+    pub fn run_with_outline(
+        &self,
+        problem: &Problem,
+        outline: &[[f64; 2]],
+    ) -> Result<EngineRun, ModelError> {
         let start = Instant::now();
         problem.check()?;
         self.settings.check()?;
         let raw = match self.settings.precision {
-            Precision::F64 => f64_engine::world::simulate(problem, &self.settings)?,
-            Precision::F32 => f32_engine::world::simulate(problem, &self.settings)?,
+            Precision::F64 => f64_engine::world::simulate(problem, &self.settings, outline)?,
+            Precision::F32 => f32_engine::world::simulate(problem, &self.settings, outline)?,
         };
         let samples = history::sample(problem, &raw.history);
         let segments = history::segment_reports(problem, &raw.history, &samples);

@@ -80,8 +80,16 @@ struct State {
     omega: f64,
 }
 
-/// Runs the problem in this precision's rapier build.
-pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<RawRun, ModelError> {
+/// Radius (m) of the pusher's collider when the scene has colliders.
+const PUSHER_RADIUS: Real = 0.005;
+
+/// Runs the problem in this precision's rapier build; `outline` is the
+/// object's outline for its collider (see `RapierSimulator::run_with_outline`).
+pub(crate) fn simulate(
+    problem: &Problem,
+    settings: &EngineSettings,
+    outline: &[[f64; 2]],
+) -> Result<RawRun, ModelError> {
     let body = &problem.body;
     let init = problem.initial;
     let pc = [body.contact().x, body.contact().y];
@@ -131,6 +139,9 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
         .contacts_enabled(false)
         .softness(SpringCoefficients::new(JOINT_FREQUENCY, 1.0));
     world.insert_impulse_joint(pusher, object, joint);
+    if settings.colliders {
+        attach_colliders(&mut world, object, pusher, outline, &supports, pc)?;
+    }
 
     // Mass properties take effect only inside a step: a zero-length one.
     world.integration_parameters.dt = 0.0;
@@ -355,6 +366,53 @@ pub(crate) fn simulate(problem: &Problem, settings: &EngineSettings) -> Result<R
             0.0
         },
     })
+}
+
+/// Attaches the massless, non-interacting colliders of
+/// `EngineSettings::colliders`: the convex hull of `outline` (or, when it is
+/// empty, of the supports and the contact point) on the object and a small
+/// ball on the pusher. The object is in group 1 and sees only group 1, the
+/// pusher in group 2 and sees only group 2, so the pair is never tested for
+/// contact; no solver group either, so no contact could push; density 0, so
+/// the mass properties set on the body stay exact.
+fn attach_colliders(
+    world: &mut PhysicsWorld,
+    object: RigidBodyHandle,
+    pusher: RigidBodyHandle,
+    outline: &[[f64; 2]],
+    supports: &[([f64; 2], f64)],
+    pc: [f64; 2],
+) -> Result<(), ModelError> {
+    let points: Vec<Vector> = if outline.is_empty() {
+        supports
+            .iter()
+            .map(|s| s.0)
+            .chain([pc])
+            .map(|p| v(p[0], p[1]))
+            .collect()
+    } else {
+        outline.iter().map(|p| v(p[0], p[1])).collect()
+    };
+    let hull = ColliderBuilder::convex_hull(&points).ok_or(ModelError::Parameter {
+        name: "engine collider outline",
+        requirement: "at least three points not on one line",
+        value: points.len() as f64,
+    })?;
+    let own = |group: Group| InteractionGroups::new(group, group, InteractionTestMode::And);
+    world.insert_collider(
+        hull.density(0.0)
+            .collision_groups(own(Group::GROUP_1))
+            .solver_groups(InteractionGroups::none()),
+        Some(object),
+    );
+    world.insert_collider(
+        ColliderBuilder::ball(PUSHER_RADIUS)
+            .density(0.0)
+            .collision_groups(own(Group::GROUP_2))
+            .solver_groups(InteractionGroups::none()),
+        Some(pusher),
+    );
+    Ok(())
 }
 
 /// Sets the pusher velocity for the coming step and the support friction forces.
