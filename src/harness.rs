@@ -106,8 +106,8 @@ pub struct Comparison {
 }
 
 /// How an engine's steady ω converges as its time step shrinks: runs at 4h,
-/// 2h and h (h the scenario's step), the observed order
-/// `p = log2(|ω(4h) − ω(2h)| / |ω(2h) − ω(h)|)`, and Richardson extrapolations
+/// 2h and h (h the gated run's step; runs the time-step search made are
+/// reused), the observed order `p = log2(|ω(4h) − ω(2h)| / |ω(2h) − ω(h)|)`, and Richardson extrapolations
 /// to dt → 0 with the scheme's expected order p: `ω(h) + (ω(h) − ω(2h)) / (2^p − 1)`,
 /// and the same applied again for the order p + 1 term.
 #[derive(Debug, Clone)]
@@ -165,7 +165,9 @@ impl ScenarioReport {
 }
 
 /// The engine settings a scenario asks for: its `[engine]` table over the
-/// adapter's defaults.
+/// adapter's defaults. Without `[engine] dt` this is the adapter's default
+/// step; the gated `rapier2d` run of [`run_scenario`] chooses its own with
+/// [`choose_engine_dt`].
 pub fn engine_settings(sc: &Scenario) -> EngineSettings {
     let mut s = EngineSettings::default();
     let e = &sc.engine;
@@ -208,6 +210,7 @@ pub fn engine_settings_json(s: &EngineSettings) -> serde_json::Value {
         "precision": s.precision.as_str(),
         "friction_velocity": s.friction_velocity.as_str(),
         "switch_step_fraction": s.switch_step_fraction,
+        "colliders": s.colliders,
         "label": s.label(),
     })
 }
@@ -303,6 +306,13 @@ fn simulator(
             };
             let mut json = engine_settings_json(&settings);
             json["friction_model"] = serde_json::json!(friction_model.as_str());
+            // Informational rows keep the adapter's step: their findings
+            // (results/friction_models/) are stated at it.
+            json["dt_source"] = serde_json::json!(if sc.engine.dt.is_some() {
+                "scenario"
+            } else {
+                "adapter default"
+            });
             Some((Box::new(RapierSimulator { settings }), json))
         }
     }
@@ -321,6 +331,302 @@ fn engine_run(problem: &Problem, settings: EngineSettings) -> Result<EngineRun, 
     RapierSimulator { settings }.run(problem)
 }
 
+/// The largest engine time step the automatic choice tries (s): 1/60 s,
+/// rapier's own default step and the usual game-engine frame. Coarser steps
+/// would put several 0.01 s samples inside one step and stop resolving the
+/// relaxation times of the shipped scenes (τ ≈ 0.05–0.3 s).
+pub const DT_LADDER_TOP: f64 = 1.0 / 60.0;
+
+/// No rung of the automatic ladder is below this (s). Eight rungs, 1/60 s to
+/// 1/7680 s ≈ 1.3e-4 s: at the bottom a second-order step is 16 000 times
+/// more accurate than at the top and a 10 s scene takes 77 000 steps (about
+/// 0.2 s); a scene that needs less than that has a problem worth seeing
+/// rather than a step to shrink.
+pub const DT_FLOOR: f64 = 1e-4;
+
+/// The share of each `[tolerance]` figure the engine's own discretisation
+/// error may use up at the automatic step. The gate compares engine and
+/// model, so the engine's error eats into the tolerance a model error must
+/// exceed to be caught: at 1/4 a model error of 5/4 of the tolerance always
+/// fails the gate, and at most 1/4 is hidden. The margin also covers the
+/// estimate itself, which assumes the asymptotic order: at the coarse rungs
+/// the observed order can be off (the convergence check reports it) and the
+/// estimate off by a factor of 2 or so.
+pub const DT_FRACTION: f64 = 0.25;
+
+/// The rungs of the automatic time-step ladder, largest first:
+/// `DT_LADDER_TOP / 2^k` down to [`DT_FLOOR`].
+pub fn dt_ladder() -> Vec<f64> {
+    std::iter::successors(Some(DT_LADDER_TOP), |h| Some(h / 2.0))
+        .take_while(|h| *h >= DT_FLOOR)
+        .collect()
+}
+
+/// Where the engine's time step came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DtSource {
+    /// `[engine] dt` in the scenario, kept exactly.
+    Scenario,
+    /// Chosen by [`choose_engine_dt`].
+    Automatic,
+}
+
+/// The engine's self-convergence error estimate at one time step h, from
+/// the runs at h and h/2 alone (never against the model): Richardson's
+/// `|X(h) − X(h/2)| · 2^p / (2^p − 1)` for the scheme's order p, for each
+/// gated figure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DtEstimate {
+    /// The time step h (s).
+    pub dt: f64,
+    /// Largest centre-of-mass distance over the samples (m).
+    pub position_max: f64,
+    /// Largest angle difference over the samples (rad).
+    pub theta_max: f64,
+    /// Largest relative steady-ω difference over the segments the gate
+    /// reads a steady ω from (tail means; denominator the run at h/2 with
+    /// [`rel_err`]'s floor); None when no segment settles.
+    pub omega_steady_rel_max: Option<f64>,
+    /// Whether every figure is within [`DT_FRACTION`] of its tolerance.
+    pub meets: bool,
+}
+
+/// How the engine's time step was chosen, for the outputs.
+#[derive(Debug, Clone)]
+pub struct DtChoice {
+    /// The time step the gated engine run uses (s).
+    pub dt: f64,
+    pub source: DtSource,
+    /// Automatic only: every rung tried, largest first; the last one is the
+    /// chosen one.
+    pub rungs: Vec<DtEstimate>,
+    /// Automatic only: false when not even the ladder's floor met the
+    /// criterion (the floor is used then).
+    pub met: bool,
+    /// The scheme's order used in the estimate.
+    pub order: f64,
+    /// Wall time of the search's engine runs (the chosen run and its h/2
+    /// partner included).
+    pub search_time: Duration,
+}
+
+impl DtChoice {
+    /// One line saying which dt and why.
+    pub fn reason(&self, sc: &Scenario) -> String {
+        let t = &sc.tolerance;
+        let f = DT_FRACTION;
+        let figures = |e: &DtEstimate| {
+            format!(
+                "position {:.2e} m, theta {:.2e} rad, steady omega {} (targets {:.2e} m, {:.2e} rad, {:.2e})",
+                e.position_max,
+                e.theta_max,
+                e.omega_steady_rel_max.map_or("-".into(), |w| format!("{w:.2e}")),
+                f * t.position_max,
+                f * t.theta_max,
+                f * t.omega_steady_rel
+            )
+        };
+        match (self.source, self.rungs.last()) {
+            (DtSource::Scenario, _) | (_, None) => {
+                format!("dt = {} s set by the scenario's [engine] dt", self.dt)
+            }
+            (DtSource::Automatic, Some(last)) => {
+                let mut s = if self.met {
+                    format!(
+                        "dt = {:.4e} s: the largest ladder rung whose self-convergence estimate is within {f} of the tolerances: {}",
+                        self.dt,
+                        figures(last)
+                    )
+                } else {
+                    format!(
+                        "dt = {:.4e} s (the ladder's floor) although its estimate misses {f} of the tolerances: {}",
+                        self.dt,
+                        figures(last)
+                    )
+                };
+                if self.rungs.len() >= 2 {
+                    let prev = &self.rungs[self.rungs.len() - 2];
+                    s.push_str(&format!("; {:.4e} s misses: {}", prev.dt, figures(prev)));
+                }
+                s
+            }
+        }
+    }
+
+    /// The record written into the engine's settings in `summary.json`.
+    pub fn json(&self, sc: &Scenario) -> serde_json::Value {
+        use crate::output::num;
+        let rungs: Vec<serde_json::Value> = self
+            .rungs
+            .iter()
+            .map(|e| {
+                serde_json::json!({
+                    "dt": num(e.dt),
+                    "position_max_estimate": num(e.position_max),
+                    "theta_max_estimate": num(e.theta_max),
+                    "omega_steady_rel_max_estimate": e.omega_steady_rel_max.map_or(serde_json::Value::Null, num),
+                    "meets": e.meets,
+                })
+            })
+            .collect();
+        let t = &sc.tolerance;
+        serde_json::json!({
+            "source": match self.source {
+                DtSource::Scenario => "scenario",
+                DtSource::Automatic => "automatic",
+            },
+            "reason": self.reason(sc),
+            "criterion": "Richardson self-convergence estimate |X(h) - X(h/2)| 2^p / (2^p - 1) of each gated figure within fraction x [tolerance]",
+            "fraction": DT_FRACTION,
+            "order": self.order,
+            "ladder": dt_ladder(),
+            "targets": {
+                "position_max": num(DT_FRACTION * t.position_max),
+                "theta_max": num(DT_FRACTION * t.theta_max),
+                "omega_steady_rel": num(DT_FRACTION * t.omega_steady_rel),
+            },
+            "met": self.met,
+            "rungs": rungs,
+            "search_wall_time_s": num(self.search_time.as_secs_f64()),
+        })
+    }
+}
+
+/// The self-convergence estimate at h from the runs at h (`coarse`) and
+/// h/2 (`fine`) of a scheme of order `order`.
+pub fn dt_estimate(
+    sc: &Scenario,
+    segments: &[SegmentInfo],
+    h: f64,
+    coarse: &Trajectory,
+    fine: &Trajectory,
+    order: f64,
+) -> DtEstimate {
+    let k = 2f64.powf(order) / (2f64.powf(order) - 1.0);
+    let mut position_max: f64 = 0.0;
+    let mut theta_max: f64 = 0.0;
+    for (a, b) in coarse.samples.iter().zip(&fine.samples) {
+        position_max = position_max.max(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt());
+        theta_max = theta_max.max((a.theta - b.theta).abs());
+    }
+    if coarse.samples.len() != fine.samples.len() {
+        position_max = f64::INFINITY;
+        theta_max = f64::INFINITY;
+    }
+    let mut omega: Option<f64> = None;
+    for s in segments.iter().filter(|s| s.settles()) {
+        let (Some(wc), Some(wf)) = (
+            tail_omega(coarse, s.t_start, s.t_end),
+            tail_omega(fine, s.t_start, s.t_end),
+        ) else {
+            continue;
+        };
+        let e = rel_err(wc, wf, s.speed, sc.froude_length());
+        omega = Some(omega.map_or(e, |m: f64| m.max(e)));
+    }
+    let (position_max, theta_max) = (k * position_max, k * theta_max);
+    let omega_steady_rel_max = omega.map(|e| k * e);
+    let t = &sc.tolerance;
+    let meets = position_max <= DT_FRACTION * t.position_max
+        && theta_max <= DT_FRACTION * t.theta_max
+        && omega_steady_rel_max.is_none_or(|e| e <= DT_FRACTION * t.omega_steady_rel);
+    DtEstimate {
+        dt: h,
+        position_max,
+        theta_max,
+        omega_steady_rel_max,
+        meets,
+    }
+}
+
+/// The engine's time step for the gate: the scenario's `[engine] dt` when
+/// set, otherwise the largest rung of [`dt_ladder`] whose self-convergence
+/// estimate ([`dt_estimate`], engine runs at h and h/2 only) is within
+/// [`DT_FRACTION`] of every `[tolerance]` figure, or the floor when none is.
+/// `segments` (from the dynamic model's run) only say which segments the
+/// gate reads a steady ω from. Returns the settings, the choice and every
+/// engine run made, for reuse.
+pub fn choose_engine_dt(
+    sc: &Scenario,
+    problem: &Problem,
+    segments: &[SegmentInfo],
+) -> Result<(EngineSettings, DtChoice, Vec<EngineRun>), ModelError> {
+    let base = engine_settings(sc);
+    let order = expected_order(&base);
+    let start = Instant::now();
+    if sc.engine.dt.is_some() {
+        return Ok((
+            base,
+            DtChoice {
+                dt: base.dt,
+                source: DtSource::Scenario,
+                rungs: Vec::new(),
+                met: true,
+                order,
+                search_time: Duration::ZERO,
+            },
+            Vec::new(),
+        ));
+    }
+    let ladder = dt_ladder();
+    let mut runs: Vec<EngineRun> = Vec::new();
+    let mut rungs = Vec::new();
+    let run_at = |dt: f64, runs: &mut Vec<EngineRun>| -> Result<usize, ModelError> {
+        if let Some(i) = runs.iter().position(|r| r.settings.dt == dt) {
+            return Ok(i);
+        }
+        runs.push(engine_run(problem, EngineSettings { dt, ..base })?);
+        Ok(runs.len() - 1)
+    };
+    let mut last_err = None;
+    let mut announced = false;
+    for (i, &h) in ladder.iter().enumerate() {
+        if !announced && start.elapsed() > Duration::from_secs(2) {
+            eprintln!(
+                "pushval: {}: choosing the engine time step (trying dt = {h:.3e} s, rung {} of {})",
+                sc.name,
+                i + 1,
+                ladder.len()
+            );
+            announced = true;
+        }
+        // A rung whose runs fail (blow up) does not meet the criterion.
+        let pair = run_at(h, &mut runs).and_then(|a| Ok((a, run_at(h / 2.0, &mut runs)?)));
+        let (a, b) = match pair {
+            Ok(p) => p,
+            Err(e) => {
+                last_err = Some(e);
+                continue;
+            }
+        };
+        let est = dt_estimate(
+            sc,
+            segments,
+            h,
+            &runs[a].trajectory,
+            &runs[b].trajectory,
+            order,
+        );
+        rungs.push(est);
+        if est.meets || i + 1 == ladder.len() {
+            let settings = EngineSettings { dt: h, ..base };
+            return Ok((
+                settings,
+                DtChoice {
+                    dt: h,
+                    source: DtSource::Automatic,
+                    rungs,
+                    met: est.meets,
+                    order,
+                    search_time: start.elapsed(),
+                },
+                runs,
+            ));
+        }
+    }
+    Err(last_err.expect("the ladder's floor either returns or fails"))
+}
+
 /// Runs the engine at 2h and 4h beside the run at h and measures how its
 /// steady ω converges.
 fn engine_convergence(
@@ -330,22 +636,22 @@ fn engine_convergence(
     fine: &Trajectory,
     reference: &Trajectory,
     settings: EngineSettings,
+    done: &[EngineRun],
 ) -> Result<Convergence, ModelError> {
     let h = settings.dt;
-    let mid = engine_run(
-        problem,
-        EngineSettings {
-            dt: 2.0 * h,
-            ..settings
-        },
-    )?;
-    let coarse = engine_run(
-        problem,
-        EngineSettings {
-            dt: 4.0 * h,
-            ..settings
-        },
-    )?;
+    // Runs the search already made at 2h or 4h are reused (same settings,
+    // deterministic: the same trajectory).
+    let at = |dt: f64| -> Result<Trajectory, ModelError> {
+        match done
+            .iter()
+            .find(|r| r.settings == EngineSettings { dt, ..settings })
+        {
+            Some(r) => Ok(r.trajectory.clone()),
+            None => engine_run(problem, EngineSettings { dt, ..settings }).map(|r| r.trajectory),
+        }
+    };
+    let mid = at(2.0 * h)?;
+    let coarse = at(4.0 * h)?;
     let order = expected_order(&settings);
     let mut out = Convergence {
         expected_order: order,
@@ -362,8 +668,7 @@ fn engine_convergence(
             continue;
         };
         let w = |tr: &Trajectory| tail_omega(tr, s.t_start, s.t_end);
-        let (Some(w1), Some(w2), Some(w4)) = (w(fine), w(&mid.trajectory), w(&coarse.trajectory))
-        else {
+        let (Some(w1), Some(w2), Some(w4)) = (w(fine), w(&mid), w(&coarse)) else {
             continue;
         };
         let p = ((w4 - w2).abs() / (w2 - w1).abs()).log2();
@@ -574,27 +879,50 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             .copied()
             .filter(|k| *k != ModelKind::Dynamic),
     );
-    let mut runs = Vec::new();
+    let mut runs: Vec<ModelRun> = Vec::new();
     let mut missing = Vec::new();
     let mut failures: Vec<(ModelKind, String)> = Vec::new();
+    // The gated engine's time step and the engine runs its choice made.
+    let mut gate_engine: Option<(EngineSettings, Vec<EngineRun>)> = None;
     for kind in kinds {
-        let Some((sim, settings)) = simulator(kind, sc, opts) else {
+        let Some((sim, mut settings)) = simulator(kind, sc, opts) else {
             missing.push(kind);
             continue;
         };
         let t0 = Instant::now();
-        let (result, diagnostics) = if kind == ModelKind::Rapier2d {
-            match engine_run(&problem, engine_settings(sc)) {
-                Ok(r) => (
-                    Ok(r.trajectory),
-                    serde_json::json!({"max_joint_drift": r.max_joint_drift, "steps": r.steps}),
-                ),
-                Err(e) => (Err(e), serde_json::Value::Null),
+        let (result, diagnostics, elapsed) = if kind == ModelKind::Rapier2d {
+            // The dynamic model ran first: its segments say which ones the
+            // gate reads a steady ω from.
+            let segments = analyse_segments(sc, &problem, &runs[0].trajectory);
+            let chosen = choose_engine_dt(sc, &problem, &segments).and_then(|(s, choice, done)| {
+                let run = match done.iter().find(|r| r.settings == s) {
+                    Some(r) => r.clone(),
+                    None => engine_run(&problem, s)?,
+                };
+                Ok((s, choice, done, run))
+            });
+            match chosen {
+                Ok((s, choice, done, r)) => {
+                    settings = engine_settings_json(&s);
+                    settings["dt_source"] = serde_json::json!(match choice.source {
+                        DtSource::Scenario => "scenario",
+                        DtSource::Automatic => "automatic",
+                    });
+                    settings["dt_choice"] = choice.json(sc);
+                    let elapsed = r.wall_time;
+                    gate_engine = Some((s, done));
+                    (
+                        Ok(r.trajectory),
+                        serde_json::json!({"max_joint_drift": r.max_joint_drift, "steps": r.steps}),
+                        elapsed,
+                    )
+                }
+                Err(e) => (Err(e), serde_json::Value::Null, t0.elapsed()),
             }
         } else {
-            (sim.simulate(&problem), serde_json::Value::Null)
+            let result = sim.simulate(&problem);
+            (result, serde_json::Value::Null, t0.elapsed())
         };
-        let elapsed = t0.elapsed();
         match result {
             Ok(trajectory) => runs.push(ModelRun {
                 kind,
@@ -621,13 +949,17 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             .iter()
             .find(|r| r.kind == ModelKind::Rapier2d)
             .expect("compared runs exist");
+        let (settings, done) = gate_engine
+            .as_ref()
+            .expect("a rapier2d run has its settings");
         c.convergence = Some(engine_convergence(
             sc,
             &problem,
             &segments,
             &run.trajectory,
             &reference,
-            engine_settings(sc),
+            *settings,
+            done,
         )?);
     }
     for (kind, e) in failures {

@@ -3,26 +3,25 @@
 
 use std::path::PathBuf;
 
-use pushval::harness::{analyse_segments_with, compare, run_scenario, ModelRun, RunOptions};
-use pushval_model::{DynamicModel, InertialTerm, Problem, Simulator, Switching};
-use pushval_rapier::RapierSimulator;
+use pushval::harness::{
+    analyse_segments_with, compare, dt_ladder, run_scenario, ModelRun, RunOptions, DT_FRACTION,
+};
+use pushval_model::{DynamicModel, InertialTerm, Problem, Simulator, Switching, Trajectory};
+use pushval_rapier::{tail_mean_omega, EngineSettings, RapierSimulator};
 use pushval_scenario::{ModelKind, Scenario};
 use rstest::rstest;
 
 use crate::common::*;
 
-/// The engine's run of the physical scene.
+/// The engine's run of the physical scene, as the gate makes it (at the
+/// automatically chosen time step when the scenario sets none).
 fn engine(sc: &Scenario) -> ModelRun {
-    let settings = pushval::harness::engine_settings(sc);
-    ModelRun {
-        kind: ModelKind::Rapier2d,
-        trajectory: RapierSimulator { settings }
-            .simulate(&sc.problem())
-            .unwrap(),
-        settings: serde_json::Value::Null,
-        elapsed: Default::default(),
-        diagnostics: serde_json::Value::Null,
-    }
+    run_scenario(sc, &RunOptions::default())
+        .unwrap()
+        .runs
+        .into_iter()
+        .find(|r| r.kind == ModelKind::Rapier2d)
+        .unwrap()
 }
 
 /// Gate a model reading (its problem and its model) against the engine run of
@@ -114,11 +113,14 @@ fn engine_converges_at_its_order_and_extrapolates_to_the_root(
     );
 }
 
-/// At the default dt = 1e-3, every scenario's engine steady ω is within 1e-4
-/// (relative) of ω* (issue target), and the scenario's own tolerances hold.
+/// At dt = 1e-3 (the adapter's default step, set here as a scenario's
+/// `[engine] dt`, which the harness keeps), every scenario's engine steady ω
+/// is within 1e-4 (relative) of ω* (issue target), and the scenario's own
+/// tolerances hold.
 #[rstest]
 fn engine_meets_steady_target(#[files("scenarios/*.toml")] path: PathBuf) {
-    let sc = load(&path);
+    let mut sc = load(&path);
+    sc.engine.dt = Some(1e-3);
     let report = run_scenario(&sc, &RunOptions::default()).unwrap();
     let c = report
         .comparisons
@@ -129,6 +131,136 @@ fn engine_meets_steady_target(#[files("scenarios/*.toml")] path: PathBuf) {
     if let Some(e) = c.omega_steady_rel_max {
         assert!(e <= 1e-4, "steady-ω error {e:e}");
     }
+    let run = report
+        .runs
+        .iter()
+        .find(|r| r.kind == ModelKind::Rapier2d)
+        .unwrap();
+    assert_eq!(run.settings["dt"], 1e-3);
+    assert_eq!(run.settings["dt_source"], "scenario");
+}
+
+/// Richardson's estimate of the error of a run at h from the runs at h and
+/// h/2 of a second-order scheme (the default leapfrog stepping; its order is
+/// asserted by `engine_converges_at_its_order_and_extrapolates_to_the_root`):
+/// `|X(h) − X(h/2)| · 4/3` for position and angle over the samples, and the
+/// relative steady-ω difference of the settled segments, read here with the
+/// engine crate's trapezoidal tail mean (not the harness's reading).
+fn estimate(sc: &Scenario, settled: &[usize], h: f64) -> (f64, f64, f64) {
+    let problem = sc.problem();
+    let at = |dt: f64| -> Trajectory {
+        RapierSimulator::new(EngineSettings {
+            dt,
+            ..Default::default()
+        })
+        .simulate(&problem)
+        .unwrap()
+    };
+    let (a, b) = (at(h), at(h / 2.0));
+    let (dp, dth) = max_diff(&a, &b);
+    let (wa, wb) = (
+        tail_mean_omega(&problem, &a, 0.2),
+        tail_mean_omega(&problem, &b, 0.2),
+    );
+    let l = sc.froude_length();
+    let dw = settled
+        .iter()
+        .map(|&j| {
+            let (x, y) = (wa[j].unwrap(), wb[j].unwrap());
+            (x - y).abs() / y.abs().max(1e-3 * sc.pushes[j].speed / l)
+        })
+        .fold(0.0, f64::max);
+    (dp * 4.0 / 3.0, dth * 4.0 / 3.0, dw * 4.0 / 3.0)
+}
+
+/// Without `[engine] dt` the gate runs the engine at the largest rung of the
+/// ladder whose self-convergence estimate (engine runs at h and h/2 only)
+/// is within `DT_FRACTION` of each tolerance: recomputed here, the chosen
+/// rung meets it and the next coarser one (when there is one) does not.
+/// The estimate is a real error estimate: the gated figures against the
+/// model stay within twice the estimate's target.
+#[rstest]
+fn automatic_dt_is_the_largest_rung_that_meets_its_criterion(
+    #[files("scenarios/*.toml")] path: PathBuf,
+) {
+    let sc = load(&path);
+    assert_eq!(sc.engine.dt, None, "shipped scenarios leave dt automatic");
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let run = report
+        .runs
+        .iter()
+        .find(|r| r.kind == ModelKind::Rapier2d)
+        .unwrap();
+    assert_eq!(run.settings["dt_source"], "automatic");
+    assert_eq!(run.settings["dt_choice"]["met"], true);
+    let h = run.settings["dt"].as_f64().unwrap();
+    let ladder = dt_ladder();
+    let rung = ladder
+        .iter()
+        .position(|&r| r == h)
+        .expect("dt on the ladder");
+    let settled: Vec<usize> = report
+        .segments
+        .iter()
+        .filter(|s| s.settles())
+        .map(|s| s.index)
+        .collect();
+    let t = &sc.tolerance;
+    let within = |(p, th, w): (f64, f64, f64), f: f64| {
+        p <= f * t.position_max && th <= f * t.theta_max && w <= f * t.omega_steady_rel
+    };
+    let chosen = estimate(&sc, &settled, h);
+    assert!(within(chosen, DT_FRACTION), "dt {h}: {chosen:?}");
+    if rung > 0 {
+        let coarser = estimate(&sc, &settled, ladder[rung - 1]);
+        assert!(
+            !within(coarser, DT_FRACTION),
+            "dt {} meets too: {coarser:?}",
+            ladder[rung - 1]
+        );
+    }
+    let c = report
+        .comparisons
+        .iter()
+        .find(|c| c.model == "rapier2d")
+        .unwrap();
+    assert_eq!(c.pass, Some(true), "{c:?}");
+    let gated = (
+        c.position_max,
+        c.theta_max,
+        c.omega_steady_rel_max.unwrap_or(0.0),
+    );
+    assert!(within(gated, 2.0 * DT_FRACTION), "{gated:?} at dt {h}");
+}
+
+/// A scenario that sets `[engine] dt` runs at exactly that step: no search,
+/// the step count of that dt (5 segments of 2 s at 2e-3 s: 5000 steps, one
+/// switch step per segment, one closing step before each of the 4 switches),
+/// and the convergence check at 2 and 4 times it.
+#[test]
+fn fixed_dt_is_kept() {
+    let path = root().join("scenarios/paper-square-v1.0.toml");
+    let text = std::fs::read_to_string(&path).unwrap() + "\n[engine]\ndt = 0.002\n";
+    let sc = Scenario::from_toml(&text, &path).unwrap();
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let run = report
+        .runs
+        .iter()
+        .find(|r| r.kind == ModelKind::Rapier2d)
+        .unwrap();
+    assert_eq!(run.settings["dt"], 0.002);
+    assert_eq!(run.settings["dt_source"], "scenario");
+    assert_eq!(
+        run.settings["dt_choice"]["rungs"].as_array().unwrap().len(),
+        0
+    );
+    assert_eq!(run.diagnostics["steps"], 5009);
+    let c = report
+        .comparisons
+        .iter()
+        .find(|c| c.model == "rapier2d")
+        .unwrap();
+    assert_eq!(c.convergence.as_ref().unwrap().dts, [0.008, 0.004, 0.002]);
 }
 
 /// The 2-D friction idioms run from a scenario as informational rows of the

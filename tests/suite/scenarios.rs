@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use approx::assert_relative_eq;
 use pushval::{output, run_scenario, RunOptions};
 use pushval_model::{DynamicModel, Simulator};
+use pushval_rapier::{EngineSettings, RapierSimulator};
 use rstest::rstest;
 
 use crate::common::*;
@@ -42,6 +43,14 @@ fn scenario_runs_and_writes_contract_outputs(#[files("scenarios/*.toml")] path: 
             assert!(m.get(key).is_some(), "models.{name} lacks {key}");
         }
     }
+    // The engine's time step and where it came from (the choice's reason
+    // included) are part of its settings.
+    let engine = &summary["models"]["rapier2d"]["settings"];
+    assert!(engine["dt"].as_f64().is_some_and(|dt| dt > 0.0));
+    assert!(["automatic", "scenario"].contains(&engine["dt_source"].as_str().unwrap()));
+    assert!(engine["dt_choice"]["reason"]
+        .as_str()
+        .is_some_and(|r| r.starts_with("dt = ")));
     assert!(summary["assumptions"].is_object());
     let csv = output::trajectory_csv(&report);
     let mut lines = csv.lines();
@@ -204,4 +213,27 @@ fn uniform_grid_is_centred_and_complete() {
         .fold(pushval_model::Vec2::zeros(), |a, s| a + s.position * s.load)
         / w;
     assert!(c.norm() < 1e-12);
+}
+
+/// Colliders on every scenario's own polygon (massless, interacting with
+/// nothing: `EngineSettings::colliders`) leave the engine's run unchanged,
+/// bit for bit.
+#[rstest]
+fn scenario_engine_colliders_change_nothing(#[files("scenarios/*.toml")] path: PathBuf) {
+    let sc = load(&path);
+    let problem = sc.problem();
+    let outline: Vec<[f64; 2]> = sc
+        .polygon
+        .iter()
+        .map(|p| [p.x - sc.center_of_mass.x, p.y - sc.center_of_mass.y])
+        .collect();
+    let settings = pushval::harness::engine_settings(&sc);
+    let a = RapierSimulator::new(settings).run(&problem).unwrap();
+    let b = RapierSimulator::new(EngineSettings {
+        colliders: true,
+        ..settings
+    })
+    .run_with_outline(&problem, &outline)
+    .unwrap();
+    assert_eq!(a.trajectory.samples, b.trajectory.samples);
 }
