@@ -154,11 +154,15 @@ fn main() {
         for target in [1e-3, 1e-6] {
             let cheapest = |rule: &str| {
                 recs.iter()
-                    .filter(|r| r[0] == rule && r[5].parse::<f64>().unwrap() <= target)
+                    .filter(|r| {
+                        r[0] == rule
+                            && r[3].parse::<f64>().unwrap() == 1.0
+                            && r[5].parse::<f64>().unwrap() <= target
+                    })
                     .min_by_key(|r| r[2].parse::<usize>().unwrap())
                     .cloned()
             };
-            if let (Some(g), Some(q)) = (cheapest("grid"), cheapest("gauss")) {
+            if let (Some(g), Some(q)) = (cheapest("grid"), cheapest("gauss_legendre")) {
                 rows.push(Row {
                     skip: "support_discretisation",
                     scene: "uniform-pressure square, 1 m/s".into(),
