@@ -262,7 +262,7 @@ impl MirrorHalf {
         let (f, rx, ry) = (&self.f[..n], &self.rx[..n], &self.ry[..n]);
         let mut acc = [0.0f64; 2];
         for c in 0..n / 2 {
-            for l in 0..2 {
+            for (l, acc) in acc.iter_mut().enumerate() {
                 let i = 2 * c + l;
                 let (fi, x0, y0) = (f[i], rx[i], ry[i]);
                 let uy = vy + omega * x0;
@@ -271,7 +271,7 @@ impl MirrorHalf {
                 let y = (ux2 * ux2 + uy * uy).max(floor);
                 let a = fi * (x0 * uy - y0 * ux1);
                 let b = fi * (x0 * uy + y0 * ux2);
-                acc[l] += (a * x.sqrt() * y + b * y.sqrt() * x) / (x * y);
+                *acc += (a * y * x.sqrt() + b * x * y.sqrt()) * (1.0 / (x * y));
             }
         }
         -(acc[0] + acc[1])

@@ -79,6 +79,9 @@ pub struct SegmentDynamics {
     dir: Vec2,
     k: f64,
     inertia_contact: f64,
+    /// `1 / I_P` (1/(kg m²)): ω̇ multiplies by it (a division would sit on
+    /// the integrator's critical path, see [`SegmentDynamics::omega_dot`]).
+    inv_inertia_contact: f64,
     mass: f64,
     contact: Vec2,
     max_moment: f64,
@@ -120,6 +123,7 @@ impl SegmentDynamics {
             dir,
             k: sign * body.mass() * push.speed * pc.dot(&dir),
             inertia_contact: body.inertia_contact(),
+            inv_inertia_contact: 1.0 / body.inertia_contact(),
             mass: body.mass(),
             contact: pc,
             max_moment: 0.0,
@@ -169,7 +173,11 @@ impl SegmentDynamics {
     /// it), so supports are taken in pairs over one division:
     /// `a/√x + c/√y = (a √x y + c √y x) / (x y)` with `x, y = |u|²` — two
     /// square roots and one division per pair instead of two of each
-    /// (`model_rhs` bench: about 2× per support at 1024 supports). `|u|²` is
+    /// (`model_rhs` bench: about 2× per support at 1024 supports). The
+    /// reciprocal `1/(x y)` is taken apart from the numerator so the division
+    /// runs beside the square roots rather than after them: for a handful of
+    /// supports the sum's latency, not its throughput, is what an integrator
+    /// waits for. `|u|²` is
     /// clamped below at [`U2_FLOOR`] so `x y` stays a normal number; a support
     /// at rest then has `a = r_i × u_i = 0` and contributes nothing.
     #[inline]
@@ -182,31 +190,40 @@ impl SegmentDynamics {
             let u2 = (ux * ux + uy * uy).max(U2_FLOOR);
             (f * (rx * uy - ry * ux), u2)
         };
+        // a/√x + b/√y over one reciprocal; `a y` and `b x` are ready before
+        // the square roots finish, so one product follows each of them.
+        let pair = |(a, x): (f64, f64), (b, y): (f64, f64)| {
+            (a * y * x.sqrt() + b * x * y.sqrt()) * (1.0 / (x * y))
+        };
         let n = self.f.len();
         let (f, rx, ry) = (&self.f[..n], &self.rx[..n], &self.ry[..n]);
-        // Blocks of four: supports k, k+1 are paired with k+2, k+3; two
+        let term = |i: usize| parts(f[i], rx[i], ry[i]);
+        // Blocks of four: supports k, k+1 are paired with k+2, k+3, into two
         // independent accumulators (a single sum would be a serial chain).
-        let mut acc = [0.0f64; 2];
+        // The first block initialises them, sparing two additions on the
+        // path an integrator waits on.
         let blocks = n / 4;
-        for c in 0..blocks {
+        let mut acc = [-0.0f64; 2];
+        if blocks > 0 {
+            acc = [pair(term(0), term(2)), pair(term(1), term(3))];
+        }
+        for c in 1..blocks {
             let k = 4 * c;
-            for l in 0..2 {
-                let (a, x) = parts(f[k + l], rx[k + l], ry[k + l]);
-                let (b, y) = parts(f[k + 2 + l], rx[k + 2 + l], ry[k + 2 + l]);
-                acc[l] += (a * x.sqrt() * y + b * y.sqrt() * x) / (x * y);
+            for (l, a) in acc.iter_mut().enumerate() {
+                *a += pair(term(k + l), term(k + 2 + l));
             }
         }
         // The remainder (0–3 supports): one more pair, then a single one.
-        let mut tail = 0.0;
+        // −0.0 is the additive identity the compiler may drop (x + −0.0 = x
+        // for every x, −0.0 included).
+        let mut tail = -0.0;
         let mut i = 4 * blocks;
         if n - i >= 2 {
-            let (a, x) = parts(f[i], rx[i], ry[i]);
-            let (b, y) = parts(f[i + 1], rx[i + 1], ry[i + 1]);
-            tail += (a * x.sqrt() * y + b * y.sqrt() * x) / (x * y);
+            tail = pair(term(i), term(i + 1));
             i += 2;
         }
         if i < n {
-            let (a, x) = parts(f[i], rx[i], ry[i]);
+            let (a, x) = term(i);
             tail += a / x.sqrt();
         }
         -((acc[0] + acc[1]) + tail)
@@ -219,9 +236,13 @@ impl SegmentDynamics {
     }
 
     /// ω̇ (rad/s²).
+    ///
+    /// An integrator's stages are serial in ω, so this function's latency
+    /// (not its throughput) sets the integration speed for few supports:
+    /// it multiplies by a stored `1/I_P` instead of dividing.
     #[inline]
     pub fn omega_dot(&self, omega: f64) -> f64 {
-        self.moment(omega) / self.inertia_contact
+        self.moment(omega) * self.inv_inertia_contact
     }
 
     /// `G'(ω)` (N m s), using `b_i − s_i² = (r_i · n_φ)²`. Supports that are
