@@ -178,13 +178,18 @@ pub(crate) struct TailCursor {
     step: f64,
     p_step: C,
     e_step: f64,
-    /// `e^{iθ_s}`.
-    rot0: C,
     /// `1/(iω*)`.
     inv_iw: C,
     beta: [C; 3],
     /// `τ δ₀` (rad).
     td: f64,
+    /// `ε(∞) = −ln(1 − a)/q` (rad), the angle the relaxation adds in all.
+    eps_inf: f64,
+    /// `g = τδ₀/(1 − a)` (rad) and `q g`: `ε(s) = ε(∞) − ln(1 + q g E)/q`.
+    g: f64,
+    qg: f64,
+    /// `e^{i(θ_s + ε(∞))}`.
+    rot_inf: C,
 }
 
 impl TailCursor {
@@ -193,6 +198,13 @@ impl TailCursor {
         let rot0 = C::new(c0, s0);
         let rv = rot0 * C::new(tail.vel.x, tail.vel.y);
         let td = tail.tau * tail.delta;
+        // ε(s) split into its limit and a remainder that decays with E, so
+        // the remainder's log and rotation take their short series for most
+        // samples: 1 − x = (1 − a)(1 + q g E) with a = q τδ₀.
+        let a = tail.q * td;
+        let eps_inf = td * log_ratio(a);
+        let g = td / (1.0 - a);
+        let (si, ci) = eps_inf.sin_cos();
         // With J₁ = A₀ − A₁ and J₂ = A₀ − 2A₁ + A₂ the local displacement is
         // A₀ + iτδ₀ J₁ + κ J₂, κ = (iq − 1)(τδ₀)²/2; A₁ = (PE − 1)/z₁ and
         // A₂ = (PE² − 1)/z₂ with z_k = iω* − k/τ.
@@ -213,7 +225,10 @@ impl TailCursor {
             step: f64::NAN,
             p_step: C::new(1.0, 0.0),
             e_step: 1.0,
-            rot0,
+            rot_inf: rot0 * C::new(ci, si),
+            eps_inf,
+            g,
+            qg: tail.q * g,
             inv_iw: C::new(0.0, -1.0 / tail.omega),
             beta,
             td,
@@ -303,6 +318,7 @@ impl TailCursor {
         };
         let [b0, b1, b2] = self.beta;
         let mut dc = b0 * a0;
+        // ε − ε(∞) (rad).
         let mut eps = 0.0;
         let mut omega = w;
         if tl.delta != 0.0 {
@@ -310,13 +326,14 @@ impl TailCursor {
             dc += pe * (b1 + b2 * e) - (b1 + b2);
             let x = tl.q * self.td * (1.0 - e);
             omega = w + tl.delta * e / (1.0 - x);
-            eps = self.td * (1.0 - e) * log_ratio(x);
+            // ε − ε(∞) = −ln(1 + q g E)/q = −g E ln(1 + y)/y, y = q g E.
+            eps = -self.g * e * log_ratio(-self.qg * e);
         }
         let (ce, se) = small_sin_cos(eps);
-        let rot = self.rot0 * p * C::new(ce, se);
+        let rot = self.rot_inf * p * C::new(ce, se);
         TailPose {
             c: tl.c + Vec2::new(dc.re, dc.im),
-            theta: tl.theta + x + eps,
+            theta: tl.theta + x + (self.eps_inf + eps),
             omega,
             cos: rot.re,
             sin: rot.im,
