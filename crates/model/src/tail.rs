@@ -445,4 +445,57 @@ mod tests {
             }
         }
     }
+
+    /// The tail's angle, ω and rotation against the logistic solution written
+    /// out directly (module docs): `θ = θ_s + ω* s − ln(1 − x)/q`,
+    /// `ω = ω* + δ₀E/(1 − x)`, `x = qτδ₀(1 − E)`, for `qτδ₀` from the
+    /// largest the settle rule admits (0.25, the log's libm branch) down to
+    /// 1e-6 (its series), both signs, and `q = 0`.
+    #[test]
+    fn angle_and_rate_follow_the_logistic_solution() {
+        for (q, delta) in [
+            (2.5, 1.0),
+            (-2.5, 1.0),
+            (0.8, 0.05),
+            (0.8, -0.05),
+            (0.8, 1e-5),
+            (0.0, 0.3),
+        ] {
+            let tail = Tail {
+                t: 0.25,
+                c: Vec2::new(0.1, -0.2),
+                theta: 0.4,
+                omega: -0.65,
+                delta,
+                tau: 0.1,
+                q,
+                vel: Vec2::new(0.7, 0.7),
+            };
+            let td = tail.tau * delta;
+            let mut cur = TailCursor::new(tail);
+            for k in 0..200 {
+                let s = 0.005 * k as f64;
+                let p = cur.eval(tail.t + s);
+                let e = (-s / tail.tau).exp();
+                let x = q * td * (1.0 - e);
+                let eps = if q == 0.0 {
+                    td * (1.0 - e)
+                } else {
+                    -(-x).ln_1p() / q
+                };
+                let theta = tail.theta + tail.omega * s + eps;
+                let omega = tail.omega + delta * e / (1.0 - x);
+                assert!(
+                    (p.theta - theta).abs() <= 1e-14,
+                    "q {q}, δ₀ {delta}, s {s}: θ {} against {theta}",
+                    p.theta
+                );
+                assert!((p.omega - omega).abs() <= 1e-14, "q {q}, δ₀ {delta}, s {s}");
+                assert!(
+                    (p.cos - theta.cos()).abs() <= 1e-14 && (p.sin - theta.sin()).abs() <= 1e-14,
+                    "q {q}, δ₀ {delta}, s {s}: rotation"
+                );
+            }
+        }
+    }
 }
