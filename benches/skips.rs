@@ -210,7 +210,6 @@ fn main() {
         assert!((ga - gb).abs() <= 1e-12 * ga.abs(), "{ga} against {gb}");
         rows.push(Row {
             skip: "symmetric_fold",
-
             scene: "1024 supports, mirror-symmetric about a line through the contact".into(),
             without: "paired friction loop over all supports".into(),
             without_s: a / calls as f64,

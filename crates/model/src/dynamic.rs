@@ -171,25 +171,19 @@ impl SegmentDynamics {
     ///
     /// The loop is bound by the divider (square roots and divisions share
     /// it), so supports are taken in pairs over one division:
-    /// `a/√x + c/√y = (a √x y + c √y x) / (x y)` with `x, y = |u|²` — two
+    /// `a/√x + c/√y = (a y √x + c x √y) / (x y)` with `x, y = |u|²` — two
     /// square roots and one division per pair instead of two of each
     /// (`model_rhs` bench: about 2× per support at 1024 supports). The
     /// reciprocal `1/(x y)` is taken apart from the numerator so the division
     /// runs beside the square roots rather than after them: for a handful of
     /// supports the sum's latency, not its throughput, is what an integrator
-    /// waits for. `|u|²` is
-    /// clamped below at [`U2_FLOOR`] so `x y` stays a normal number; a support
-    /// at rest then has `a = r_i × u_i = 0` and contributes nothing.
+    /// waits for. `|u|²` is clamped below at [`U2_FLOOR`] so `x y` stays a
+    /// normal number; a support at rest then has `a = r_i × u_i = 0` and
+    /// contributes nothing.
     #[inline]
     pub fn friction_moment_at(&self, v: f64, omega: f64) -> f64 {
         let (vx, vy) = (v * self.dir.x, v * self.dir.y);
-        // (F_i r_i × u_i, |u_i|²), branch-free so the loop vectorises.
-        let parts = |f: f64, rx: f64, ry: f64| {
-            let ux = vx - omega * ry;
-            let uy = vy + omega * rx;
-            let u2 = (ux * ux + uy * uy).max(U2_FLOOR);
-            (f * (rx * uy - ry * ux), u2)
-        };
+
         // a/√x + b/√y over one reciprocal; `a y` and `b x` are ready before
         // the square roots finish, so one product follows each of them.
         let pair = |(a, x): (f64, f64), (b, y): (f64, f64)| {
@@ -197,7 +191,13 @@ impl SegmentDynamics {
         };
         let n = self.f.len();
         let (f, rx, ry) = (&self.f[..n], &self.rx[..n], &self.ry[..n]);
-        let term = |i: usize| parts(f[i], rx[i], ry[i]);
+        // (F_i r_i × u_i, |u_i|²) of support i, branch-free so the loop vectorises.
+        let term = |i: usize| {
+            let ux = vx - omega * ry[i];
+            let uy = vy + omega * rx[i];
+            let u2 = (ux * ux + uy * uy).max(U2_FLOOR);
+            (f[i] * (rx[i] * uy - ry[i] * ux), u2)
+        };
         // Blocks of four: supports k, k+1 are paired with k+2, k+3, into two
         // independent accumulators (a single sum would be a serial chain).
         // The first block initialises them, sparing two additions on the

@@ -319,7 +319,7 @@ impl TailCursor {
         let [b0, b1, b2] = self.beta;
         let mut dc = b0 * a0;
         // ε − ε(∞) (rad).
-        let mut eps = 0.0;
+        let mut eps_rest = 0.0;
         let mut omega = w;
         if tl.delta != 0.0 {
             let pe = p * e;
@@ -327,13 +327,13 @@ impl TailCursor {
             let x = tl.q * self.td * (1.0 - e);
             omega = w + tl.delta * e / (1.0 - x);
             // ε − ε(∞) = −ln(1 + q g E)/q = −g E ln(1 + y)/y, y = q g E.
-            eps = -self.g * e * log_ratio(-self.qg * e);
+            eps_rest = -self.g * e * log_ratio(-self.qg * e);
         }
-        let (ce, se) = small_sin_cos(eps);
+        let (ce, se) = small_sin_cos(eps_rest);
         let rot = self.rot_inf * p * C::new(ce, se);
         TailPose {
             c: tl.c + Vec2::new(dc.re, dc.im),
-            theta: tl.theta + x + (self.eps_inf + eps),
+            theta: tl.theta + x + (self.eps_inf + eps_rest),
             omega,
             cos: rot.re,
             sin: rot.im,
