@@ -245,6 +245,75 @@ impl SegmentDynamics {
         self.moment(omega) * self.inv_inertia_contact
     }
 
+    /// Taylor coefficients of ω̇ about `omega`: `out[j] = g⁽ʲ⁾(ω)/j!` for
+    /// `j = 0 .. out.len()`, with `g = ω̇` (units rad/s² per (rad/s)ʲ).
+    ///
+    /// Per support, `|u|²` is a quadratic in the offset `d`:
+    /// `x₀ + x₁ d + x₂ d² = x₀ (1 − 2 t z + z²)` with `z = d √(x₂/x₀)` and
+    /// `t = −x₁ / (2 √(x₀ x₂))`, `|t| ≤ 1`, and Legendre's generating
+    /// function `(1 − 2 t z + z²)^(−1/2) = Σ Pₙ(t) zⁿ` gives the series of
+    /// `1/|u|` by the three-term recurrence of `Pₙ`; the numerator
+    /// `F (r × u)` is linear in `d`. So each support costs O(`out.len()`).
+    ///
+    /// A support at rest at `omega` (`|u| = 0`) has no series: the result is
+    /// then NaN.
+    pub fn omega_dot_taylor(&self, omega: f64, out: &mut [f64]) {
+        let n = out.len();
+        out.fill(0.0);
+        if n == 0 {
+            return;
+        }
+        let (vx, vy) = (self.speed * self.dir.x, self.speed * self.dir.y);
+        // The recurrence's factors (2j + 1)/(j + 1) and j/(j + 1), so no
+        // division sits on its serial chain.
+        let fac: Vec<(f64, f64)> = (0..n)
+            .map(|j| {
+                let jf = j as f64;
+                ((2.0 * jf + 1.0) / (jf + 1.0), jf / (jf + 1.0))
+            })
+            .collect();
+        for i in 0..self.f.len() {
+            let (rx, ry) = (self.rx[i], self.ry[i]);
+            let x2 = rx * rx + ry * ry;
+            if x2 == 0.0 {
+                // The support under the contact: no lever arm, no moment.
+                continue;
+            }
+            let ux = vx - omega * ry;
+            let uy = vy + omega * rx;
+            let x0 = ux * ux + uy * uy;
+            if x0 == 0.0 {
+                out.fill(f64::NAN);
+                return;
+            }
+            let x1 = 2.0 * (rx * uy - ry * ux);
+            let sc = (x2 / x0).sqrt();
+            let t = (-x1 / (2.0 * (x0 * x2).sqrt())).clamp(-1.0, 1.0);
+            let (ts, s2) = (t * sc, sc * sc);
+            // Moment −F (r × u)/|u| = (m₀ + m₁ d) / |u|.
+            let m0 = -self.f[i] * (rx * uy - ry * ux);
+            let m1 = -self.f[i] * x2;
+            // pj = Pⱼ(t) scʲ / √x₀, the series of 1/|u|.
+            let mut prev = 0.0;
+            let mut pj = 1.0 / x0.sqrt();
+            out[0] += m0 * pj;
+            for (j, o) in out.iter_mut().enumerate().skip(1) {
+                let (a, b) = fac[j - 1];
+                let next = a * ts * pj - b * s2 * prev;
+                *o += m0 * next + m1 * pj;
+                prev = pj;
+                pj = next;
+            }
+        }
+        out[0] += self.k * omega;
+        if n > 1 {
+            out[1] += self.k;
+        }
+        for o in out.iter_mut() {
+            *o *= self.inv_inertia_contact;
+        }
+    }
+
     /// `G'(ω)` (N m s), using `b_i − s_i² = (r_i · n_φ)²`. Supports that are
     /// not sliding are skipped.
     pub fn moment_slope(&self, omega: f64) -> f64 {

@@ -464,10 +464,14 @@ impl Simulator for DynamicModel {
                     kind: crate::RootKind::Stable,
                     tau: Some(tau),
                     omega: ws,
-                }) if self.skip_settled => Some(SettleRule::new(&seg, ws, tau, tol)),
+                }) if self.skip_settled && tau > 0.0 => SettleRule::new(&seg, ws, tol),
                 _ => None,
             };
-            let settled = |t: f64, w: f64| settle.filter(|r| r.holds(w, t1 - t));
+            let try_tail = |t: f64, c: Vec2, theta: f64, w: f64| {
+                settle
+                    .as_ref()
+                    .and_then(|r| r.tail(&seg, t, c, theta, w, vel, t1 - t))
+            };
             // A stable pivot is reached in finite time (ω̇ jumps there); past
             // it the support sticks and the object turns about it at the
             // constant ω_p. Integrating across the jump would chatter, so the
@@ -486,16 +490,8 @@ impl Simulator for DynamicModel {
                         || (w1 - wp).signum() != (w0 - wp).signum()
                 })
             };
-            let pivot_tail = |t: f64, c: Vec2, theta: f64| Tail {
-                t,
-                c,
-                theta,
-                omega: pivot.unwrap_or(0.0),
-                delta: 0.0,
-                tau: 1.0,
-                q: 0.0,
-                vel,
-            };
+            let pivot_tail =
+                |t: f64, c: Vec2, theta: f64| Tail::arc(t, c, theta, pivot.unwrap_or(0.0), vel);
 
             // Segment start: the state just after the switch.
             while let Some(ts) = sampler.due(t0, t1, last) {
@@ -509,7 +505,7 @@ impl Simulator for DynamicModel {
             let mut settle_state: Option<Tail> = if pivot_reached(omega, omega) {
                 Some(pivot_tail(t0, c, theta))
             } else {
-                settled(t0, omega).map(|r| r.tail(t0, c, theta, omega, vel))
+                try_tail(t0, c, theta, omega)
             };
 
             if push.speed == 0.0 {
@@ -684,9 +680,9 @@ impl Simulator for DynamicModel {
                                     h = hn;
                                 }
                                 if t < t1 {
-                                    if let Some(r) = settled(t, y[1]) {
-                                        settle_state =
-                                            Some(r.tail(t, Vec2::new(y[2], y[3]), y[0], y[1], vel));
+                                    if let Some(tl) = try_tail(t, Vec2::new(y[2], y[3]), y[0], y[1])
+                                    {
+                                        settle_state = Some(tl);
                                         break;
                                     }
                                 }
@@ -758,9 +754,8 @@ impl Simulator for DynamicModel {
                                 });
                             }
                             if t < t1 {
-                                if let Some(r) = settled(t, y[1]) {
-                                    settle_state =
-                                        Some(r.tail(t, Vec2::new(y[2], y[3]), y[0], y[1], vel));
+                                if let Some(tl) = try_tail(t, Vec2::new(y[2], y[3]), y[0], y[1]) {
+                                    settle_state = Some(tl);
                                     break;
                                 }
                             }
@@ -838,16 +833,7 @@ fn constant_omega_run(
         let last = j + 1 == n_seg;
         let w = omega_of(&problem.body, push);
         let vel = push.velocity();
-        let arc = Tail {
-            t: t0,
-            c,
-            theta,
-            omega: w,
-            delta: 0.0,
-            tau: 1.0,
-            q: 0.0,
-            vel,
-        };
+        let arc = Tail::arc(t0, c, theta, w, vel);
         let p = sample_tail(arc, &mut sampler, t1, last, pc, &mut out.samples);
         (c, theta) = (p.c, p.theta);
         out.segments.push(SegmentReport {
