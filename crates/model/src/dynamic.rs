@@ -669,4 +669,64 @@ mod tests {
             );
         }
     }
+
+    /// The Taylor coefficients of ω̇ against ω̇ itself: the constant term,
+    /// the slope against the analytic `G'` of [`SegmentDynamics::moment_slope`],
+    /// the curvature against a central difference, and the whole polynomial
+    /// against ω̇ at offsets up to a fifth of the distance to the nearest
+    /// complex singularity (`v |n·r| / r²`, where a support's sliding speed
+    /// would vanish), where the dropped terms are below 1e-14. One support
+    /// sits under the contact (no lever arm).
+    #[test]
+    fn taylor_coefficients_reproduce_omega_dot() {
+        let b = body(&[
+            (0.12, 0.03),
+            (-0.1, -0.05),
+            (0.02, 0.11),
+            (-0.09, 0.08),
+            (0.05, -0.1),
+        ]);
+        let push = Push {
+            duration: 1.0,
+            speed: 0.7,
+            phi: 0.4,
+        };
+        let seg = SegmentDynamics::new(&b, &push);
+        let n = push.direction();
+        let radius = b
+            .supports()
+            .map(|s| s.position - b.contact())
+            .filter(|r| r.norm() > 0.0)
+            .map(|r| push.speed * n.dot(&r).abs() / r.norm_squared())
+            .fold(f64::INFINITY, f64::min);
+        let scale = seg.max_moment() / seg.inertia_contact();
+        let mut c = [0.0; 21];
+        for omega in [-3.0, -0.4, 0.0, 0.9, 4.0] {
+            seg.omega_dot_taylor(omega, &mut c);
+            assert!(
+                (c[0] - seg.omega_dot(omega)).abs() <= 1e-14 * scale,
+                "ω {omega}: g"
+            );
+            let slope = seg.moment_slope(omega) / seg.inertia_contact();
+            assert!(
+                (c[1] - slope).abs() <= 1e-12 * slope.abs().max(scale),
+                "ω {omega}: g'"
+            );
+            let h = 1e-3 * radius;
+            let g = |w: f64| seg.omega_dot(w);
+            let g2 = (g(omega + h) - 2.0 * g(omega) + g(omega - h)) / (h * h);
+            assert!(
+                (g2 - 2.0 * c[2]).abs() <= 1e-5 * g2.abs().max(scale / radius),
+                "ω {omega}: g''"
+            );
+            for d in [-0.2, -0.05, 0.05, 0.2].map(|f| f * radius) {
+                let series: f64 = c.iter().rev().fold(0.0, |acc, cj| acc * d + cj);
+                assert!(
+                    (series - g(omega + d)).abs() <= 1e-12 * scale,
+                    "ω {omega}, d {d}: {series} against {}",
+                    g(omega + d)
+                );
+            }
+        }
+    }
 }

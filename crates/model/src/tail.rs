@@ -53,8 +53,18 @@ pub(crate) const ORDER: usize = 20;
 /// `k − 1`) from the Taylor coefficients `g_0 … g_ORDER` of `g` at a root
 /// (`g_1 < 0`). Writing `[h^j]_k` for the `k`-th coefficient of `h^j`, each
 /// power is built from the one below, `[h^j]_k = Σ_i a_i [h^{j−1}]_{k−i}`,
-/// and for `j ≥ 2` only needs `a_1 … a_{k−1}`: about `ORDER³/6` products.
-pub(crate) fn linearising_map(g: &[f64; ORDER + 1]) -> [f64; ORDER] {
+/// and for `j ≥ 2` only needs `a_1 … a_{k−1}`: about `K³/6` products for
+/// `K` terms.
+///
+/// Stops early, at `K ≥ 4` terms, once the last two terms at `|z| = reach`
+/// are below `small` (the work grows as `K³`; a tight tolerance or a long way
+/// to the root needs more terms). Returns the coefficients (zero beyond
+/// `K`) and `K`.
+pub(crate) fn linearising_map(
+    g: &[f64; ORDER + 1],
+    reach: f64,
+    small: f64,
+) -> ([f64; ORDER], usize) {
     let tau = -1.0 / g[1];
     let mut a = [0.0; ORDER + 1];
     a[1] = 1.0;
@@ -74,18 +84,23 @@ pub(crate) fn linearising_map(g: &[f64; ORDER + 1]) -> [f64; ORDER] {
         let sum: f64 = (2..=k).map(|j| g[j] * pw[k][j]).sum();
         a[k] = -tau / (k as f64 - 1.0) * sum;
         pw[k][1] = a[k];
+        if k >= 4
+            && a[k].abs() * reach.powi(k as i32) + a[k - 1].abs() * reach.powi(k as i32 - 1) < small
+        {
+            return (std::array::from_fn(|i| a[i + 1]), k);
+        }
     }
-    std::array::from_fn(|k| a[k + 1])
+    (std::array::from_fn(|k| a[k + 1]), ORDER)
 }
 
 /// `α_k = a_k ξ^k` for the deviation `d = h(ξ)` (Newton's method from
 /// `ξ = d`); `None` where `h` is not safely invertible there.
-pub(crate) fn series_for(a: &[f64; ORDER], d: f64) -> Option<[f64; ORDER]> {
+pub(crate) fn series_for(a: &[f64; ORDER], order: usize, d: f64) -> Option<[f64; ORDER]> {
     let mut xi = d;
     let mut converged = false;
     for _ in 0..30 {
         let (mut h, mut dh) = (0.0, 0.0);
-        for k in (0..ORDER).rev() {
+        for k in (0..order).rev() {
             h = (h + a[k]) * xi;
             dh = dh * xi + (k + 1) as f64 * a[k];
         }
@@ -116,29 +131,50 @@ pub(crate) struct SettleRule {
     pub omega: f64,
     /// τ = −1/g'(ω*) (s).
     pub tau: f64,
-    /// `a_1 … a_ORDER` (index `k − 1`).
+    /// `a_1 … a_K` (index `k − 1`; zero beyond `K`).
     a: [f64; ORDER],
+    /// `K`, the number of terms kept.
+    order: usize,
     speed: f64,
     tol: f64,
 }
 
 impl SettleRule {
-    /// The rule for a stable root `omega`; `None` where `g` has no series
-    /// there (a support at rest) or the root is not attracting.
-    pub fn new(seg: &SegmentDynamics, omega: f64, tol: f64) -> Option<Self> {
+    /// The rule for a stable root `omega` of a segment that starts at
+    /// ω = `w_start` and lasts `duration` (s); `None` where `g` has no series
+    /// there (a support at rest) or the root is not attracting. The series
+    /// gets as many terms (up to [`ORDER`]) as it needs to hold from the
+    /// segment's start.
+    pub fn new(
+        seg: &SegmentDynamics,
+        omega: f64,
+        tol: f64,
+        w_start: f64,
+        duration: f64,
+    ) -> Option<Self> {
         let mut g = [0.0; ORDER + 1];
         seg.omega_dot_taylor(omega, &mut g);
         if !(g[1] < 0.0) || g.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        let a = linearising_map(&g);
-        a.iter().all(|v| v.is_finite()).then_some(Self {
+        let mut rule = Self {
             omega,
             tau: -1.0 / g[1],
-            a,
+            a: [0.0; ORDER],
+            order: ORDER,
             speed: seg.speed(),
             tol,
-        })
+        };
+        let reach = 1.25 * (w_start - omega).abs();
+        (rule.a, rule.order) = linearising_map(&g, reach, 0.1 * rule.allowed(duration));
+        rule.a.iter().all(|v| v.is_finite()).then_some(rule)
+    }
+
+    /// The error allowed in ω at a hand-over (rad/s) with `remaining` time
+    /// (s) to go: the angle error is at most `τ` times it, the position
+    /// error at most `v_c × remaining` times the angle error.
+    fn allowed(&self, remaining: f64) -> f64 {
+        SETTLE_FRACTION * self.tol / (self.tau * (self.speed * remaining.max(0.0)).max(1.0))
     }
 
     /// The tail from time `t` (s) with contact point `c`, angle `theta` and
@@ -172,20 +208,19 @@ impl SettleRule {
         if d == 0.0 {
             return Some(tail);
         }
-        let allowed =
-            SETTLE_FRACTION * self.tol / (self.tau * (self.speed * remaining.max(0.0)).max(1.0));
+        let allowed = self.allowed(remaining);
+        let k = self.order;
         // Cheap screen before solving for ξ (|ξ| is within 1.25 |δ₀| wherever
         // the series is of any use).
         let dd = 1.25 * d.abs();
-        if self.a[ORDER - 1].abs() * dd.powi(ORDER as i32)
-            + self.a[ORDER - 2].abs() * dd.powi(ORDER as i32 - 1)
+        if self.a[k - 1].abs() * dd.powi(k as i32) + self.a[k - 2].abs() * dd.powi(k as i32 - 1)
             > allowed
         {
             return None;
         }
-        tail.alpha = series_for(&self.a, d)?;
+        tail.alpha = series_for(&self.a, k, d)?;
         let al = &tail.alpha;
-        let cut = al[ORDER - 1].abs() + al[ORDER - 2].abs();
+        let cut = al[k - 1].abs() + al[k - 2].abs();
         let rate: f64 = al
             .iter()
             .enumerate()
@@ -471,6 +506,42 @@ impl TailCursor {
                 let w_iw = self.w * self.inv_iw;
                 let c0 = self.c_base - w_iw;
                 let rpc = self.rot_inf * C::new(pc.x, pc.y);
+                let b_max = ba[..len].iter().fold(0.0f64, |m, b| m.max(b.abs()));
+                if b_max <= Rotor::REACH {
+                    // Branch-free over the block, so the poses vectorise:
+                    // e^{−ib} by the short polynomials below 1e-3 rad, the
+                    // long ones within the rotor's reach.
+                    let short = b_max < 1e-3;
+                    let mut xs = [0.0; BLOCK];
+                    let mut ys = [0.0; BLOCK];
+                    for j in 0..len {
+                        let b = -ba[j];
+                        let (ce, se) = if short {
+                            let b2 = b * b;
+                            (
+                                1.0 - b2 * (0.5 - b2 * (1.0 / 24.0)),
+                                b * (1.0 - b2 * (1.0 / 6.0 - b2 * (1.0 / 120.0))),
+                            )
+                        } else {
+                            small_cos_sin(b)
+                        };
+                        let ir = w_iw.re + kr[j] - (rpc.re * ce - rpc.im * se);
+                        let ii = w_iw.im + ki[j] - (rpc.re * se + rpc.im * ce);
+                        let (pr, pi) = (p[j].re, p[j].im);
+                        xs[j] = c0.re + (pr * ir - pi * ii);
+                        ys[j] = c0.im + (pr * ii + pi * ir);
+                    }
+                    for (j, &t) in block.iter().enumerate() {
+                        out.push(crate::Sample {
+                            t,
+                            x: xs[j],
+                            y: ys[j],
+                            theta: tl.theta + tl.omega * s[j] + (self.eps_inf - ba[j]),
+                            omega: tl.omega + wa[j],
+                        });
+                    }
+                    continue;
+                }
                 for (j, &t) in block.iter().enumerate() {
                     let (ce, se) = small_sin_cos(-ba[j]);
                     let cm = c0 + p[j] * (w_iw + C::new(kr[j], ki[j]) - rpc * C::new(ce, se));
@@ -569,10 +640,11 @@ mod tests {
     }
 
     fn tail_for(q: f64, r: f64, omega: f64, delta: f64) -> Tail {
-        let a = linearising_map(&poly_g(q, r));
+        let (a, k) = linearising_map(&poly_g(q, r), 0.0, 0.0);
+        assert_eq!(k, ORDER);
         let mut tail = Tail::arc(0.25, Vec2::new(0.1, -0.2), 0.4, omega, Vec2::new(0.7, 0.7));
         tail.tau = TAU;
-        tail.alpha = series_for(&a, delta).expect("invertible");
+        tail.alpha = series_for(&a, ORDER, delta).expect("invertible");
         tail
     }
 
@@ -583,7 +655,7 @@ mod tests {
     #[test]
     fn linearising_map_matches_closed_forms() {
         let q = 0.8;
-        let a = linearising_map(&poly_g(q, 0.0));
+        let (a, _) = linearising_map(&poly_g(q, 0.0), 0.0, 0.0);
         for (k, ak) in a.iter().enumerate() {
             let want = (-q * TAU).powi(k as i32);
             assert!(
@@ -593,7 +665,7 @@ mod tests {
             );
         }
         let r = -2.0;
-        let a = linearising_map(&poly_g(0.0, r));
+        let (a, _) = linearising_map(&poly_g(0.0, r), 0.0, 0.0);
         let mut binom = 1.0; // C(−1/2, m)
         for m in 0..ORDER / 2 {
             let want = binom * (r * TAU).powi(m as i32);

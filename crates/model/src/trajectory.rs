@@ -185,9 +185,10 @@ impl AnyDense {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DynamicModel {
     pub integrator: Integrator,
-    /// Once a segment has settled onto a stable steady state (remaining angle
-    /// deficit `|ω − ω*| τ` below a tenth of the tolerance), follow the
-    /// closed-form arc instead of integrating. Default true.
+    /// Once a segment's transient toward a stable steady state can be
+    /// written as a converging series in `e^{−t/τ}` to within a share of the
+    /// tolerance (often from the switch on), follow that closed form instead
+    /// of integrating (module `tail`). Default true.
     pub skip_settled: bool,
     /// Evaluate the pusher force and the assumption checks at every sample.
     /// Default true.
@@ -464,7 +465,9 @@ impl Simulator for DynamicModel {
                     kind: crate::RootKind::Stable,
                     tau: Some(tau),
                     omega: ws,
-                }) if self.skip_settled && tau > 0.0 => SettleRule::new(&seg, ws, tol),
+                }) if self.skip_settled && tau > 0.0 => {
+                    SettleRule::new(&seg, ws, tol, omega, t1 - t0)
+                }
                 _ => None,
             };
             let try_tail = |t: f64, c: Vec2, theta: f64, w: f64| {
