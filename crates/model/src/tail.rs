@@ -287,17 +287,23 @@ pub(crate) struct TailPose {
 #[inline(always)]
 fn small_sin_cos(e: f64) -> (f64, f64) {
     if e.abs() < 1e-3 {
-        let e2 = e * e;
-        return (
-            1.0 - e2 * (0.5 - e2 * (1.0 / 24.0)),
-            e * (1.0 - e2 * (1.0 / 6.0 - e2 * (1.0 / 120.0))),
-        );
+        return short_cos_sin(e);
     }
     if e.abs() > Rotor::REACH {
         let (s, c) = e.sin_cos();
         return (c, s);
     }
     small_cos_sin(e)
+}
+
+/// `(cos e, sin e)` by the short Taylor polynomials, for `|e| < 1e-3`.
+#[inline(always)]
+fn short_cos_sin(e: f64) -> (f64, f64) {
+    let e2 = e * e;
+    (
+        1.0 - e2 * (0.5 - e2 * (1.0 / 24.0)),
+        e * (1.0 - e2 * (1.0 / 6.0 - e2 * (1.0 / 120.0))),
+    )
 }
 
 /// Samples per block in [`TailCursor::fill`].
@@ -498,57 +504,38 @@ impl TailCursor {
                 }
             }
             let tl = &self.tail;
-            if (tl.omega * s[0]).abs() >= 1e-3 {
+            let b_max = ba[..len].iter().fold(0.0f64, |m, b| m.max(b.abs()));
+            if (tl.omega * s[0]).abs() >= 1e-3 && b_max <= Rotor::REACH {
                 // A₀ = (P − 1)/(iω*) throughout the block, so the centre of
                 // mass c − e^{iθ} p_c is one product by P:
                 // c'' + P (W/(iω*) + Σκ_m E^m − e^{i(θ_s+ε∞)} p_c e^{−ib}),
-                // c'' = c' − W/(iω*).
+                // c'' = c' − W/(iω*). Branch-free over the block, so the
+                // poses vectorise: e^{−ib} by the short polynomials below
+                // 1e-3 rad, the long ones within the rotor's reach.
                 let w_iw = self.w * self.inv_iw;
                 let c0 = self.c_base - w_iw;
                 let rpc = self.rot_inf * C::new(pc.x, pc.y);
-                let b_max = ba[..len].iter().fold(0.0f64, |m, b| m.max(b.abs()));
-                if b_max <= Rotor::REACH {
-                    // Branch-free over the block, so the poses vectorise:
-                    // e^{−ib} by the short polynomials below 1e-3 rad, the
-                    // long ones within the rotor's reach.
-                    let short = b_max < 1e-3;
-                    let mut xs = [0.0; BLOCK];
-                    let mut ys = [0.0; BLOCK];
-                    for j in 0..len {
-                        let b = -ba[j];
-                        let (ce, se) = if short {
-                            let b2 = b * b;
-                            (
-                                1.0 - b2 * (0.5 - b2 * (1.0 / 24.0)),
-                                b * (1.0 - b2 * (1.0 / 6.0 - b2 * (1.0 / 120.0))),
-                            )
-                        } else {
-                            small_cos_sin(b)
-                        };
-                        let ir = w_iw.re + kr[j] - (rpc.re * ce - rpc.im * se);
-                        let ii = w_iw.im + ki[j] - (rpc.re * se + rpc.im * ce);
-                        let (pr, pi) = (p[j].re, p[j].im);
-                        xs[j] = c0.re + (pr * ir - pi * ii);
-                        ys[j] = c0.im + (pr * ii + pi * ir);
-                    }
-                    for (j, &t) in block.iter().enumerate() {
-                        out.push(crate::Sample {
-                            t,
-                            x: xs[j],
-                            y: ys[j],
-                            theta: tl.theta + tl.omega * s[j] + (self.eps_inf - ba[j]),
-                            omega: tl.omega + wa[j],
-                        });
-                    }
-                    continue;
+                let short = b_max < 1e-3;
+                let mut xs = [0.0; BLOCK];
+                let mut ys = [0.0; BLOCK];
+                for j in 0..len {
+                    let b = -ba[j];
+                    let (ce, se) = if short {
+                        short_cos_sin(b)
+                    } else {
+                        small_cos_sin(b)
+                    };
+                    let ir = w_iw.re + kr[j] - (rpc.re * ce - rpc.im * se);
+                    let ii = w_iw.im + ki[j] - (rpc.re * se + rpc.im * ce);
+                    let (pr, pi) = (p[j].re, p[j].im);
+                    xs[j] = c0.re + (pr * ir - pi * ii);
+                    ys[j] = c0.im + (pr * ii + pi * ir);
                 }
                 for (j, &t) in block.iter().enumerate() {
-                    let (ce, se) = small_sin_cos(-ba[j]);
-                    let cm = c0 + p[j] * (w_iw + C::new(kr[j], ki[j]) - rpc * C::new(ce, se));
                     out.push(crate::Sample {
                         t,
-                        x: cm.re,
-                        y: cm.im,
+                        x: xs[j],
+                        y: ys[j],
                         theta: tl.theta + tl.omega * s[j] + (self.eps_inf - ba[j]),
                         omega: tl.omega + wa[j],
                     });
