@@ -22,8 +22,9 @@
 //! A₀ = (P − 1)/(iω*),   κ_m = W γ_m / z_m,   c' = c_s − Σ κ_m
 //! ```
 //!
-//! A sample is three Horner sums in `E` and one small rotation
-//! `e^{iθ} = e^{i(θ_s + ε∞)} P e^{−i b(E)}`. The `g_j` come from
+//! The rotation is a series too, `e^{iθ} = e^{i(θ_s + ε∞)} P Σ γ_m E^m`, so
+//! a sample of the centre of mass, `c − e^{iθ} p_c`, is three Horner sums in
+//! `E` and a complex product, with no sine or cosine. The `g_j` come from
 //! [`SegmentDynamics::omega_dot_taylor`]; the series is cut at [`ORDER`]
 //! terms, and [`SettleRule`] hands a transient over only once the dropped
 //! part, checked against `g` itself, is below a share of the tolerance. How
@@ -38,7 +39,6 @@
 
 use nalgebra::Complex;
 
-use crate::rotor::{small_cos_sin, Rotor};
 use crate::{dynamic::SegmentDynamics, Vec2};
 
 type C = Complex<f64>;
@@ -68,22 +68,40 @@ pub(crate) fn linearising_map(
     let tau = -1.0 / g[1];
     let mut a = [0.0; ORDER + 1];
     a[1] = 1.0;
-    // pw[k][j] = [h^j]_k. For one k the powers are independent of each
-    // other, so the innermost loop runs over j (no serial sum).
-    let mut pw = [[0.0; ORDER + 1]; ORDER + 1];
+    // pw[k][j] = [h^j]_k, zero for j > k. For one k the powers are
+    // independent of each other, so the innermost loop runs over j (no
+    // serial sum), in chunks of four over the zero padding: fixed-length
+    // loops with no remainder to handle.
+    const ROW: usize = ORDER + 4;
+    let mut pw = [[0.0; ROW]; ORDER + 1];
     pw[1][1] = 1.0;
+    let gp: [f64; ROW] = std::array::from_fn(|j| if j <= ORDER { g[j] } else { 0.0 });
     for k in 2..=ORDER {
+        let (lo, hi) = pw.split_at_mut(k);
+        let dst = &mut hi[0];
         for i in 1..k {
             let ai = a[i];
-            let (lo, hi) = pw.split_at_mut(k);
-            let (src, dst) = (&lo[k - i][1..=k - i], &mut hi[0][2..=k - i + 1]);
-            for (d, s) in dst.iter_mut().zip(src) {
-                *d += ai * s;
+            let src = &lo[k - i];
+            let mut o = 0;
+            while o < k - i {
+                let d: &mut [f64; 4] = (&mut dst[o + 2..o + 6]).try_into().expect("in the row");
+                let s: &[f64; 4] = (&src[o + 1..o + 5]).try_into().expect("in the row");
+                for l in 0..4 {
+                    d[l] += ai * s[l];
+                }
+                o += 4;
             }
         }
-        let sum: f64 = (2..=k).map(|j| g[j] * pw[k][j]).sum();
+        // Σ_j g_j [h^j]_k in four partial sums (the row is zero past k).
+        let mut part = [0.0; 4];
+        for c in 0..(ROW - 2) / 4 {
+            for l in 0..4 {
+                part[l] += gp[2 + 4 * c + l] * dst[2 + 4 * c + l];
+            }
+        }
+        let sum = (part[0] + part[1]) + (part[2] + part[3]);
         a[k] = -tau / (k as f64 - 1.0) * sum;
-        pw[k][1] = a[k];
+        dst[1] = a[k];
         if k >= 4
             && a[k].abs() * reach.powi(k as i32) + a[k - 1].abs() * reach.powi(k as i32 - 1) < small
         {
@@ -271,58 +289,43 @@ impl Tail {
     }
 }
 
-/// A tail pose: contact point, angle, ω, and `(cos θ, sin θ)`.
+/// A tail pose: contact point, angle and ω.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct TailPose {
     pub c: Vec2,
     pub theta: f64,
     pub omega: f64,
-    pub cos: f64,
-    pub sin: f64,
-}
-
-/// `(cos ε, sin ε)` for the small angles of a tail: below 1e-3 rad the short
-/// Taylor polynomials (first dropped terms ε⁶/720 and ε⁷/5040, below 2e-21),
-/// within [`Rotor::REACH`] the long ones, libm beyond.
-#[inline(always)]
-fn small_sin_cos(e: f64) -> (f64, f64) {
-    if e.abs() < 1e-3 {
-        return short_cos_sin(e);
-    }
-    if e.abs() > Rotor::REACH {
-        let (s, c) = e.sin_cos();
-        return (c, s);
-    }
-    small_cos_sin(e)
-}
-
-/// `(cos e, sin e)` by the short Taylor polynomials, for `|e| < 1e-3`.
-#[inline(always)]
-fn short_cos_sin(e: f64) -> (f64, f64) {
-    let e2 = e * e;
-    (
-        1.0 - e2 * (0.5 - e2 * (1.0 / 24.0)),
-        e * (1.0 - e2 * (1.0 / 6.0 - e2 * (1.0 / 120.0))),
-    )
 }
 
 /// Samples per block in [`TailCursor::fill`].
 const BLOCK: usize = 16;
+
+/// Samples summed together in registers in [`TailCursor::fill`].
+const LANES: usize = 4;
+
+/// `j Δt`, `P^j` and `E^j` for `j < BLOCK` and a time step `Δt` (s).
+struct StepPowers {
+    dt: f64,
+    s: [f64; BLOCK],
+    p: [C; BLOCK],
+    e: [f64; BLOCK],
+}
 
 /// Evaluates a [`Tail`] at increasing times, advancing the phasors
 /// `P = e^{iω* s}` and `E = e^{−s/τ}` by multiplication when the time step
 /// repeats.
 pub(crate) struct TailCursor {
     tail: Tail,
-    /// Number of series terms in use.
+    /// Number of series terms in use (those of `α` and `γ`).
     n: usize,
     /// `β_k` (rad).
     beta: [f64; ORDER],
     /// `κ_m` (m).
     kappa: [C; ORDER],
-    /// Size of the k-th terms at `E = 1`, as angles (rad): `|α_k| τ`,
-    /// `|β_k|`, `|κ_k|/(|V| τ)`. A block of samples drops the terms that
-    /// stay below 1e-18 rad.
+    /// `γ_1 … γ_n` of `e^{−i b(E)} = Σ γ_m E^m` (index `m − 1`).
+    gamma: [C; ORDER],
+    /// Size of the k-th terms of ω and the angle at `E = 1`, as angles
+    /// (rad): the larger of `|α_k| τ` and `|β_k|`.
     mag: [f64; ORDER],
     /// `ε∞` (rad).
     eps_inf: f64,
@@ -360,41 +363,53 @@ impl TailCursor {
         let v = C::new(tail.vel.x, tail.vel.y);
         let w = v * rot_inf;
         // e^{−i b(E)} = Σ γ_m E^m: with f = e^u, m γ_m = Σ_k k u_k γ_{m−k},
-        // u_k = −i β_k.
+        // u_k = −i β_k, and k β_k = τ α_k.
+        let ta: [f64; ORDER] = std::array::from_fn(|k| tail.alpha[k] * tau);
+        // γ does not stop where β does (e^{−iβ₁E} alone has every power), so
+        // it goes on to ORDER terms and is cut where it no longer counts.
         let mut gamma = [C::new(0.0, 0.0); ORDER + 1];
         gamma[0] = C::new(1.0, 0.0);
+        let n_alpha = n;
+        let n = if n == 0 { 0 } else { ORDER };
         for m in 1..=n {
-            // Two partial sums: half the serial chain.
-            let mut acc = [C::new(0.0, 0.0); 2];
-            for k in 1..=m {
-                acc[k & 1] += gamma[m - k] * ((k as f64) * beta[k - 1]);
+            // Two partial sums in registers: half the serial chain.
+            let (mut a0, mut a1) = (C::new(0.0, 0.0), C::new(0.0, 0.0));
+            let mut k = 1;
+            while k < m {
+                a0 += gamma[m - k] * ta[k - 1];
+                a1 += gamma[m - k - 1] * ta[k];
+                k += 2;
             }
-            let acc = acc[0] + acc[1];
+            if k == m {
+                a0 += gamma[0] * ta[m - 1];
+            }
+            let acc = a0 + a1;
             gamma[m] = C::new(acc.im, -acc.re) * (1.0 / m as f64);
         }
+        let n = (n_alpha..=n)
+            .rev()
+            .find(|&m| m == n_alpha || gamma[m].norm_sqr() > 1e-40)
+            .unwrap_or(0);
+        // κ_m = W γ_m / z_m, 1/z_m = conj(z_m)/|z_m|²; the divisions are
+        // independent of each other, so they go first.
+        let inv_z2: [f64; ORDER] = std::array::from_fn(|k| {
+            let re = (k + 1) as f64 / tau;
+            1.0 / (re * re + tail.omega * tail.omega)
+        });
         let mut kappa = [C::new(0.0, 0.0); ORDER];
-        let mut mag = [0.0; ORDER];
-        let vt = v.norm_sqr().sqrt() * tau;
         let mut sum_kappa = C::new(0.0, 0.0);
         for m in (1..=n).rev() {
-            // 1/z_m = conj(z_m)/|z_m|².
-            let z = C::new(-(m as f64) / tau, tail.omega);
-            kappa[m - 1] = w * gamma[m] * z.conj() * (1.0 / z.norm_sqr());
+            let z = C::new(-(m as f64) / tau, -tail.omega);
+            kappa[m - 1] = w * gamma[m] * z * inv_z2[m - 1];
             sum_kappa += kappa[m - 1];
-            let kr = if vt > 0.0 {
-                kappa[m - 1].norm_sqr().sqrt() / vt
-            } else {
-                0.0
-            };
-            mag[m - 1] = (tail.alpha[m - 1].abs() * tau)
-                .max(beta[m - 1].abs())
-                .max(kr);
         }
+        let mag = std::array::from_fn(|k| ta[k].abs().max(beta[k].abs()));
         Self {
             tail,
             n,
             beta,
             kappa,
+            gamma: std::array::from_fn(|m| gamma[m + 1]),
             mag,
             eps_inf,
             rot_inf,
@@ -427,38 +442,87 @@ impl TailCursor {
     /// evaluation), appending the centre-of-mass samples for the contact
     /// point `pc` (object frame) to `out`.
     ///
-    /// Per block: the phasor recurrences (a short serial chain); the three
-    /// Horner sums with the samples innermost, so they vectorise, cut at the
-    /// last term that counts at the block's largest `E`; then the poses,
-    /// independent of each other.
+    /// The centre of mass is `c − e^{iθ} p_c`, and with
+    /// `e^{iθ} = e^{i(θ_s+ε∞)} P Σ γ_m E^m` both parts are one series in `E`
+    /// times `P`:
+    ///
+    /// ```text
+    /// c − e^{iθ} p_c = c' + W A₀(s) + P (−r + Σ λ_m E^m),
+    /// r = e^{i(θ_s+ε∞)} p_c,   λ_m = κ_m − r γ_m
+    /// ```
+    ///
+    /// so a sample needs no sine or cosine: three Horner sums (`ω`, the
+    /// angle, `λ`) and a complex product. Per block of samples: the phasor
+    /// recurrences (a short serial chain); the Horner sums with the samples
+    /// innermost, so they vectorise, cut at the last term that counts at the
+    /// block's largest `E`; then the poses, independent of each other.
     pub fn fill(&mut self, times: &[f64], pc: Vec2, out: &mut Vec<crate::Sample>) {
+        let tl = self.tail;
+        let n = self.n;
+        let r = self.rot_inf * C::new(pc.x, pc.y);
+        let mut lam = [C::new(0.0, 0.0); ORDER];
+        // Size of a term as an angle (rad): the λ terms over the lengths they
+        // scale, |V| τ for the path and |p_c| for the lever. A block drops
+        // the terms that stay below 1e-18 rad.
+        let mut mag = self.mag;
+        let len_scale = tl.vel.norm() * tl.tau + pc.norm();
+        for m in 0..n {
+            lam[m] = self.kappa[m] - r * self.gamma[m];
+            if len_scale > 0.0 {
+                mag[m] = mag[m].max(lam[m].norm_sqr().sqrt() / len_scale);
+            }
+        }
+        // A₀ = (P − 1)/(iω*) away from s = 0 (then c' + W A₀ − P r =
+        // c'' + P (W/(iω*) − r), c'' = c' − W/(iω*)); its series below
+        // |ω* s| = 1e-3, where the quotient would lose a factor |ω* s| to
+        // cancellation.
+        let w_iw = self.w * self.inv_iw;
+        let c_far = self.c_base - w_iw;
+        let mu_far = w_iw - r;
+        let theta0 = tl.theta + self.eps_inf;
+        // Per term: α_k, β_k, λ_k.
+        let coef: [[f64; 4]; ORDER] =
+            std::array::from_fn(|k| [tl.alpha[k], self.beta[k], lam[k].re, lam[k].im]);
+        // Every block computes all BLOCK lanes (a short last block repeats
+        // its last sample), so the loops below have a fixed length.
         let mut s = [0.0; BLOCK];
         let mut p = [C::new(1.0, 0.0); BLOCK];
         let mut e = [1.0; BLOCK];
-        // Powers of the phasor steps for an evenly spaced block, so its
-        // samples do not wait on each other: (step, P^j, E^j).
-        let mut pows: Option<(f64, [C; BLOCK], [f64; BLOCK])> = None;
-        out.reserve(times.len());
-        for block in times.chunks(BLOCK) {
+        // Powers of the phasor steps for evenly spaced samples, so a block's
+        // samples do not wait on each other.
+        let mut pows: Option<StepPowers> = None;
+        // Usually all of `times` is evenly spaced: one check for the lot
+        // (a fold without early exit or NaN rules, so it vectorises);
+        // otherwise per block.
+        let spacing = |ts: &[f64]| {
+            let dt = if ts.len() > 1 { ts[1] - ts[0] } else { 0.0 };
+            let tol = 1e-9 * dt;
+            let ok = ts.iter().enumerate().fold(true, |ok, (j, &t)| {
+                ok & (((t - ts[0]) - j as f64 * dt).abs() <= tol)
+            });
+            (ts.len() > 1 && ok).then_some(dt)
+        };
+        let all_even = spacing(times);
+        let mut nb = n;
+        // Written in place: a block assembled on the stack and then copied
+        // would be read back before its narrow stores retire.
+        let base = out.len();
+        out.resize(base + times.len(), crate::Sample::default());
+        for (block, dst) in times.chunks(BLOCK).zip(out[base..].chunks_mut(BLOCK)) {
             let len = block.len();
             self.advance(block[0]);
             (s[0], p[0], e[0]) = (self.s, self.p, self.e);
-            let dt = if len > 1 { block[1] - block[0] } else { 0.0 };
-            let even = len > 1
-                && block
-                    .iter()
-                    .enumerate()
-                    .all(|(j, &t)| ((t - block[0]) - j as f64 * dt).abs() <= 1e-9 * dt);
-            if even {
-                if pows.is_none_or(|(st, _, _)| st != dt) {
-                    let (sn, cs) = (self.tail.omega * dt).sin_cos();
+            let even = match all_even {
+                Some(dt) if len > 1 => Some(dt),
+                Some(_) => None,
+                None => spacing(block),
+            };
+            if let Some(dt) = even {
+                if pows.as_ref().is_none_or(|w| w.dt != dt) {
+                    let (sn, cs) = (tl.omega * dt).sin_cos();
                     let (ps, es) = (
                         C::new(cs, sn),
-                        if self.n == 0 {
-                            0.0
-                        } else {
-                            (-dt / self.tail.tau).exp()
-                        },
+                        if n == 0 { 0.0 } else { (-dt / tl.tau).exp() },
                     );
                     let mut pp = [C::new(1.0, 0.0); BLOCK];
                     let mut ep = [1.0; BLOCK];
@@ -466,93 +530,103 @@ impl TailCursor {
                         pp[j] = pp[j - 1] * ps;
                         ep[j] = ep[j - 1] * es;
                     }
-                    pows = Some((dt, pp, ep));
+                    pows = Some(StepPowers {
+                        dt,
+                        s: std::array::from_fn(|j| j as f64 * dt),
+                        p: pp,
+                        e: ep,
+                    });
                 }
-                let (_, pp, ep) = pows.as_ref().expect("just set");
-                for j in 1..len {
-                    s[j] = s[0] + j as f64 * dt;
-                    p[j] = p[0] * pp[j];
-                    e[j] = e[0] * ep[j];
+                let w = pows.as_ref().expect("just set");
+                for j in 1..BLOCK {
+                    s[j] = s[0] + w.s[j];
+                    p[j] = p[0] * w.p[j];
+                    e[j] = e[0] * w.e[j];
                 }
                 (self.s, self.p, self.e) = (s[len - 1], p[len - 1], e[len - 1]);
             } else {
-                for (j, &t) in block.iter().enumerate().skip(1) {
-                    self.advance(t);
+                for j in 1..BLOCK {
+                    if j < len {
+                        self.advance(block[j]);
+                    }
                     (s[j], p[j], e[j]) = (self.s, self.p, self.e);
                 }
             }
-            // Terms that still count at the block's largest E.
-            let mut nb = 0;
-            let mut ek = 1.0;
-            for k in 0..self.n {
-                ek *= e[0];
-                if self.mag[k] * ek > 1e-18 {
-                    nb = k + 1;
+            // Terms that still count at the block's largest E (E only
+            // decreases, so neither do the terms beyond the last block's).
+            while nb > 0 && mag[nb - 1] * e[0].powi(nb as i32) <= 1e-18 {
+                nb -= 1;
+            }
+            // The four sums LANES samples at a time, so the accumulators
+            // stay in registers (a whole block's would spill to the stack
+            // and cost a load and a store per term).
+            let mut sums = [[0.0; BLOCK]; 4];
+            for g in (0..BLOCK).step_by(LANES) {
+                let eg: [f64; LANES] = std::array::from_fn(|l| e[g + l]);
+                let mut acc = [[0.0; LANES]; 4];
+                for c in coef[..nb].iter().rev() {
+                    for (a, ck) in acc.iter_mut().zip(c) {
+                        for (al, el) in a.iter_mut().zip(&eg) {
+                            *al = (*al + ck) * el;
+                        }
+                    }
+                }
+                for (sq, a) in sums.iter_mut().zip(&acc) {
+                    sq[g..g + LANES].copy_from_slice(a);
                 }
             }
-            let mut wa = [0.0; BLOCK];
-            let mut ba = [0.0; BLOCK];
-            let mut kr = [0.0; BLOCK];
-            let mut ki = [0.0; BLOCK];
-            for k in (0..nb).rev() {
-                let (al, be, ka) = (self.tail.alpha[k], self.beta[k], self.kappa[k]);
-                for j in 0..len {
-                    wa[j] = (wa[j] + al) * e[j];
-                    ba[j] = (ba[j] + be) * e[j];
-                    kr[j] = (kr[j] + ka.re) * e[j];
-                    ki[j] = (ki[j] + ka.im) * e[j];
-                }
-            }
-            let tl = &self.tail;
-            let b_max = ba[..len].iter().fold(0.0f64, |m, b| m.max(b.abs()));
-            if (tl.omega * s[0]).abs() >= 1e-3 && b_max <= Rotor::REACH {
-                // A₀ = (P − 1)/(iω*) throughout the block, so the centre of
-                // mass c − e^{iθ} p_c is one product by P:
-                // c'' + P (W/(iω*) + Σκ_m E^m − e^{i(θ_s+ε∞)} p_c e^{−ib}),
-                // c'' = c' − W/(iω*). Branch-free over the block, so the
-                // poses vectorise: e^{−ib} by the short polynomials below
-                // 1e-3 rad, the long ones within the rotor's reach.
-                let w_iw = self.w * self.inv_iw;
-                let c0 = self.c_base - w_iw;
-                let rpc = self.rot_inf * C::new(pc.x, pc.y);
-                let short = b_max < 1e-3;
-                let mut xs = [0.0; BLOCK];
-                let mut ys = [0.0; BLOCK];
-                for j in 0..len {
-                    let b = -ba[j];
-                    let (ce, se) = if short {
-                        short_cos_sin(b)
-                    } else {
-                        small_cos_sin(b)
-                    };
-                    let ir = w_iw.re + kr[j] - (rpc.re * ce - rpc.im * se);
-                    let ii = w_iw.im + ki[j] - (rpc.re * se + rpc.im * ce);
+            let [wa, ba, lr, li] = &sums;
+            let mut xs = [0.0; BLOCK];
+            let mut ys = [0.0; BLOCK];
+            if (tl.omega * s[0]).abs() >= 1e-3 {
+                // Branch-free over the block, so the poses vectorise.
+                for j in 0..BLOCK {
+                    let (ir, ii) = (mu_far.re + lr[j], mu_far.im + li[j]);
                     let (pr, pi) = (p[j].re, p[j].im);
-                    xs[j] = c0.re + (pr * ir - pi * ii);
-                    ys[j] = c0.im + (pr * ii + pi * ir);
+                    xs[j] = c_far.re + (pr * ir - pi * ii);
+                    ys[j] = c_far.im + (pr * ii + pi * ir);
                 }
-                for (j, &t) in block.iter().enumerate() {
-                    out.push(crate::Sample {
-                        t,
-                        x: xs[j],
-                        y: ys[j],
-                        theta: tl.theta + tl.omega * s[j] + (self.eps_inf - ba[j]),
-                        omega: tl.omega + wa[j],
-                    });
+            } else if (tl.omega * s[BLOCK - 1]).abs() < 1e-3 {
+                for j in 0..BLOCK {
+                    let a0 = self.w * self.a0_short(s[j]);
+                    let (ir, ii) = (lr[j] - r.re, li[j] - r.im);
+                    let (pr, pi) = (p[j].re, p[j].im);
+                    xs[j] = (self.c_base.re + a0.re) + (pr * ir - pi * ii);
+                    ys[j] = (self.c_base.im + a0.im) + (pr * ii + pi * ir);
                 }
-                continue;
+            } else {
+                for j in 0..BLOCK {
+                    let a0 = if (tl.omega * s[j]).abs() < 1e-3 {
+                        self.a0_short(s[j])
+                    } else {
+                        (p[j] - 1.0) * self.inv_iw
+                    };
+                    let q = self.c_base + self.w * a0 + p[j] * (C::new(lr[j], li[j]) - r);
+                    (xs[j], ys[j]) = (q.re, q.im);
+                }
             }
-            for (j, &t) in block.iter().enumerate() {
-                let q = self.pose(s[j], p[j], wa[j], ba[j], C::new(kr[j], ki[j]));
-                out.push(crate::Sample {
+            for (j, (smp, &t)) in dst.iter_mut().zip(block).enumerate() {
+                *smp = crate::Sample {
                     t,
-                    x: q.c.x - (q.cos * pc.x - q.sin * pc.y),
-                    y: q.c.y - (q.sin * pc.x + q.cos * pc.y),
-                    theta: q.theta,
-                    omega: q.omega,
-                });
+                    x: xs[j],
+                    y: ys[j],
+                    theta: theta0 + tl.omega * s[j] - ba[j],
+                    omega: tl.omega + wa[j],
+                };
             }
         }
+    }
+
+    /// `A₀ = (P − 1)/(iω*)` by its series in `x = ω* s`, for `|x| < 1e-3`:
+    /// `s (1 − x²/6 + x⁴/120, x/2 − x³/24 + x⁵/720)`.
+    #[inline(always)]
+    fn a0_short(&self, s: f64) -> C {
+        let x = self.tail.omega * s;
+        let x2 = x * x;
+        C::new(
+            1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0)),
+            x * 0.5 * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0))),
+        ) * s
     }
 
     /// Moves the phasors to time `t` (s).
@@ -587,27 +661,18 @@ impl TailCursor {
         let tl = &self.tail;
         let w = tl.omega;
         // A₀ = (P − 1)/(iω*) loses a factor |ω* s| to cancellation, so
-        // angles below 1e-3 rad take the series
-        // s (1 − x²/6 + x⁴/120, x/2 − x³/24 + x⁵/720), x = ω* s.
+        // angles below 1e-3 rad take its series.
         let x = w * s;
         let a0 = if x.abs() < 1e-3 {
-            let x2 = x * x;
-            C::new(
-                1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0)),
-                x * 0.5 * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0))),
-            ) * s
+            self.a0_short(s)
         } else {
             (p - 1.0) * self.inv_iw
         };
         let c = self.c_base + self.w * a0 + p * ka;
-        let (ce, se) = small_sin_cos(-ba);
-        let rot = self.rot_inf * p * C::new(ce, se);
         TailPose {
             c: Vec2::new(c.re, c.im),
             theta: tl.theta + x + (self.eps_inf - ba),
             omega: w + wa,
-            cos: rot.re,
-            sin: rot.im,
         }
     }
 }
@@ -707,9 +772,6 @@ mod tests {
                     err_c = err_c.max(((p.c.x - y[2]).powi(2) + (p.c.y - y[3]).powi(2)).sqrt());
                     err_w = err_w.max((p.omega - y[1]).abs());
                     err_th = err_th.max((p.theta - y[0]).abs());
-                    assert!(
-                        (p.cos - y[0].cos()).abs() < 1e-12 && (p.sin - y[0].sin()).abs() < 1e-12
-                    );
                 }
             }
             assert!(
@@ -736,8 +798,9 @@ mod tests {
             assert_eq!(batch.len(), times.len());
             for (smp, &t) in batch.iter().zip(&times) {
                 let p = one.eval(t);
-                let x = p.c.x - (p.cos * pc.x - p.sin * pc.y);
-                let y = p.c.y - (p.sin * pc.x + p.cos * pc.y);
+                let (sin, cos) = p.theta.sin_cos();
+                let x = p.c.x - (cos * pc.x - sin * pc.y);
+                let y = p.c.y - (sin * pc.x + cos * pc.y);
                 assert_eq!(smp.t, t);
                 assert!(
                     (smp.x - x).abs() < 1e-14 && (smp.y - y).abs() < 1e-14,
@@ -758,6 +821,9 @@ mod tests {
     /// The tail's angle, ω and rotation against the logistic solution written
     /// out directly: `θ = θ_s + ω* s − ln(1 − x)/q`, `ω = ω* + δ₀E/(1 − x)`,
     /// `x = qτδ₀(1 − E)`, both signs of q and δ₀, δ₀ down to 1e-5, and q = 0.
+    /// The rotation is the series `e^{iθ} = e^{i(θ_s+ε∞)} P Σ γ_m E^m` that
+    /// [`TailCursor::fill`] uses: with the contact point at rest (`V = 0`)
+    /// and `p_c = (1, 0)` its samples are `c − (cos θ, sin θ)`.
     #[test]
     fn angle_and_rate_follow_the_logistic_solution() {
         for (q, delta) in [
@@ -771,7 +837,14 @@ mod tests {
             let tail = tail_for(q, 0.0, -0.65, delta);
             let td = TAU * delta;
             let mut cur = TailCursor::new(tail);
-            for k in 0..200 {
+            let times: Vec<f64> = (0..200).map(|k| tail.t + 0.005 * k as f64).collect();
+            let mut turned = Vec::new();
+            let at_rest = Tail {
+                vel: Vec2::zeros(),
+                ..tail
+            };
+            TailCursor::new(at_rest).fill(&times, Vec2::new(1.0, 0.0), &mut turned);
+            for (k, at) in turned.iter().enumerate() {
                 let s = 0.005 * k as f64;
                 let p = cur.eval(tail.t + s);
                 let e = (-s / TAU).exp();
@@ -789,9 +862,12 @@ mod tests {
                     p.theta
                 );
                 assert!((p.omega - omega).abs() <= 1e-14, "q {q}, δ₀ {delta}, s {s}");
+                let (x, y) = (tail.c.x - at.x, tail.c.y - at.y);
                 assert!(
-                    (p.cos - theta.cos()).abs() <= 1e-14 && (p.sin - theta.sin()).abs() <= 1e-14,
-                    "q {q}, δ₀ {delta}, s {s}: rotation"
+                    (x - theta.cos()).abs() <= 1e-14 && (y - theta.sin()).abs() <= 1e-14,
+                    "q {q}, δ₀ {delta}, s {s}: rotation off by {:e}, {:e}",
+                    x - theta.cos(),
+                    y - theta.sin()
                 );
             }
         }
