@@ -267,6 +267,41 @@ proptest! {
         }
     }
 
+    /// The directed search a trajectory uses (from ω towards where ω̇ drives
+    /// it, up to the first sign change) finds the same steady state as the
+    /// full scan followed by the choice among all roots: from random ω, from
+    /// each root itself and from just either side of it.
+    #[test]
+    fn the_directed_root_search_finds_the_full_scans_attractor(
+        s in scene(), ws in prop::collection::vec(-30.0..30.0f64, 8)
+    ) {
+        let body = s.body();
+        for push in &s.pushes {
+            let seg = SegmentDynamics::new(&body, push);
+            let roots = seg.steady_states();
+            let mut starts = ws.clone();
+            for r in &roots {
+                let h = 1e-6 * (1.0 + r.omega.abs());
+                starts.extend([r.omega, r.omega - h, r.omega + h]);
+            }
+            for w in starts {
+                let full = seg.attractor(&roots, w);
+                let directed = seg.attractor_from(w);
+                match (full, directed) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        prop_assert!(
+                            (a.omega - b.omega).abs() <= 1e-9 * (1.0 + a.omega.abs())
+                                && a.kind == b.kind,
+                            "from ω = {w}: full scan {a:?}, directed {b:?}"
+                        );
+                    }
+                    (a, b) => prop_assert!(false, "from ω = {w}: full scan {a:?}, directed {b:?}"),
+                }
+            }
+        }
+    }
+
     /// Pusher work equals friction dissipation plus the change of kinetic
     /// energy. Power is integrated by Simpson's rule over fine samples; at a
     /// switch (and at a start from rest) the contact impulse J does the work
@@ -290,6 +325,17 @@ proptest! {
             .filter_map(|r| r.tau)
             .fold(f64::INFINITY, f64::min);
         prop_assume!(tau_min >= 40.0 * dt);
+        // The same for the slowest support's speed |u|, whose kink near rest
+        // is the sharpest feature of the dissipation: it may change by at
+        // most its smallest value over 40 samples (|u̇| ≤ r_max |ω̇|).
+        let r_max = s.supports.iter().map(|q| (q - s.contact).norm()).fold(0.0, f64::max);
+        let accel = tr
+            .samples
+            .windows(2)
+            .map(|w| ((w[1].omega - w[0].omega) / (w[1].t - w[0].t)).abs())
+            .filter(|a| a.is_finite())
+            .fold(0.0, f64::max);
+        prop_assume!(tr.assumptions.min_support_speed >= 40.0 * dt * r_max * accel);
         let b = energy_books(&p, &tr);
         let scale = b.work.abs().max(b.dissipation).max(1e-12);
         prop_assert!((b.work - b.dissipation - b.kinetic).abs() <= 1e-6 * scale, "{b:?}");

@@ -96,6 +96,10 @@ pub const U2_FLOOR: f64 = 1e-150;
 /// Relative speed below which a support counts as not sliding.
 pub const STICK_REL: f64 = 1e-9;
 
+/// Intervals of the uniform grid that [`SegmentDynamics::steady_states`]
+/// scans for sign changes of `G` over ±(the bound on |ω*|).
+const ROOT_GRID: usize = 512;
+
 impl SegmentDynamics {
     /// Precomputes the segment for `push` (only its speed and direction matter).
     pub fn new(body: &Body, push: &Push) -> Self {
@@ -368,26 +372,7 @@ impl SegmentDynamics {
                 tau: None,
             }];
         }
-        // Scale of ω: friction moment at most M, so |k ω*| ≤ M; with k = 0 the
-        // root sits where the friction moment changes sign, within a few v/r.
-        let rmin = self
-            .b
-            .iter()
-            .fold(f64::INFINITY, |a, &b| if b > 0.0 { a.min(b) } else { a })
-            .sqrt();
-        let bound = if self.k > 0.0 {
-            self.max_moment / self.k * (1.0 + 1e-9) + 1e-300
-        } else {
-            // Expand until the sign changes (G decreasing: G(+∞) < 0 < G(−∞)).
-            let mut w = self.speed / rmin.max(1e-300);
-            for _ in 0..200 {
-                if g(w) < 0.0 && g(-w) > 0.0 {
-                    break;
-                }
-                w *= 2.0;
-            }
-            w
-        };
+        let bound = self.root_bound();
         if self.k <= 0.0 {
             // Monotone: one sign change in [−bound, bound] at most.
             let (lo, hi) = (-bound, bound);
@@ -399,26 +384,10 @@ impl SegmentDynamics {
         } else {
             // Several roots possible: scan a grid clustered where each support's
             // term is steepest (ω = −v s_i / b_i, where |u_i| is smallest).
-            let mut grid: Vec<f64> = (0..=512)
-                .map(|j| -bound + 2.0 * bound * j as f64 / 512.0)
+            let mut grid: Vec<f64> = (0..=ROOT_GRID)
+                .map(|j| -bound + 2.0 * bound * j as f64 / ROOT_GRID as f64)
                 .collect();
-            for i in 0..self.f.len() {
-                if self.b[i] > 0.0 {
-                    let w0 = -self.speed * self.s[i] / self.b[i];
-                    let width = self.speed / self.b[i].sqrt();
-                    for d in [
-                        -1.0, -0.3, -0.1, -0.03, -0.01, 0.0, 0.01, 0.03, 0.1, 0.3, 1.0,
-                    ] {
-                        let w = w0 + d * width;
-                        if w.abs() < bound {
-                            grid.push(w);
-                        }
-                    }
-                }
-                if grid.len() > 20_000 {
-                    break;
-                }
-            }
+            self.cluster_points(bound, &mut grid);
             grid.sort_by(f64::total_cmp);
             grid.dedup();
             let vals: Vec<f64> = grid.iter().map(|&w| g(w)).collect();
@@ -436,6 +405,119 @@ impl SegmentDynamics {
         }
         roots.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (1.0 + b.abs()));
         roots.into_iter().map(|w| self.classify(w)).collect()
+    }
+
+    /// A bound on |ω| of every steady state (rad/s). With `k > 0` the friction
+    /// moment is at most M, so |k ω*| ≤ M; with k ≤ 0 the root sits where the
+    /// friction moment changes sign, within a few v/r.
+    fn root_bound(&self) -> f64 {
+        let g = |w: f64| self.moment(w);
+        if self.k > 0.0 {
+            return self.max_moment / self.k * (1.0 + 1e-9) + 1e-300;
+        }
+        let rmin = self
+            .b
+            .iter()
+            .fold(f64::INFINITY, |a, &b| if b > 0.0 { a.min(b) } else { a })
+            .sqrt();
+        // Expand until the sign changes (G decreasing: G(+∞) < 0 < G(−∞)).
+        let mut w = self.speed / rmin.max(1e-300);
+        for _ in 0..200 {
+            if g(w) < 0.0 && g(-w) > 0.0 {
+                break;
+            }
+            w *= 2.0;
+        }
+        w
+    }
+
+    /// Appends to `grid` the scan points clustered about each support's
+    /// steepest place (ω = −v s_i / b_i) that lie inside ±`bound`.
+    fn cluster_points(&self, bound: f64, grid: &mut Vec<f64>) {
+        for i in 0..self.f.len() {
+            if self.b[i] > 0.0 {
+                let w0 = -self.speed * self.s[i] / self.b[i];
+                let width = self.speed / self.b[i].sqrt();
+                for d in [
+                    -1.0, -0.3, -0.1, -0.03, -0.01, 0.0, 0.01, 0.03, 0.1, 0.3, 1.0,
+                ] {
+                    let w = w0 + d * width;
+                    if w.abs() < bound {
+                        grid.push(w);
+                    }
+                }
+            }
+            if grid.len() > 20_000 {
+                break;
+            }
+        }
+    }
+
+    /// The steady state a transient starting at `omega` converges to, as
+    /// [`Self::attractor`] of [`Self::steady_states`] but scanning only the
+    /// stretch of the grid from `omega` in the direction ω̇ drives it, up to
+    /// its first sign change (a trajectory needs no other root). None when ω
+    /// runs away.
+    pub fn attractor_from(&self, omega: f64) -> Option<SteadyState> {
+        if self.speed == 0.0 || self.k <= 0.0 {
+            // One root at most: the full search is as cheap.
+            return self.attractor(&self.steady_states(), omega);
+        }
+        let g0 = self.moment(omega);
+        if g0 == 0.0 {
+            return Some(self.classify(omega));
+        }
+        // A root within rounding of ω is the state itself (as in `attractor`).
+        let h = 1e-12 * (1.0 + omega.abs());
+        let (gl, gh) = (self.moment(omega - h), self.moment(omega + h));
+        if (gl > 0.0) != (gh > 0.0) && gl != 0.0 && gh != 0.0 {
+            return Some(self.classify(self.refine(omega - h, omega + h)));
+        }
+        let up = g0 > 0.0;
+        let bound = self.root_bound();
+        // The clustered points ahead, nearest first.
+        let mut extra = Vec::new();
+        self.cluster_points(bound, &mut extra);
+        extra.retain(|&w| if up { w > omega } else { w < omega });
+        extra.sort_by(|a, b| if up { a.total_cmp(b) } else { b.total_cmp(a) });
+        // The uniform points ahead, nearest first.
+        let step = 2.0 * bound / ROOT_GRID as f64;
+        let first = ((omega + bound) / step).floor();
+        let mut j = if up {
+            (first + 1.0).max(0.0)
+        } else {
+            first.min(ROOT_GRID as f64)
+        };
+        let uniform_done = |j: f64| !(0.0..=ROOT_GRID as f64).contains(&j);
+        let mut e = 0;
+        let (mut prev, mut gprev) = (omega, g0);
+        loop {
+            let wu = (!uniform_done(j)).then(|| -bound + step * j);
+            let we = extra.get(e).copied();
+            let w = match (wu, we) {
+                (Some(a), Some(b)) if (a < b) == up => a,
+                (Some(_), Some(b)) | (None, Some(b)) => b,
+                (Some(a), None) => a,
+                (None, None) => return None,
+            };
+            if wu == Some(w) {
+                j += if up { 1.0 } else { -1.0 };
+            } else {
+                e += 1;
+            }
+            if (w > prev) != up || w == prev {
+                continue;
+            }
+            let gw = self.moment(w);
+            if gw == 0.0 {
+                return Some(self.classify(w));
+            }
+            if (gw > 0.0) != (gprev > 0.0) {
+                let (lo, hi) = if up { (prev, w) } else { (w, prev) };
+                return Some(self.classify(self.refine(lo, hi)));
+            }
+            (prev, gprev) = (w, gw);
+        }
     }
 
     fn classify(&self, w: f64) -> SteadyState {

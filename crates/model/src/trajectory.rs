@@ -412,21 +412,21 @@ impl Simulator for DynamicModel {
                 omega_start: omega,
                 ..Default::default()
             };
-            let roots = if push.speed > 0.0 {
-                seg.steady_states()
+            let target = if push.speed > 0.0 {
+                seg.attractor_from(omega)
             } else {
-                Vec::new()
+                None
             };
-            let target = seg.attractor(&roots, omega);
             // For a constant input ω is a scalar autonomous ODE: it moves
-            // monotonically and never passes max(|ω_start|, |roots|). Far
-            // beyond that it is running away (or an integrator is unstable);
-            // stop there instead of grinding on ever shorter steps.
+            // monotonically from ω_start to the root it tends to and never
+            // passes it. Far beyond that it is running away (or an integrator
+            // is unstable); stop there instead of grinding on ever shorter
+            // steps.
             let omega_limit = 1e3
-                * roots
-                    .iter()
-                    .map(|r| r.omega.abs())
-                    .fold(omega.abs().max(push.speed / r_min), f64::max);
+                * target
+                    .map_or(0.0, |r| r.omega.abs())
+                    .max(omega.abs())
+                    .max(push.speed / r_min);
             if push.speed > 0.0 {
                 match target {
                     None if checker.enabled => {
@@ -802,9 +802,9 @@ fn sample_tail(
 ) -> TailPose {
     let mut cursor = TailCursor::new(tail);
     let first = sampler.next;
-    while sampler.due(t1, t1, last).is_some() {
-        sampler.next += 1;
-    }
+    // Every sample `due` would hand out up to t1 (times increase).
+    let (eps, times) = (sampler.eps, &sampler.times[first..]);
+    sampler.next += times.partition_point(|&ts| (last || ts < t1 - eps) && ts <= t1 + eps);
     cursor.fill(&sampler.times[first..sampler.next], pc, out);
     cursor.eval(t1)
 }
