@@ -1,7 +1,9 @@
 //! Work–precision on the 10 s paper trajectory (1 m/s, five segments):
 //! every method's median run time against its error, measured side by side in
-//! one process. Writes `results/work_precision.csv` (and the figure when the
-//! report's plotting is available).
+//! one process. Writes `results/work_precision.csv`, the figure
+//! `results/work_precision.svg`, and `results/work_precision_target.csv`: the
+//! cheapest pushval and ode_solvers Dop853 settings at 1e-9 m maximum
+//! position error, timed alternately and compared.
 //!
 //! `cargo bench --bench work_precision` (add `-- --quick` for fewer repeats).
 //!
@@ -242,8 +244,16 @@ fn main() {
         }
         eprint!(".");
     }
+    let target = target_comparison(
+        &sc,
+        &segs,
+        &problem,
+        &reference,
+        if quick { 21 } else { 61 },
+    );
     if model_only {
         eprintln!();
+        print!("{target}");
         for r in &rows {
             println!(
                 "{:20} {:10} evals {:5} median {:8.2} us  pos err {:.2e}",
@@ -353,10 +363,70 @@ fn main() {
     }
     let dir = root.join("results");
     std::fs::create_dir_all(&dir).unwrap();
+    pushval::output::write_atomic(&dir.join("work_precision_target.csv"), target.as_bytes())
+        .unwrap();
     pushval::output::write_atomic(&dir.join("work_precision.csv"), csv.as_bytes()).unwrap();
     pushval::output::write_atomic(&dir.join("work_precision.svg"), figure(&rows).as_bytes())
         .unwrap();
     print!("{csv}");
+}
+
+/// Maximum position error the speed target is set at (m).
+const TARGET_ERR: f64 = 1e-9;
+
+/// The cheapest setting of pushval's DOP853 and of ode_solvers' Dop853 that
+/// keeps the maximum position error at or below [`TARGET_ERR`], each found
+/// on the same fine tolerance ladder (eight steps per decade, from 1e-5 down:
+/// the first tolerance that meets the target), then timed side by side: runs
+/// alternate between the two, `runs` each, and the medians are compared.
+/// Returns CSV: one row per method, then the ratio.
+fn target_comparison(
+    sc: &Scenario,
+    segs: &[SegmentInfo],
+    problem: &Problem,
+    reference: &Trajectory,
+    runs: usize,
+) -> String {
+    let ours = |tol: f64| {
+        let m = DynamicModel {
+            integrator: Integrator::Dop853 { tol },
+            check_assumptions: false,
+            ..Default::default()
+        };
+        let tr = m.simulate(problem).unwrap();
+        let n = tr.stats.rhs_evals;
+        (tr, n)
+    };
+    let theirs = |tol: f64| peer(problem, tol, true);
+    let ladder: Vec<f64> = (0..=56)
+        .map(|i| 1e-5 * 10f64.powf(-i as f64 / 8.0))
+        .collect();
+    let cheapest = |run: &dyn Fn(f64) -> (Trajectory, usize)| {
+        ladder.iter().find_map(|&tol| {
+            let (tr, n) = run(tol);
+            let (pe, _) = errors(sc, segs, reference, &tr, false);
+            (pe <= TARGET_ERR).then_some((tol, n, pe))
+        })
+    };
+    let a = cheapest(&ours).expect("pushval meets the target on the ladder");
+    let b = cheapest(&theirs).expect("the peer meets the target on the ladder");
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        ta.push(time(1, || ours(a.0)).0);
+        tb.push(time(1, || theirs(b.0)).0);
+    }
+    ta.sort();
+    tb.sort();
+    let (ma, mb) = (ta[runs / 2].as_secs_f64(), tb[runs / 2].as_secs_f64());
+    let mut out =
+        String::from("target_position_err_m,method,tol,rhs_evals,position_err_m,median_s\n");
+    for (name, (tol, n, pe), m) in [("pushval DOP853", a, ma), ("ode_solvers Dop853", b, mb)] {
+        out.push_str(&format!(
+            "{TARGET_ERR:e},{name},{tol:.3e},{n},{pe:.3e},{m:.6e}\n"
+        ));
+    }
+    out.push_str(&format!("# speed-up at the target: {:.2}x\n", mb / ma));
+    out
 }
 
 /// Log–log work–precision figure: error against median run time, one line per
