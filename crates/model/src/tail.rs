@@ -183,8 +183,11 @@ impl SettleRule {
             speed: seg.speed(),
             tol,
         };
+        // As many terms as the hand-over check in `tail` asks for at the
+        // segment's start (there with the actual ξ, here with the bound
+        // 1.25 |δ₀| on it); that check decides, so this only sets the work.
         let reach = 1.25 * (w_start - omega).abs();
-        (rule.a, rule.order) = linearising_map(&g, reach, 0.1 * rule.allowed(duration));
+        (rule.a, rule.order) = linearising_map(&g, reach, rule.allowed(duration));
         rule.a.iter().all(|v| v.is_finite()).then_some(rule)
     }
 
