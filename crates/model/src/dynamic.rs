@@ -491,8 +491,7 @@ impl SegmentDynamics {
     /// its first sign change (a trajectory needs no other root). None when ω
     /// runs away.
     pub fn attractor_from(&self, omega: f64) -> Option<SteadyState> {
-        if self.speed == 0.0 || self.k <= 0.0 {
-            // One root at most: the full search is as cheap.
+        if self.speed == 0.0 {
             return self.attractor(&self.steady_states(), omega);
         }
         let g0 = self.moment(omega);
@@ -506,6 +505,33 @@ impl SegmentDynamics {
             return Some(self.classify(self.refine(omega - h, omega + h)));
         }
         let up = g0 > 0.0;
+        if self.k <= 0.0 {
+            // G is monotone: its one root lies ahead. Steps from ω growing
+            // by doubling from a tenth of v/r_min bracket it; past 2⁶⁰ times
+            // that scale there is none (the full scan's bound stops sooner).
+            let rmin = self
+                .b
+                .iter()
+                .fold(f64::INFINITY, |a, &b| if b > 0.0 { a.min(b) } else { a })
+                .sqrt();
+            let mut h = 0.1 * self.speed / rmin.max(1e-300);
+            let dir = if up { 1.0 } else { -1.0 };
+            let mut prev = omega;
+            for _ in 0..64 {
+                let w = omega + dir * h;
+                let gw = self.moment(w);
+                if gw == 0.0 {
+                    return Some(self.classify(w));
+                }
+                if (gw > 0.0) != up {
+                    let (lo, hi) = if up { (prev, w) } else { (w, prev) };
+                    return Some(self.classify(self.refine(lo, hi)));
+                }
+                prev = w;
+                h *= 2.0;
+            }
+            return None;
+        }
         let bound = self.root_bound();
         // The clustered points ahead, nearest first.
         let mut extra = Vec::new();
@@ -590,14 +616,22 @@ impl SegmentDynamics {
         }
     }
 
-    /// Bracketed root refinement: Illinois-modified regula falsi, falling back to
-    /// bisection, to machine precision. `g(lo)` and `g(hi)` have opposite signs.
+    /// Bracketed root refinement to machine precision: regula falsi with the
+    /// Anderson–Björck scaling of the retained end (superlinear), and a
+    /// bisection whenever three steps in a row have not halved the bracket.
+    /// Stops when the bracket is a few ulps wide or `|G|` is down to its
+    /// rounding floor (a few ε times the moments summed): near ω* = 0 the
+    /// bracket's relative width never gets there. `g(lo)` and `g(hi)` have
+    /// opposite signs.
     fn refine(&self, mut lo: f64, mut hi: f64) -> f64 {
         let g = |w: f64| self.moment(w);
         let (mut glo, mut ghi) = (g(lo), g(hi));
         let mut side = 0i8;
-        for it in 0..200 {
-            let mut w = if it % 4 == 3 {
+        let mut width = (hi - lo).abs();
+        let mut slow = 0;
+        for _ in 0..200 {
+            let mut w = if slow >= 3 {
+                slow = 0;
                 0.5 * (lo + hi)
             } else {
                 (lo * ghi - hi * glo) / (ghi - glo)
@@ -606,27 +640,38 @@ impl SegmentDynamics {
                 w = 0.5 * (lo + hi);
             }
             let gw = g(w);
-            if gw == 0.0 {
+            // |G| at its rounding floor: no point in the bracket is closer.
+            if gw.abs() <= 4.0 * f64::EPSILON * (self.max_moment + (self.k * w).abs()) {
                 return w;
             }
             if gw.signum() == glo.signum() {
+                // The hi end is kept: scale its value (Anderson–Björck).
+                if side == -1 {
+                    let m = 1.0 - gw / glo;
+                    ghi *= if m > 0.0 { m } else { 0.5 };
+                }
                 lo = w;
                 glo = gw;
-                if side == -1 {
-                    ghi *= 0.5;
-                }
                 side = -1;
             } else {
+                if side == 1 {
+                    let m = 1.0 - gw / ghi;
+                    glo *= if m > 0.0 { m } else { 0.5 };
+                }
                 hi = w;
                 ghi = gw;
-                if side == 1 {
-                    glo *= 0.5;
-                }
                 side = 1;
             }
-            if (hi - lo).abs() <= 4.0 * f64::EPSILON * lo.abs().max(hi.abs()) + 1e-300 {
+            let new_width = (hi - lo).abs();
+            if new_width <= 4.0 * f64::EPSILON * lo.abs().max(hi.abs()) + 1e-300 {
                 break;
             }
+            if new_width > 0.5 * width {
+                slow += 1;
+            } else {
+                slow = 0;
+            }
+            width = new_width;
         }
         if glo.abs() < ghi.abs() {
             lo
@@ -746,6 +791,41 @@ mod tests {
                     "n {n}, ω {omega}: {got} against {want}"
                 );
             }
+        }
+    }
+
+    /// A push through the centre of a support set that is mirror-symmetric
+    /// about the push line has its steady state at ω = 0 (the mirror image
+    /// of a turning motion turns the other way), from either side and
+    /// whether the search is the full scan or the directed one. There `G`
+    /// is rounding noise, so the search stops on `|G|` at its rounding floor
+    /// (waiting for the bracket to shrink relative to |ω| spent the whole
+    /// iteration budget); this checks that stop lands at zero.
+    #[test]
+    fn a_symmetric_push_settles_at_zero_rate() {
+        let sup: Vec<Support> = [(0.1, 0.1), (0.1, -0.1), (-0.1, 0.1), (-0.1, -0.1)]
+            .iter()
+            .map(|&(x, y)| Support {
+                position: Vec2::new(x, y),
+                friction: 0.5,
+            })
+            .collect();
+        // Contact on the x axis, pushed along +x: the mirror is y → −y.
+        let b = Body::new(1.0, 0.01, Vec2::new(-0.1, 0.0), &sup).unwrap();
+        let push = Push {
+            duration: 1.0,
+            speed: 0.3,
+            phi: 0.0,
+        };
+        let seg = SegmentDynamics::new(&b, &push);
+        let scale = push.speed / 0.1;
+        let roots = seg.steady_states();
+        assert_eq!(roots.len(), 1, "{roots:?}");
+        assert!(roots[0].omega.abs() <= 1e-14 * scale, "{roots:?}");
+        for w in [-2.0, -0.3, 0.3, 2.0] {
+            let r = seg.attractor_from(w).expect("a stable root");
+            assert!(r.omega.abs() <= 1e-14 * scale, "from {w}: {r:?}");
+            assert_eq!(r.kind, RootKind::Stable);
         }
     }
 

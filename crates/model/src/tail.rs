@@ -495,23 +495,28 @@ impl TailCursor {
         // samples do not wait on each other.
         let mut pows: Option<StepPowers> = None;
         // Usually all of `times` is evenly spaced: one check for the lot
-        // (a fold without early exit or NaN rules, so it vectorises);
-        // otherwise per block.
+        // (eight at a time against a table of offsets, without early exit
+        // or NaN rules, so it vectorises); otherwise per block.
         let spacing = |ts: &[f64]| {
             let dt = if ts.len() > 1 { ts[1] - ts[0] } else { 0.0 };
             let tol = 1e-9 * dt;
-            let ok = ts.iter().enumerate().fold(true, |ok, (j, &t)| {
-                ok & (((t - ts[0]) - j as f64 * dt).abs() <= tol)
-            });
+            let off: [f64; 8] = std::array::from_fn(|l| l as f64 * dt);
+            let mut ok = true;
+            for (c, chunk) in ts.chunks(8).enumerate() {
+                let base = (8 * c) as f64 * dt + ts[0];
+                for (t, o) in chunk.iter().zip(&off) {
+                    ok &= ((t - base) - o).abs() <= tol;
+                }
+            }
             (ts.len() > 1 && ok).then_some(dt)
         };
         let all_even = spacing(times);
         let mut nb = n;
-        // Written in place: a block assembled on the stack and then copied
-        // would be read back before its narrow stores retire.
-        let base = out.len();
-        out.resize(base + times.len(), crate::Sample::default());
-        for (block, dst) in times.chunks(BLOCK).zip(out[base..].chunks_mut(BLOCK)) {
+        // Pushed one by one: a block assembled on the stack and then copied
+        // would be read back before its narrow stores retire, and writing
+        // in place would first need the whole output zeroed.
+        out.reserve(times.len());
+        for block in times.chunks(BLOCK) {
             let len = block.len();
             self.advance(block[0]);
             (s[0], p[0], e[0]) = (self.s, self.p, self.e);
@@ -608,14 +613,14 @@ impl TailCursor {
                     (xs[j], ys[j]) = (q.re, q.im);
                 }
             }
-            for (j, (smp, &t)) in dst.iter_mut().zip(block).enumerate() {
-                *smp = crate::Sample {
+            for (j, &t) in block.iter().enumerate() {
+                out.push(crate::Sample {
                     t,
                     x: xs[j],
                     y: ys[j],
                     theta: theta0 + tl.omega * s[j] - ba[j],
                     omega: tl.omega + wa[j],
-                };
+                });
             }
         }
     }
