@@ -68,10 +68,8 @@ pub(crate) fn linearising_map(
     let tau = -1.0 / g[1];
     let mut a = [0.0; ORDER + 1];
     a[1] = 1.0;
-    // pw[k][j] = [h^j]_k, zero for j > k. For one k the powers are
-    // independent of each other, so the innermost loop runs over j (no
-    // serial sum), in chunks of four over the zero padding: fixed-length
-    // loops with no remainder to handle.
+    // pw[k][j] = [h^j]_k, zero for j > k (rows padded with zeros, so chunks
+    // of four need no remainder).
     const ROW: usize = ORDER + 4;
     let mut pw = [[0.0; ROW]; ORDER + 1];
     pw[1][1] = 1.0;
@@ -79,18 +77,19 @@ pub(crate) fn linearising_map(
     for k in 2..=ORDER {
         let (lo, hi) = pw.split_at_mut(k);
         let dst = &mut hi[0];
-        for i in 1..k {
-            let ai = a[i];
-            let src = &lo[k - i];
-            let mut o = 0;
-            while o < k - i {
-                let d: &mut [f64; 4] = (&mut dst[o + 2..o + 6]).try_into().expect("in the row");
-                let s: &[f64; 4] = (&src[o + 1..o + 5]).try_into().expect("in the row");
+        // [h^j]_k = Σ_i a_i [h^{j−1}]_{k−i}, four j at a time held in
+        // registers over i (the terms with i ≥ k − j + 2 are zero).
+        let mut o = 0;
+        while o + 1 < k {
+            let mut acc = [0.0; 4];
+            for i in 1..k - o {
+                let s: &[f64; 4] = (&lo[k - i][o + 1..o + 5]).try_into().expect("in the row");
                 for l in 0..4 {
-                    d[l] += ai * s[l];
+                    acc[l] += a[i] * s[l];
                 }
-                o += 4;
             }
+            dst[o + 2..o + 6].copy_from_slice(&acc);
+            o += 4;
         }
         // Σ_j g_j [h^j]_k in four partial sums (the row is zero past k).
         let mut part = [0.0; 4];
@@ -360,9 +359,8 @@ impl TailCursor {
             .map_or(0, |k| k + 1);
         let beta: [f64; ORDER] = std::array::from_fn(|k| tail.alpha[k] * tau / (k + 1) as f64);
         let eps_inf: f64 = beta[..n].iter().rev().sum();
-        let (s0, c0) = tail.theta.sin_cos();
-        let (si, ci) = eps_inf.sin_cos();
-        let rot_inf = C::new(c0, s0) * C::new(ci, si);
+        let (s0, c0) = (tail.theta + eps_inf).sin_cos();
+        let rot_inf = C::new(c0, s0);
         let v = C::new(tail.vel.x, tail.vel.y);
         let w = v * rot_inf;
         // e^{−i b(E)} = Σ γ_m E^m: with f = e^u, m γ_m = Σ_k k u_k γ_{m−k},
@@ -375,18 +373,19 @@ impl TailCursor {
         let n_alpha = n;
         let n = if n == 0 { 0 } else { ORDER };
         for m in 1..=n {
-            // Two partial sums in registers: half the serial chain.
-            let (mut a0, mut a1) = (C::new(0.0, 0.0), C::new(0.0, 0.0));
+            // Four partial sums in registers: a quarter of the serial chain.
+            let mut acc4 = [C::new(0.0, 0.0); 4];
             let mut k = 1;
-            while k < m {
-                a0 += gamma[m - k] * ta[k - 1];
-                a1 += gamma[m - k - 1] * ta[k];
-                k += 2;
+            while k + 3 <= m {
+                for (l, a) in acc4.iter_mut().enumerate() {
+                    *a += gamma[m - k - l] * ta[k + l - 1];
+                }
+                k += 4;
             }
-            if k == m {
-                a0 += gamma[0] * ta[m - 1];
+            for (l, a) in acc4.iter_mut().enumerate().take(m + 1 - k) {
+                *a += gamma[m - k - l] * ta[k + l - 1];
             }
-            let acc = a0 + a1;
+            let acc = (acc4[0] + acc4[1]) + (acc4[2] + acc4[3]);
             gamma[m] = C::new(acc.im, -acc.re) * (1.0 / m as f64);
         }
         let n = (n_alpha..=n)
@@ -538,6 +537,8 @@ impl TailCursor {
                         pp[j] = pp[j - 1] * ps;
                         ep[j] = ep[j - 1] * es;
                     }
+                    // The step between blocks is the same one.
+                    (self.step, self.p_step, self.e_step) = (dt, ps, es);
                     pows = Some(StepPowers {
                         dt,
                         s: std::array::from_fn(|j| j as f64 * dt),
