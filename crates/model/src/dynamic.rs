@@ -439,6 +439,16 @@ impl SegmentDynamics {
         roots.into_iter().map(|w| self.classify(w)).collect()
     }
 
+    /// The distance from the contact point to the nearest support not under
+    /// it, `min √b_i` over `b_i = |r_i|² > 0` (m; infinite when there is
+    /// none).
+    fn r_min(&self) -> f64 {
+        self.b
+            .iter()
+            .fold(f64::INFINITY, |a, &b| if b > 0.0 { a.min(b) } else { a })
+            .sqrt()
+    }
+
     /// A bound on |ω| of every steady state (rad/s). With `k > 0` the friction
     /// moment is at most M, so |k ω*| ≤ M; with k ≤ 0 the root sits where the
     /// friction moment changes sign, within a few v/r.
@@ -447,13 +457,8 @@ impl SegmentDynamics {
         if self.k > 0.0 {
             return self.max_moment / self.k * (1.0 + 1e-9) + 1e-300;
         }
-        let rmin = self
-            .b
-            .iter()
-            .fold(f64::INFINITY, |a, &b| if b > 0.0 { a.min(b) } else { a })
-            .sqrt();
         // Expand until the sign changes (G decreasing: G(+∞) < 0 < G(−∞)).
-        let mut w = self.speed / rmin.max(1e-300);
+        let mut w = self.speed / self.r_min().max(1e-300);
         for _ in 0..200 {
             if g(w) < 0.0 && g(-w) > 0.0 {
                 break;
@@ -509,12 +514,7 @@ impl SegmentDynamics {
             // G is monotone: its one root lies ahead. Steps from ω growing
             // by doubling from a tenth of v/r_min bracket it; past 2⁶⁰ times
             // that scale there is none (the full scan's bound stops sooner).
-            let rmin = self
-                .b
-                .iter()
-                .fold(f64::INFINITY, |a, &b| if b > 0.0 { a.min(b) } else { a })
-                .sqrt();
-            let mut h = 0.1 * self.speed / rmin.max(1e-300);
+            let mut h = 0.1 * self.speed / self.r_min().max(1e-300);
             let dir = if up { 1.0 } else { -1.0 };
             let mut prev = omega;
             for _ in 0..64 {

@@ -327,7 +327,7 @@ pub(crate) struct TailCursor {
     /// `γ_1 … γ_n` of `e^{−i b(E)} = Σ γ_m E^m` (index `m − 1`).
     gamma: [C; ORDER],
     /// Size of the k-th terms of ω and the angle at `E = 1`, as angles
-    /// (rad): the larger of `|α_k| τ` and `|β_k|`.
+    /// (rad): `|α_k| τ` (the angle's `|β_k| = |α_k| τ/k` is no larger).
     mag: [f64; ORDER],
     /// `ε∞` (rad).
     eps_inf: f64,
@@ -405,7 +405,7 @@ impl TailCursor {
             kappa[m - 1] = w * gamma[m] * z * inv_z2[m - 1];
             sum_kappa += kappa[m - 1];
         }
-        let mag = std::array::from_fn(|k| ta[k].abs().max(beta[k].abs()));
+        let mag = ta.map(f64::abs);
         Self {
             tail,
             n,
