@@ -26,7 +26,7 @@ use pushval_model::{
     DynamicModel, Integrator, Problem, Rotor, SegmentDynamics, Simulator, Switching, Trajectory,
     Vec2,
 };
-use pushval_rapier::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
+use pushval_rapier2d::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
 use pushval_scenario::Scenario;
 
 struct Row {

@@ -5,7 +5,9 @@
 pub mod harness;
 pub mod output;
 pub mod outside;
+pub mod registry;
 pub mod report;
 pub mod stress;
 
 pub use harness::{run_scenario, Comparison, ModelRun, RunOptions, ScenarioReport, SegmentInfo};
+pub use registry::engines_table;

@@ -71,6 +71,9 @@ enum Command {
         #[arg(long)]
         merge: bool,
     },
+    /// List every engine model: crate, engine version, order, whether it can
+    /// be gated and whether this build has it.
+    Engines,
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
         file: PathBuf,
@@ -105,7 +108,7 @@ fn default_scenarios() -> anyhow::Result<Vec<PathBuf>> {
 fn load_all(files: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
     files
         .iter()
-        .map(|f| Scenario::from_path(f).map_err(anyhow::Error::from))
+        .map(|f| pushval::registry::load(f).map_err(anyhow::Error::from))
         .collect()
 }
 
@@ -159,7 +162,7 @@ fn validate(
 }
 
 fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
-    let sc = Scenario::from_path(&file)?;
+    let sc = pushval::registry::load(&file)?;
     let report = run_scenario(&sc, &RunOptions::default())
         .with_context(|| format!("{}: running the models", file.display()))?;
     let summary = serde_json::to_string_pretty(&output::summary(&report))?;
@@ -181,7 +184,7 @@ fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
 }
 
 fn compare(file: PathBuf, csv: PathBuf) -> anyhow::Result<ExitCode> {
-    let sc = Scenario::from_path(&file)?;
+    let sc = pushval::registry::load(&file)?;
     let outside = pushval::outside::read_csv(&csv)?;
     let (mut report, comparisons) = pushval::outside::compare_outside(&sc, &outside, &csv)?;
     report.comparisons = comparisons;
@@ -227,6 +230,10 @@ fn main() -> ExitCode {
         None => validate(Vec::new(), false, None),
         Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Engines) => {
+            print!("{}", pushval::engines_table());
+            Ok(ExitCode::SUCCESS)
+        }
         Some(Command::Compare { file, trajectory }) => compare(file, trajectory),
         Some(Command::Stress { out, quick }) => stress(out, quick),
         Some(Command::Report {

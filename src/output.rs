@@ -86,7 +86,7 @@ pub fn summary(report: &ScenarioReport) -> Value {
         .collect();
     let mut models = serde_json::Map::new();
     for c in &report.comparisons {
-        let run = report.runs.iter().find(|r| r.kind.name() == c.model);
+        let run = report.runs.iter().find(|r| r.name == c.model);
         models.insert(
             c.model.clone(),
             json!({
@@ -185,12 +185,7 @@ pub fn trajectory_csv(report: &ScenarioReport) -> String {
             // Samples are finite: the models return an error on a blow-up.
             s.push_str(&format!(
                 "{},{},{},{},{},{}\n",
-                r.kind.name(),
-                p.t,
-                p.x,
-                p.y,
-                p.theta,
-                p.omega
+                r.name, p.t, p.x, p.y, p.theta, p.omega
             ));
         }
     }
@@ -311,7 +306,7 @@ pub fn junit(reports: &[ScenarioReport]) -> String {
             let time = r
                 .runs
                 .iter()
-                .find(|run| run.kind.name() == c.model)
+                .find(|run| run.name == c.model)
                 .map_or(0.0, |run| run.elapsed.as_secs_f64());
             body.push_str(&format!(
                 "    <testcase classname=\"pushval.{name}\" name=\"{}\" time=\"{time:.6}\">\n",

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context};
 use pushval_model::{Sample, Trajectory};
-use pushval_scenario::{ModelKind, Scenario};
+use pushval_scenario::Scenario;
 
 use crate::harness::{
     compare_trajectory, run_scenario, Comparison, RunOptions, ScenarioReport, SteadyRead,
@@ -116,7 +116,10 @@ pub fn compare_outside(
     if !(sc.sample_dt > 0.0) {
         bail!("{}: t must increase", file.display());
     }
-    sc.models = vec![ModelKind::Dynamic, ModelKind::Rapier2d];
+    // The dynamic model and the scenario's gated engines.
+    sc.models = std::iter::once("dynamic".to_string())
+        .chain(sc.gate.iter().cloned())
+        .collect();
     let report = run_scenario(&sc, &RunOptions::default()).context("running the models")?;
     let times = sc.problem().sample_times();
     let mut out = Vec::new();
@@ -151,7 +154,7 @@ pub fn compare_outside(
                 SteadyRead::TailMean,
                 true,
             );
-            c.model = format!("{name} vs {}", run.kind.name());
+            c.model = format!("{name} vs {}", run.name);
             out.push(c);
         }
     }

@@ -36,12 +36,13 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Context;
+use pushval_engine::EngineOptions;
 use pushval_model::{
     DynamicModel, Initial, Integrator, ModelError, Problem, Push, SegmentDynamics, Simulator,
     Support, Switching, Trajectory, Vec2,
 };
-use pushval_rapier::{EngineSettings, RapierSimulator};
 use pushval_scenario::Tolerance;
+use pushval_scenario::DEFAULT_GATE;
 use rayon::prelude::*;
 
 use crate::harness::{rel_err, tail_omega};
@@ -60,18 +61,18 @@ pub enum Solver {
     Adaptive,
     /// The dynamic model, classical RK4 at the case's dt, integrating to the end.
     Rk4,
-    /// rapier2d (f64, default friction velocity) at the case's dt.
+    /// The default gated engine (its default settings) at the case's dt.
     Engine,
 }
 
 impl Solver {
     pub const ALL: [Solver; 3] = [Solver::Adaptive, Solver::Rk4, Solver::Engine];
-    /// `"adaptive"`, `"rk4"` or `"rapier2d"`.
+    /// `"adaptive"`, `"rk4"` or the default gated engine's name.
     pub fn name(self) -> &'static str {
         match self {
             Solver::Adaptive => "adaptive",
             Solver::Rk4 => "rk4",
-            Solver::Engine => "rapier2d",
+            Solver::Engine => DEFAULT_GATE[0],
         }
     }
 }
@@ -325,24 +326,21 @@ pub fn run_case(case: &Case) -> Outcome {
             }
         }
         Solver::Engine => {
-            let settings = EngineSettings {
-                dt: case.dt,
-                ..Default::default()
-            };
-            match RapierSimulator::new(settings).run(&problem) {
+            let engine = crate::registry::engine(DEFAULT_GATE[0], &EngineOptions::default());
+            match engine.run(&problem, case.dt) {
                 Err(e) => Err(blowup_of(&e)),
                 Ok(run) => match run
-                    .history
+                    .trajectory
+                    .samples
                     .iter()
-                    .enumerate()
-                    .find(|(_, r)| r.omega.abs() > bound)
+                    .find(|s| s.omega.abs() > bound)
                 {
-                    Some((k, r)) => Err(BlowUp {
-                        t: r.t1,
-                        step: k,
+                    Some(s) => Err(BlowUp {
+                        t: s.t,
+                        step: (s.t / case.dt - 1e-9).ceil().max(1.0) as usize,
                         what: format!(
                             "|omega| = {:.3e} rad/s passed the bound {bound:.3e} rad/s",
-                            r.omega.abs()
+                            s.omega.abs()
                         ),
                     }),
                     None => Ok(run.trajectory),

@@ -8,13 +8,12 @@ use anyhow::Context;
 use pushval_model::{
     DynamicModel, KinematicModel, Problem, SegmentDynamics, Simulator, Switching, Trajectory,
 };
-use pushval_rapier::RapierSimulator;
 use pushval_scenario::Scenario;
 use rayon::prelude::*;
 
 use super::plot::{Axis, Figure, Legend, Panel, Series, Stroke, BLUE_, DARK, GREEN_, ORANGE, RED_};
 use super::{num, num10, Csv, Entry, Writer};
-use crate::harness::engine_settings;
+use crate::harness::reference_engine;
 
 /// The pusher speeds of the paper's ω(t) figure (m/s).
 pub const SPEEDS: [f64; 5] = [0.2, 0.4, 0.6, 0.8, 1.0];
@@ -48,9 +47,11 @@ fn run_problem(sc: &Scenario, problem: &Problem) -> anyhow::Result<Runs> {
     let kinematic = KinematicModel
         .simulate(problem)
         .with_context(|| format!("{}: kinematic model", sc.name))?;
-    let engine = RapierSimulator::new(engine_settings(sc))
-        .simulate(problem)
-        .with_context(|| format!("{}: rapier2d", sc.name))?;
+    let e = reference_engine(sc);
+    let engine = e
+        .run(problem, e.default_dt())
+        .with_context(|| format!("{}: {}", sc.name, e.name()))?
+        .trajectory;
     Ok(Runs {
         dynamic,
         kinematic,
@@ -653,9 +654,12 @@ fn switching_figure(base: &Scenario, w: &mut Writer) -> anyhow::Result<Entry> {
     let (r_imp, r_con, r_eng) = (
         model.simulate(&impulsive).context("dynamic, impulsive")?,
         model.simulate(&continuous).context("dynamic, continuous")?,
-        RapierSimulator::new(engine_settings(&sc))
-            .simulate(&impulsive)
-            .context("rapier2d")?,
+        {
+            let e = reference_engine(&sc);
+            e.run(&impulsive, e.default_dt())
+                .with_context(|| e.name())?
+                .trajectory
+        },
     );
     let windows = [(1.95, 2.25), (5.95, 6.25)];
     let mut csv = Csv::new(&header(&["switching", "model"]));

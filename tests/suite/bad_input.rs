@@ -3,7 +3,6 @@
 
 use std::path::Path;
 
-use pushval_scenario::Scenario;
 use rstest::rstest;
 
 /// A valid scenario; each case below replaces one line or appends one.
@@ -30,7 +29,7 @@ fn edit(from: &str, to: &str) -> String {
 
 #[test]
 fn the_base_file_is_valid() {
-    Scenario::from_toml(GOOD, Path::new("good.toml")).unwrap();
+    pushval::registry::from_toml(GOOD, Path::new("good.toml")).unwrap();
 }
 
 // Columns: the file text, the key the error must name, a fragment of its message.
@@ -182,7 +181,8 @@ fn bad_input_is_refused_with_key_and_reason(
     #[case] key: &str,
     #[case] fragment: &str,
 ) {
-    let e = Scenario::from_toml(&text, Path::new("bad.toml")).expect_err("must be refused");
+    let e =
+        pushval::registry::from_toml(&text, Path::new("bad.toml")).expect_err("must be refused");
     let msg = e.to_string();
     assert!(msg.starts_with("bad.toml: "), "{msg}");
     assert_eq!(e.key, key, "{msg}");

@@ -91,7 +91,7 @@ pub fn root() -> PathBuf {
 }
 
 pub fn load(p: &Path) -> Scenario {
-    Scenario::from_path(p).unwrap_or_else(|e| panic!("{e}"))
+    pushval::registry::load(p).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The paper plate with one heavily loaded corner (−a, a) on the line through

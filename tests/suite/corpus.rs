@@ -10,7 +10,6 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use proptest::prelude::*;
-use pushval_scenario::Scenario;
 
 use crate::common::root;
 
@@ -53,7 +52,7 @@ fn every_bad_file_is_refused_by_the_loader_with_its_key_and_fragment() {
     let mut wrong = Vec::new();
     for f in corpus() {
         let (key, frag) = expectation(&f);
-        match Scenario::from_path(&f) {
+        match pushval::registry::load(&f) {
             Ok(_) => wrong.push(format!("{}: accepted", f.display())),
             Err(e) => {
                 if e.key != key || !e.message.contains(&frag) || e.file != f {
@@ -243,7 +242,7 @@ const TOKENS: &[&str] = &[
 
 fn load_never_panics(text: &str) {
     // Ok or a ScenarioError; a valid scene must also build its problem.
-    if let Ok(sc) = Scenario::from_toml(text, Path::new("fuzz.toml")) {
+    if let Ok(sc) = pushval::registry::from_toml(text, Path::new("fuzz.toml")) {
         let p = sc.problem();
         assert!(p.check().is_ok());
     }

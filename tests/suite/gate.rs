@@ -7,8 +7,8 @@ use pushval::harness::{
     analyse_segments_with, compare, dt_ladder, run_scenario, ModelRun, RunOptions, DT_FRACTION,
 };
 use pushval_model::{DynamicModel, InertialTerm, Problem, Simulator, Switching, Trajectory};
-use pushval_rapier::{tail_mean_omega, EngineSettings, RapierSimulator};
-use pushval_scenario::{ModelKind, Scenario};
+use pushval_rapier2d::{tail_mean_omega, EngineSettings, RapierSimulator};
+use pushval_scenario::Scenario;
 use rstest::rstest;
 
 use crate::common::*;
@@ -20,7 +20,7 @@ fn engine(sc: &Scenario) -> ModelRun {
         .unwrap()
         .runs
         .into_iter()
-        .find(|r| r.kind == ModelKind::Rapier2d)
+        .find(|r| r.name == "rapier2d")
         .unwrap()
 }
 
@@ -90,7 +90,7 @@ fn engine_converges_at_its_order_and_extrapolates_to_the_root(
     if let Some(m) = mode {
         text.push_str(&format!("\n[engine]\nfriction_velocity = \"{m}\"\n"));
     }
-    let sc = Scenario::from_toml(&text, &path).unwrap();
+    let sc = pushval::registry::from_toml(&text, &path).unwrap();
     let report = run_scenario(&sc, &RunOptions::default()).unwrap();
     let c = report
         .comparisons
@@ -131,11 +131,7 @@ fn engine_meets_steady_target(#[files("scenarios/*.toml")] path: PathBuf) {
     if let Some(e) = c.omega_steady_rel_max {
         assert!(e <= 1e-4, "steady-ω error {e:e}");
     }
-    let run = report
-        .runs
-        .iter()
-        .find(|r| r.kind == ModelKind::Rapier2d)
-        .unwrap();
+    let run = report.runs.iter().find(|r| r.name == "rapier2d").unwrap();
     assert_eq!(run.settings["dt"], 1e-3);
     assert_eq!(run.settings["dt_source"], "scenario");
 }
@@ -186,11 +182,7 @@ fn automatic_dt_is_the_largest_rung_that_meets_its_criterion(
     let sc = load(&path);
     assert_eq!(sc.engine.dt, None, "shipped scenarios leave dt automatic");
     let report = run_scenario(&sc, &RunOptions::default()).unwrap();
-    let run = report
-        .runs
-        .iter()
-        .find(|r| r.kind == ModelKind::Rapier2d)
-        .unwrap();
+    let run = report.runs.iter().find(|r| r.name == "rapier2d").unwrap();
     assert_eq!(run.settings["dt_source"], "automatic");
     assert_eq!(run.settings["dt_choice"]["met"], true);
     let h = run.settings["dt"].as_f64().unwrap();
@@ -241,13 +233,9 @@ fn automatic_dt_is_the_largest_rung_that_meets_its_criterion(
 fn fixed_dt_is_kept() {
     let path = root().join("scenarios/paper-square-v1.0.toml");
     let text = std::fs::read_to_string(&path).unwrap() + "\n[engine]\ndt = 0.002\n";
-    let sc = Scenario::from_toml(&text, &path).unwrap();
+    let sc = pushval::registry::from_toml(&text, &path).unwrap();
     let report = run_scenario(&sc, &RunOptions::default()).unwrap();
-    let run = report
-        .runs
-        .iter()
-        .find(|r| r.kind == ModelKind::Rapier2d)
-        .unwrap();
+    let run = report.runs.iter().find(|r| r.name == "rapier2d").unwrap();
     assert_eq!(run.settings["dt"], 0.002);
     assert_eq!(run.settings["dt_source"], "scenario");
     assert_eq!(

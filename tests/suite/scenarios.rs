@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use approx::assert_relative_eq;
 use pushval::{output, run_scenario, RunOptions};
 use pushval_model::{DynamicModel, Simulator};
-use pushval_rapier::{EngineSettings, RapierSimulator};
+use pushval_rapier2d::{EngineSettings, RapierSimulator};
 use rstest::rstest;
 
 use crate::common::*;
@@ -227,7 +227,7 @@ fn scenario_engine_colliders_change_nothing(#[files("scenarios/*.toml")] path: P
         .iter()
         .map(|p| [p.x - sc.center_of_mass.x, p.y - sc.center_of_mass.y])
         .collect();
-    let settings = pushval::harness::engine_settings(&sc);
+    let settings = pushval_rapier2d::engine::settings_from(&sc.engine).unwrap();
     let a = RapierSimulator::new(settings).run(&problem).unwrap();
     let b = RapierSimulator::new(EngineSettings {
         colliders: true,

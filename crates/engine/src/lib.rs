@@ -1,387 +1,125 @@
-//! The pushing problem of `pushval-model`, run in the rapier2d physics engine.
+//! The engine plug-in interface of pushval.
 //!
-//! This is the only crate of the workspace that imports rapier. It builds, for a
-//! [`Problem`], a rapier world seen from above (gravity zero) with two bodies:
+//! Every physics engine pushval runs (rapier2d, rapier3d, MuJoCo, …) lives in
+//! its own crate and implements [`Engine`] for each of its models (an engine
+//! and a friction mode, e.g. `rapier3d_simplified`). The crate exports one
+//! function returning its [`ModelEntry`] rows (name and constructor); the
+//! command line's registry lists those functions, one line per engine crate.
+//! The harness, the time-step ladder, the convergence check, `compare`,
+//! `report`, `stress`, the studies and the benches use engines only through
+//! this trait, so none of them names an engine.
 //!
-//! * the **object**, a dynamic body whose mass and inertia about its centre of
-//!   mass are set directly (it has no collider by default: nothing collides,
-//!   so rapier's broad and narrow phases have nothing to do; see
-//!   [`EngineSettings::colliders`] for the scene with colliders);
-//! * the **pusher**, a kinematic velocity-based body pinned to the object at the
-//!   contact point by a revolute impulse joint. Every step its velocity is set to
-//!   the commanded contact velocity `v_c R(θ) n_φ` (taken at a mode-dependent
-//!   angle and, in the default [`FrictionVelocity::Leapfrog`] mode, corrected
-//!   for rapier's step-start lever arm), so the engine's joint solver
-//!   prescribes the contact velocity and produces, by itself, the contact
-//!   force and the impulses at switches.
+//! It also holds the one resampler every adapter shares ([`resample`]):
+//! engine steps in, samples at the problem's sample times out.
 //!
-//! Every step, each support point `i` receives the Coulomb force
-//! `−F_i u_i / |u_i|` through `add_force_at_point`, where `u_i` is the support's
-//! sliding velocity, obtained in one of the ways of [`FrictionVelocity`].
-//!
-//! The engine runs in f64 (`rapier2d-f64`, the default) or f32 (`rapier2d`),
-//! chosen at run time by [`EngineSettings::precision`]; one source file
-//! (`world.rs`) is compiled once for each precision.
-//!
-//! Units are SI throughout (m, s, rad, kg, N).
+//! What it is not: an engine (it depends on none), or the analytic model
+//! (that is `pushval-model`).
+#![warn(missing_docs)]
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use pushval_model::{ModelError, Problem, Simulator, Trajectory};
+use pushval_model::{ModelError, Problem, Trajectory};
 
-/// The f32 build of the engine adapter (`rapier2d`).
-mod f32_engine;
-/// The f64 build of the engine adapter (`rapier2d-f64`).
-mod f64_engine;
-mod history;
-pub mod idioms;
+mod options;
+mod resample;
 
-pub use history::StepRecord;
-pub use idioms::FrictionModel;
+pub use options::{EngineOptions, OptionError};
+pub use resample::{
+    resample, sample, segment_reports, step_tail_omega, tail_mean_omega, trajectory_from_steps,
+    StepRecord,
+};
 
-/// Floating-point precision of the rapier build that runs the problem.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum Precision {
-    /// `rapier2d-f64` (default).
-    #[default]
-    F64,
-    /// `rapier2d` (single precision).
-    F32,
-}
-
-impl Precision {
-    /// `"f64"` or `"f32"`.
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            Precision::F64 => "f64",
-            Precision::F32 => "f32",
-        }
-    }
-}
-
-/// How the sliding velocity `u_i` of each support is obtained when its friction
-/// force is computed for a step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum FrictionVelocity {
-    /// The engine's own `velocity_at_point` of the object at the start of the
-    /// step, with the pusher heading taken at the start of the step.
-    Body,
-    /// The commanded pusher velocity plus `ω × (p_i − p_c)` (world frame), with
-    /// `ω` the object's angular velocity at the start of the step. The pusher
-    /// heading is taken at the start of the step.
-    Constraint,
-    /// Like [`FrictionVelocity::Constraint`], but evaluated where a
-    /// second-order (leapfrog) reading of the engine's symplectic Euler step
-    /// wants it: `ω` is extrapolated from the last two step velocities of the
-    /// segment to the start of the step (the engine's step velocities live at
-    /// mid-steps), and the pusher heading is taken at the mid-step angle
-    /// `θ + ω h / 2`. First order: the joint's lever arm is taken at the
-    /// step start while the pusher velocity is a mid-step one, which leaves
-    /// an `O(h)` bias of order `m h ω³ |p_c|²` in the moment balance, and the
-    /// step velocities start and end each segment half a step out of phase.
-    Midpoint,
-    /// Second order (the default). Reads rapier's symplectic Euler step as a
-    /// leapfrog (kick–drift) scheme, with the step velocities at mid-steps,
-    /// and makes every part of the step consistent with that reading:
-    ///
-    /// * friction as in [`FrictionVelocity::Midpoint`]: the constraint form
-    ///   at the step-start pose, with `ω` extrapolated to the step start;
-    /// * the pusher velocity is
-    ///   `v_c R(θ_m) n_φ + ω_m D (R(θ) − R(θ_m)) p_c`, with `ω_m` the
-    ///   extrapolated mid-step ω and `θ_m = θ + atan(h ω_m)/2` the mid-step
-    ///   angle (rapier turns a body by `atan(h ω)` per step). Since the joint
-    ///   holds the contact with the step-start lever arm `R(θ) p_c`, this
-    ///   gives the centre of mass the chord velocity
-    ///   `R(θ_m)(v_c n_φ − ω D p_c)` of the arc it should follow, and the
-    ///   joint impulse the moment of a centred difference of momenta;
-    /// * the pusher is re-pinned onto the object's contact point before each
-    ///   step, so the joint's position bias has nothing to correct and the
-    ///   body moves with exactly the velocity the joint solved for (the bias
-    ///   would otherwise push it off the chord by `h ω² p_c / 2`);
-    /// * each segment opens with a half kick (the first full step after the
-    ///   switch step applies half the friction impulse) and, when a switch
-    ///   follows, closes with one (an extra step of the switch-step length,
-    ///   taken off the last step, with the pusher velocity at the switch
-    ///   and the friction impulse of half a step), so the switch impulse
-    ///   acts on the velocity at the switch, not on a mid-step one.
-    ///
-    /// Requires `switch_step_fraction > 0` for the closing half kick. The
-    /// joint still produces every switch and start impulse: ω is never set.
-    #[default]
-    Leapfrog,
-}
-
-impl FrictionVelocity {
-    /// `"body"`, `"constraint"`, `"midpoint"` or `"leapfrog"`.
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            FrictionVelocity::Body => "body",
-            FrictionVelocity::Constraint => "constraint",
-            FrictionVelocity::Midpoint => "midpoint",
-            FrictionVelocity::Leapfrog => "leapfrog",
-        }
-    }
-
-    /// Every mode, in the order body, constraint, midpoint, leapfrog.
-    pub const ALL: [FrictionVelocity; 4] = [
-        FrictionVelocity::Body,
-        FrictionVelocity::Constraint,
-        FrictionVelocity::Midpoint,
-        FrictionVelocity::Leapfrog,
-    ];
-}
-
-/// How the engine runs a problem.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EngineSettings {
-    /// Largest time step (s); default `1e-3`. Each push segment is cut into
-    /// `n = ceil(duration / dt)` equal steps of `duration / n`, so steps land
-    /// exactly on the switch times.
-    pub dt: f64,
-    /// rapier's `num_solver_iterations` (its number of solver substeps per
-    /// step), ≥ 1; default `1`. rapier's own default is 4, but here more
-    /// substeps *raise* the error (in `midpoint` mode the steady-ω error at
-    /// dt = 1e-3 grows from 1.6e-5 with 1 substep to 1.4e-3 with 4): the
-    /// friction forces are evaluated once per step, not per substep.
-    pub solver_iterations: usize,
-    /// rapier's `num_internal_pgs_iterations` (Gauss–Seidel sweeps per
-    /// substep), ≥ 1; default `1` (rapier's). The lone pin joint is solved
-    /// exactly in one sweep, so more change nothing measurable.
-    pub pgs_iterations: usize,
-    /// Precision of the rapier build; default [`Precision::F64`].
-    pub precision: Precision,
-    /// How the support sliding velocities (and the pusher velocity) are
-    /// obtained; default [`FrictionVelocity::Leapfrog`].
-    pub friction_velocity: FrictionVelocity,
-    /// At the start and at every switch, first take a step of
-    /// `switch_step_fraction · h` (h the segment's step) so that the joint
-    /// delivers the switch impulse before the friction forces of the first
-    /// full step are evaluated; that step's length is taken off the next one,
-    /// so steps still land on the switch times. `0` turns this off (the
-    /// friction of the first step then sees the angular velocity from before
-    /// the switch). In [`FrictionVelocity::Leapfrog`] mode a segment that
-    /// is followed by a switch also ends with a closing step of the same
-    /// length (taken off the step before it). Dimensionless, in `[0, 0.5)`;
-    /// default `1e-3`.
-    pub switch_step_fraction: f64,
-    /// The support-friction law; default [`FrictionModel::Coulomb`] (the
-    /// analytic model's). The others are game-engine idioms (see
-    /// [`idioms`]); their impulse cap uses the segment's nominal step.
-    pub friction_model: FrictionModel,
-    /// Attach colliders (default `false`): a convex polygon on the object
-    /// (the outline given to [`RapierSimulator::run_with_outline`], else the
-    /// convex hull of the supports and the contact point) and a 5 mm ball on
-    /// the pusher. They are massless (density 0: the body's mass and inertia
-    /// stay the ones set directly), in collision groups that exclude each
-    /// other and in no solver group, so the motion is the same to rounding;
-    /// only rapier's broad and narrow phases get work. Exists to measure what
-    /// the collider-free scene saves (bench `rapier_step`).
-    pub colliders: bool,
-}
-
-impl Default for EngineSettings {
-    fn default() -> Self {
-        Self {
-            dt: 1e-3,
-            solver_iterations: 1,
-            pgs_iterations: 1,
-            precision: Precision::F64,
-            friction_velocity: FrictionVelocity::Leapfrog,
-            switch_step_fraction: 1e-3,
-            friction_model: FrictionModel::Coulomb,
-            colliders: false,
-        }
-    }
-}
-
-impl EngineSettings {
-    /// A short label naming the variant, e.g. `rapier2d[f64,leapfrog,dt=0.001]`
-    /// (with the friction model appended when it is not Coulomb).
-    pub fn label(&self) -> String {
-        let model = match self.friction_model {
-            FrictionModel::Coulomb => String::new(),
-            m => format!(",{}", m.as_str()),
-        };
-        format!(
-            "rapier2d[{},{},dt={}{}]",
-            self.precision.as_str(),
-            self.friction_velocity.as_str(),
-            self.dt,
-            model
-        )
-    }
-
-    /// Checks the settings; errors name the field.
-    pub fn check(&self) -> Result<(), ModelError> {
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(ModelError::Parameter {
-                name: "engine dt",
-                requirement: "finite and > 0",
-                value: self.dt,
-            });
-        }
-        if self.solver_iterations == 0 {
-            return Err(ModelError::Parameter {
-                name: "engine solver_iterations",
-                requirement: ">= 1",
-                value: 0.0,
-            });
-        }
-        if self.pgs_iterations == 0 {
-            return Err(ModelError::Parameter {
-                name: "engine pgs_iterations",
-                requirement: ">= 1",
-                value: 0.0,
-            });
-        }
-        self.friction_model.check()?;
-        if !(self.switch_step_fraction >= 0.0 && self.switch_step_fraction < 0.5) {
-            return Err(ModelError::Parameter {
-                name: "engine switch_step_fraction",
-                requirement: "in [0, 0.5)",
-                value: self.switch_step_fraction,
-            });
-        }
-        Ok(())
-    }
-}
-
-/// A rapier run: the sampled trajectory and what the engine did.
+/// What one engine run produced.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EngineRun {
-    /// The trajectory sampled at [`Problem::sample_times`] (model `"rapier2d"`).
+    /// The trajectory sampled at [`Problem::sample_times`].
     pub trajectory: Trajectory,
-    /// Largest distance (m) between the pusher's anchor and the object's
-    /// contact point after any step: how far the joint let the contact drift.
-    pub max_joint_drift: f64,
-    /// Number of engine steps taken (the zero-length set-up step excluded,
-    /// switch steps included).
+    /// The time step the run used (s).
+    pub dt: f64,
+    /// Engine steps taken.
     pub steps: usize,
-    /// The settings used.
-    pub settings: EngineSettings,
     /// Wall-clock time of the run (set-up, stepping and sampling).
     pub wall_time: Duration,
-    /// The part of `wall_time` spent inside rapier's `step()`.
-    pub rapier_step_time: Duration,
-    /// The part of `wall_time` spent in the stepping loop: rapier's steps plus
-    /// the adapter's per-step work (friction forces, pusher velocity, reading
-    /// and recording the state). `stepping_time − rapier_step_time` is the
-    /// adapter's overhead.
-    pub stepping_time: Duration,
-    /// Per segment, the mean angular velocity (rad/s) over the segment's last
-    /// 20 % of engine steps (time-weighted): a cheap steady-ω estimate.
-    pub segment_tail_omega: Vec<f64>,
-    /// Every engine step: time, pose at the step's end, and the angular
-    /// velocity the engine held over the step.
-    pub history: Vec<StepRecord>,
+    /// Engine-specific diagnostics for the outputs (joint drift, tilt, loads,
+    /// …); an object, possibly empty.
+    pub diagnostics: serde_json::Value,
 }
 
-/// The rapier2d engine as a [`Simulator`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct RapierSimulator {
-    pub settings: EngineSettings,
+/// The crate that provides an engine, as locked in `Cargo.lock`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EngineCrate {
+    /// The crates.io name of the engine's Rust crate (e.g. `rapier2d-f64`).
+    pub name: &'static str,
+    /// Its version as the adapter's `Cargo.toml` requires and `Cargo.lock`
+    /// locks it (a test checks the two agree).
+    pub version: &'static str,
 }
 
-impl RapierSimulator {
-    /// A simulator with the given settings.
-    pub fn new(settings: EngineSettings) -> Self {
-        Self { settings }
+/// One engine model: an engine, a scene and a friction law, runnable at any
+/// time step. Implemented by each engine crate; used through `dyn Engine`.
+pub trait Engine: Send + Sync {
+    /// The model name used in scenarios and outputs (`"rapier2d"`, …).
+    fn name(&self) -> &'static str;
+    /// One line saying what the model is (scene and friction law).
+    fn description(&self) -> &'static str;
+    /// The adapter crate (`pushval-rapier2d`, …).
+    fn adapter(&self) -> &'static str;
+    /// The engine crate this adapter depends on, with its version.
+    fn engine_crate(&self) -> EngineCrate;
+    /// The engine's version as shown to users; defaults to the engine crate's
+    /// (an adapter over a native library names the library's version too).
+    fn version(&self) -> String {
+        let c = self.engine_crate();
+        format!("{} {}", c.name, c.version)
     }
-
-    /// Runs the problem and returns the trajectory with the engine's diagnostics.
-    pub fn run(&self, problem: &Problem) -> Result<EngineRun, ModelError> {
-        self.run_with_outline(problem, &[])
+    /// The order of accuracy in the time step the model's steady ω and
+    /// trajectory show (measured: see the adapter's README).
+    fn order(&self) -> f64;
+    /// Whether `[run] gate` may name it: it runs the scene the dynamic model
+    /// describes closely enough that agreement is a meaningful test (an
+    /// engine whose friction law differs can still be gated, and fails).
+    fn gateable(&self) -> bool {
+        true
     }
-
-    /// [`RapierSimulator::run`] with the object's outline (m, object frame
-    /// with the origin at the centre of mass) for the object's collider when
-    /// [`EngineSettings::colliders`] is set: the collider is the outline's
-    /// convex hull. An empty outline means the convex hull of the supports
-    /// and the contact point. Without colliders the outline is not used.
-    pub fn run_with_outline(
-        &self,
-        problem: &Problem,
-        outline: &[[f64; 2]],
-    ) -> Result<EngineRun, ModelError> {
-        let start = Instant::now();
-        problem.check()?;
-        self.settings.check()?;
-        let raw = match self.settings.precision {
-            Precision::F64 => f64_engine::world::simulate(problem, &self.settings, outline)?,
-            Precision::F32 => f32_engine::world::simulate(problem, &self.settings, outline)?,
-        };
-        let samples = history::sample(problem, &raw.history);
-        let segments = history::segment_reports(problem, &raw.history, &samples);
-        let segment_tail_omega = history::tail_omega(problem, &raw.history, 0.2);
-        let mut trajectory = Trajectory {
-            model: self.name(),
-            samples,
-            segments,
-            ..Default::default()
-        };
-        trajectory.stats.steps = raw.steps;
-        trajectory.stats.rhs_evals = raw.steps;
-        trajectory.assumptions.min_support_speed = raw.min_support_speed;
-        Ok(EngineRun {
-            trajectory,
-            max_joint_drift: raw.max_drift,
-            steps: raw.steps,
-            settings: self.settings,
-            wall_time: start.elapsed(),
-            rapier_step_time: raw.step_time,
-            stepping_time: raw.loop_time,
-            segment_tail_omega,
-            history: raw.history,
-        })
+    /// `Ok` when this build can run it; otherwise why not, naming the cargo
+    /// feature that brings it in (e.g. "build with --features mujoco").
+    fn availability(&self) -> Result<(), String> {
+        Ok(())
     }
+    /// The time step used when neither the scenario nor the ladder sets one (s).
+    fn default_dt(&self) -> f64;
+    /// The `[engine]` keys this model reads, besides `dt`.
+    fn option_keys(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// The settings that produce a run at `dt`, as JSON for the outputs
+    /// (includes `"engine"`: the version, and `"dt"`).
+    fn settings(&self, dt: f64) -> serde_json::Value;
+    /// Runs the problem at time step `dt` (s).
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError>;
 }
 
-impl Simulator for RapierSimulator {
-    fn name(&self) -> String {
-        "rapier2d".to_string()
-    }
+/// A constructor of an engine model from the scenario's `[engine]` table.
+pub type Build = fn(&EngineOptions) -> Result<Box<dyn Engine>, OptionError>;
 
-    fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
-        self.run(problem).map(|r| r.trajectory)
+/// One row of an engine crate's model table: a name and its constructor.
+#[derive(Debug, Clone, Copy)]
+pub struct ModelEntry {
+    /// The model name (as [`Engine::name`] returns it).
+    pub name: &'static str,
+    /// Builds the model from the `[engine]` options.
+    pub build: Build,
+}
+
+impl ModelEntry {
+    /// The model with default options (for listings).
+    pub fn default_engine(&self) -> Box<dyn Engine> {
+        (self.build)(&EngineOptions::default()).expect("default options are valid for every engine")
     }
 }
 
-/// Per segment of `problem`, the mean of ω over the last `fraction` of the
-/// segment, from any trajectory's samples (trapezoidal rule over the samples in
-/// `[t_end − fraction·duration, t_end]`; the sample at a switch time belongs to
-/// the segment it starts, so the segment's end value is read just before it).
-/// `None` where fewer than two samples fall in the window.
-pub fn tail_mean_omega(
-    problem: &Problem,
-    trajectory: &Trajectory,
-    fraction: f64,
-) -> Vec<Option<f64>> {
-    problem
-        .segment_times()
-        .iter()
-        .enumerate()
-        .map(|(j, &(t0, t1))| {
-            let from = t1 - fraction * (t1 - t0);
-            let last = j + 1 == problem.pushes.len();
-            let tol = 1e-9 * (t1 - t0).max(1.0);
-            let pts: Vec<(f64, f64)> = trajectory
-                .samples
-                .iter()
-                .filter(|s| s.t >= from - tol && (s.t < t1 - tol || (last && s.t <= t1 + tol)))
-                .map(|s| (s.t, s.omega))
-                .collect();
-            if pts.len() < 2 {
-                return None;
-            }
-            let span = pts[pts.len() - 1].0 - pts[0].0;
-            if span <= 0.0 {
-                return None;
-            }
-            let area: f64 = pts
-                .windows(2)
-                .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
-                .sum();
-            Some(area / span)
-        })
-        .collect()
+/// Relative steady-ω error with a floor for segments whose ω* is (near) zero:
+/// the denominator is at least `1e-3 v_c / L` (v_c in m/s, L in m).
+pub fn rel_err(w: f64, reference: f64, speed: f64, length: f64) -> f64 {
+    (w - reference).abs() / reference.abs().max(1e-3 * speed / length)
 }

@@ -11,6 +11,8 @@
 //!   velocity is the root of a scalar function ([`SegmentDynamics::steady_states`]).
 //! * [`kinematic`]: Kurisu & Yoshikawa's quasi-static model, `ω = v_c ψ(φ)`,
 //!   with ψ the root of the friction moment alone.
+//! * [`kappa`]: the scaling factor `κ = ω* / (v_c ψ)` between the two, exactly
+//!   and as a series in the Froude number.
 //! * [`limit_surface`]: the ellipsoidal limit-surface approximation used in
 //!   quasi-static planning (Goyal, Ruina & Papadopoulos; Lynch, Maekawa & Tanie).
 //!
@@ -26,6 +28,7 @@ mod dop853_tables;
 pub mod dynamic;
 mod error;
 pub mod integrate;
+pub mod kappa;
 pub mod kinematic;
 pub mod limit_surface;
 mod problem;
@@ -37,6 +40,7 @@ pub use arc::{arc_advance, sinc_versc};
 pub use body::{Body, Push, Support};
 pub use dynamic::{InertialTerm, RootKind, SegmentDynamics, SteadyState};
 pub use error::ModelError;
+pub use kappa::{kappa_exact, kappa_series, KappaSeries};
 pub use problem::{ContactLimits, Initial, Problem, Simulator, Switching};
 pub use rotor::Rotor;
 pub use trajectory::{

@@ -40,10 +40,13 @@ use std::time::Duration;
 
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
+mod engine;
 pub mod scene;
 #[cfg(feature = "mujoco")]
 mod sim;
 pub mod theory;
+
+pub use engine::{models, MujocoModel, ENGINE_CRATE};
 
 /// True when this build links MuJoCo (feature `mujoco`).
 pub const AVAILABLE: bool = cfg!(feature = "mujoco");
@@ -264,6 +267,7 @@ pub struct MujocoRun {
 /// MuJoCo as a [`Simulator`] (names `mujoco_pyramidal`, `mujoco_elliptic`).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MujocoSimulator {
+    /// How it runs.
     pub settings: MujocoSettings,
 }
 

@@ -3,7 +3,8 @@
 use std::time::Instant;
 
 use mujoco_rs::prelude::*;
-use pushval_model::{ModelError, Problem, Sample, SegmentReport, Trajectory};
+use pushval_engine::StepRecord;
+use pushval_model::{ModelError, Problem, Trajectory};
 
 use crate::scene::{self, CARRIAGE_DOF, OBJECT};
 use crate::{MjStep, MujocoRun, MujocoSettings};
@@ -288,28 +289,23 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         tail_std.push((w2_sum / cntf - mean * mean).max(0.0).sqrt());
     }
 
-    let samples = sample(problem, &history);
-    let segments = problem
-        .segment_times()
+    // The shared resampler (pose at step ends, ω at step middles: MuJoCo's
+    // Euler is semi-implicit, so the velocity after a step is the one held
+    // over it).
+    let records: Vec<StepRecord> = history
         .iter()
         .enumerate()
-        .map(|(j, &(t0, t1))| {
-            let mut it = history.iter().filter(|r| r.segment == j && r.t > t0);
-            SegmentReport {
-                index: j,
-                t_start: t0,
-                t_end: t1,
-                omega_start: it.next().map(|r| r.omega).unwrap_or(f64::NAN),
-                omega_end: history
-                    .iter()
-                    .rev()
-                    .find(|r| r.segment == j)
-                    .map(|r| r.omega)
-                    .unwrap_or(f64::NAN),
-                settled_at: None,
-            }
+        .map(|(k, r)| StepRecord {
+            segment: r.segment,
+            t0: if k == 0 { r.t } else { history[k - 1].t },
+            t1: r.t,
+            x: r.x,
+            y: r.y,
+            theta: r.theta,
+            omega: r.omega,
         })
         .collect();
+    let (samples, segments) = pushval_engine::resample(problem, &records);
     let mut trajectory = Trajectory {
         model: String::new(),
         samples,
@@ -349,36 +345,4 @@ fn wrap(a: f64) -> f64 {
     } else {
         r
     }
-}
-
-/// Linear interpolation of the step records at the problem's sample times.
-fn sample(problem: &Problem, history: &[MjStep]) -> Vec<Sample> {
-    problem
-        .sample_times()
-        .into_iter()
-        .map(|t| {
-            let k = history.partition_point(|r| r.t <= t);
-            let (a, b) = if k == 0 {
-                (&history[0], &history[0])
-            } else if k >= history.len() {
-                let l = &history[history.len() - 1];
-                (l, l)
-            } else {
-                (&history[k - 1], &history[k])
-            };
-            let s = if b.t > a.t {
-                (t - a.t) / (b.t - a.t)
-            } else {
-                0.0
-            };
-            let lerp = |p: f64, q: f64| p + s * (q - p);
-            Sample {
-                t,
-                x: lerp(a.x, b.x),
-                y: lerp(a.y, b.y),
-                theta: lerp(a.theta, b.theta),
-                omega: lerp(a.omega, b.omega),
-            }
-        })
-        .collect()
 }

@@ -15,11 +15,8 @@ pub struct ScenarioError {
 }
 
 impl ScenarioError {
-    pub(crate) fn new(
-        file: &std::path::Path,
-        key: impl Into<String>,
-        message: impl Into<String>,
-    ) -> Self {
+    /// An error about `key` of `file`.
+    pub fn new(file: &std::path::Path, key: impl Into<String>, message: impl Into<String>) -> Self {
         Self {
             file: file.to_path_buf(),
             key: key.into(),

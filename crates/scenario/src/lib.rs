@@ -15,6 +15,5 @@ mod scene;
 
 pub use error::ScenarioError;
 pub use geometry::{polygon_mass_properties, PolygonProperties};
-pub use scene::{
-    EngineConfig, FrictionVelocity, ModelKind, Precision, Scenario, SupportLoad, Tolerance,
-};
+pub use pushval_engine::EngineOptions;
+pub use scene::{Scenario, SupportLoad, Tolerance, ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS};

@@ -129,6 +129,7 @@ pub struct RawPush {
 #[serde(deny_unknown_fields)]
 pub struct RawRun {
     pub models: Option<Vec<String>>,
+    pub gate: Option<Vec<String>>,
     pub sample_dt: Option<f64>,
     pub switching: Option<String>,
 }
@@ -141,11 +142,6 @@ pub struct RawTolerance {
     pub theta_max: Option<f64>,
 }
 
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawEngine {
-    pub dt: Option<f64>,
-    pub solver_iterations: Option<usize>,
-    pub precision: Option<String>,
-    pub friction_velocity: Option<String>,
-}
+/// `[engine]`: `dt` for every engine, the other keys for the engines that
+/// read them (checked by the engines, through the command line's registry).
+pub type RawEngine = toml::Table;

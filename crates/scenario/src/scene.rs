@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use pushval_engine::EngineOptions;
 use pushval_model::{Body, ContactLimits, Initial, Problem, Push, Support, Switching, Vec2};
 
 use crate::geometry::{
@@ -11,110 +12,15 @@ use crate::geometry::{
 use crate::raw::{PerPoint, RawLoad, RawScenario};
 use crate::ScenarioError;
 
-/// A model a scenario can ask for in `[run] models`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum ModelKind {
-    Dynamic,
-    Kinematic,
-    LimitSurface,
-    Rapier2d,
-    /// rapier2d with a 2-D game engine's friction joint at each support
-    /// (impulse capped in length at μ N Δt); informational.
-    Rapier2dImpulseDisk,
-    /// The same capped per world axis; informational.
-    Rapier2dImpulseBox,
-    /// rapier2d with Coulomb regularised linearly below 0.01 m/s; informational.
-    Rapier2dRegularisedLinear,
-    /// rapier2d with Coulomb regularised by tanh(|u| / 0.01 m/s); informational.
-    Rapier2dRegularisedTanh,
-    /// rapier3d-f64: the object on ball feet on a ground plane, rapier's own
-    /// contact friction (`FrictionModel::Coulomb`); informational.
-    Rapier3d,
-    /// The same with rapier's default `FrictionModel::Simplified`; informational.
-    Rapier3dSimplified,
-    /// MuJoCo 3.17, feet on a floor, pyramidal friction cone (needs the
-    /// `mujoco` feature); informational.
-    MujocoPyramidal,
-    /// MuJoCo with the elliptic friction cone; informational.
-    MujocoElliptic,
-}
+/// The analytic models every build has, in output order; the engine models
+/// come from the command line's registry.
+pub const ANALYTIC_MODELS: [&str; 3] = ["dynamic", "kinematic", "limit_surface"];
 
-impl ModelKind {
-    /// The models a scenario runs when it does not list any, in output order.
-    pub const ALL: [ModelKind; 4] = [
-        ModelKind::Dynamic,
-        ModelKind::Kinematic,
-        ModelKind::LimitSurface,
-        ModelKind::Rapier2d,
-    ];
-    /// Every model a scenario can list.
-    pub const KNOWN: [ModelKind; 12] = [
-        ModelKind::Dynamic,
-        ModelKind::Kinematic,
-        ModelKind::LimitSurface,
-        ModelKind::Rapier2d,
-        ModelKind::Rapier2dImpulseDisk,
-        ModelKind::Rapier2dImpulseBox,
-        ModelKind::Rapier2dRegularisedLinear,
-        ModelKind::Rapier2dRegularisedTanh,
-        ModelKind::Rapier3d,
-        ModelKind::Rapier3dSimplified,
-        ModelKind::MujocoPyramidal,
-        ModelKind::MujocoElliptic,
-    ];
-    /// The name used in files and outputs.
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Dynamic => "dynamic",
-            ModelKind::Kinematic => "kinematic",
-            ModelKind::LimitSurface => "limit_surface",
-            ModelKind::Rapier2d => "rapier2d",
-            ModelKind::Rapier2dImpulseDisk => "rapier2d_impulse_disk",
-            ModelKind::Rapier2dImpulseBox => "rapier2d_impulse_box",
-            ModelKind::Rapier2dRegularisedLinear => "rapier2d_regularised_linear",
-            ModelKind::Rapier2dRegularisedTanh => "rapier2d_regularised_tanh",
-            ModelKind::Rapier3d => "rapier3d",
-            ModelKind::Rapier3dSimplified => "rapier3d_simplified",
-            ModelKind::MujocoPyramidal => "mujoco_pyramidal",
-            ModelKind::MujocoElliptic => "mujoco_elliptic",
-        }
-    }
-    /// Parses a model name.
-    pub fn parse(s: &str) -> Option<Self> {
-        Self::KNOWN.into_iter().find(|m| m.name() == s)
-    }
-}
+/// The models a scenario runs when `[run] models` is absent.
+pub const DEFAULT_MODELS: [&str; 4] = ["dynamic", "kinematic", "limit_surface", "rapier2d"];
 
-/// Engine precision.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Precision {
-    F64,
-    F32,
-}
-
-/// How the engine adapter obtains the support velocities for friction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FrictionVelocity {
-    /// The engine's body state (`velocity_at_point`).
-    Body,
-    /// The commanded pusher velocity plus `ω × r` (the joint constraint).
-    Constraint,
-    /// The constraint velocity evaluated at the middle of the step.
-    Midpoint,
-    /// Second-order stepping (the engine adapter's default).
-    Leapfrog,
-}
-
-/// `[engine]`: settings for engine models; unset fields take the adapter's defaults.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct EngineConfig {
-    /// Time step (s).
-    pub dt: Option<f64>,
-    /// Solver iterations per step.
-    pub solver_iterations: Option<usize>,
-    pub precision: Option<Precision>,
-    pub friction_velocity: Option<FrictionVelocity>,
-}
+/// The engines a scenario gates when `[run] gate` is absent.
+pub const DEFAULT_GATE: [&str; 1] = ["rapier2d"];
 
 /// `[tolerance]`: what `validate` asserts between an engine and the dynamic model.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -180,9 +86,15 @@ pub struct Scenario {
     pub switching: Switching,
     /// s
     pub sample_dt: f64,
-    pub models: Vec<ModelKind>,
+    /// `[run] models`, in order, without repeats (names are checked against
+    /// the engine registry by the command line).
+    pub models: Vec<String>,
+    /// `[run] gate`: the engines whose agreement with the dynamic model is
+    /// asserted (checked like `models`).
+    pub gate: Vec<String>,
     pub tolerance: Tolerance,
-    pub engine: EngineConfig,
+    /// `[engine]`: `dt` checked here, the other keys by the engines.
+    pub engine: EngineOptions,
 }
 
 fn finite_pos(file: &Path, key: &str, v: f64) -> Result<f64, ScenarioError> {
@@ -626,30 +538,37 @@ impl Scenario {
                 ))
             }
         };
-        let models = match rr.models {
-            None => ModelKind::ALL.to_vec(),
+        let names = |key: &str, list: Option<Vec<String>>, default: &[&str]| match list {
+            None => Ok(default.iter().map(|m| m.to_string()).collect::<Vec<_>>()),
             Some(list) => {
                 if list.is_empty() {
-                    return Err(err("run.models", "is empty".into()));
+                    return Err(err(key, "is empty".into()));
                 }
-                let mut out = Vec::new();
-                for (i, m) in list.iter().enumerate() {
-                    let k = ModelKind::parse(m).ok_or_else(|| {
-                        err(
-                            &format!("run.models[{i}]"),
-                            format!(
-                                "unknown model \"{m}\"; known: {}",
-                                ModelKind::KNOWN.map(|k| k.name()).join(", ")
-                            ),
-                        )
-                    })?;
-                    if !out.contains(&k) {
-                        out.push(k);
+                let mut out: Vec<String> = Vec::new();
+                for m in list {
+                    if !out.contains(&m) {
+                        out.push(m);
                     }
                 }
-                out
+                Ok(out)
             }
         };
+        let mut models = names("run.models", rr.models, &DEFAULT_MODELS)?;
+        // Absent `gate`: the default engines the scenario runs. A gate named
+        // explicitly runs whether `models` lists it or not.
+        let gate = match rr.gate {
+            None => DEFAULT_GATE
+                .iter()
+                .map(|g| g.to_string())
+                .filter(|g| models.contains(g))
+                .collect(),
+            list => names("run.gate", list, &DEFAULT_GATE)?,
+        };
+        for g in &gate {
+            if !models.contains(g) {
+                models.push(g.clone());
+            }
+        }
         let rt = raw.tolerance.unwrap_or_default();
         let d = Tolerance::default();
         let tolerance = Tolerance {
@@ -669,46 +588,20 @@ impl Scenario {
                 rt.theta_max.unwrap_or(d.theta_max),
             )?,
         };
-        let re = raw.engine.unwrap_or_default();
-        let engine = EngineConfig {
-            dt: re
-                .dt
-                .map(|v| finite_pos(file, "engine.dt", v))
-                .transpose()?,
-            solver_iterations: match re.solver_iterations {
-                Some(0) => {
-                    return Err(err(
-                        "engine.solver_iterations",
-                        "must be >= 1, got 0".into(),
-                    ))
-                }
-                v => v,
-            },
-            precision: match re.precision.as_deref() {
-                None => None,
-                Some("f64") => Some(Precision::F64),
-                Some("f32") => Some(Precision::F32),
-                Some(o) => {
-                    return Err(err(
-                        "engine.precision",
-                        format!("unknown value \"{o}\"; expected \"f64\" or \"f32\""),
-                    ))
-                }
-            },
-            friction_velocity: match re.friction_velocity.as_deref() {
-                None => None,
-                Some("body") => Some(FrictionVelocity::Body),
-                Some("constraint") => Some(FrictionVelocity::Constraint),
-                Some("midpoint") => Some(FrictionVelocity::Midpoint),
-                Some("leapfrog") => Some(FrictionVelocity::Leapfrog),
-                Some(o) => return Err(err(
-                    "engine.friction_velocity",
-                    format!(
-                        "unknown value \"{o}\"; expected \"body\", \"constraint\", \"midpoint\" or \"leapfrog\""
-                    ),
-                )),
-            },
-        };
+        let mut engine = EngineOptions::default();
+        for (key, value) in raw.engine.unwrap_or_default() {
+            if key == "dt" {
+                let dt = value
+                    .as_float()
+                    .or_else(|| value.as_integer().map(|i| i as f64))
+                    .ok_or_else(|| err("engine.dt", format!("must be a number, got {value}")))?;
+                engine.dt = Some(finite_pos(file, "engine.dt", dt)?);
+            } else {
+                let json = serde_json::to_value(&value)
+                    .map_err(|e| err(&format!("engine.{key}"), format!("unreadable value: {e}")))?;
+                engine.values.insert(key, json);
+            }
+        }
         Ok(Self {
             name: raw.name,
             description: raw.description.unwrap_or_default(),
@@ -733,6 +626,7 @@ impl Scenario {
             switching,
             sample_dt,
             models,
+            gate,
             tolerance,
             engine,
         })

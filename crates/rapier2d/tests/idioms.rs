@@ -4,10 +4,10 @@
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
 use pushval_model::{Body, Initial, Problem, Push, SegmentDynamics, Support, Switching, Vec2};
-use pushval_rapier::idioms::{
+use pushval_rapier2d::idioms::{
     lock_angles, predicted_mean_omega, predicted_steady_omega, stop_gain, support_force, LawContext,
 };
-use pushval_rapier::{EngineRun, EngineSettings, FrictionModel, RapierSimulator};
+use pushval_rapier2d::{EngineSettings, FrictionModel, RapierRun, RapierSimulator};
 
 const PHI: f64 = FRAC_PI_4 + 0.3;
 
@@ -31,7 +31,7 @@ fn push(speed: f64, duration: f64) -> Push {
     }
 }
 
-fn run(pushes: Vec<Push>, theta: f64, model: FrictionModel, dt: f64) -> EngineRun {
+fn run(pushes: Vec<Push>, theta: f64, model: FrictionModel, dt: f64) -> RapierRun {
     let problem = Problem {
         body: plate(),
         limits: Default::default(),

@@ -1,10 +1,10 @@
-//! The engine's step history, and how it is turned into samples.
+//! The one resampler: an engine's step history turned into samples.
 //!
-//! rapier integrates with symplectic Euler: a step first updates the velocities,
-//! then moves the poses with the new velocities. So the pose after a step is a
-//! value *at* the step's end, while the angular velocity after a step is the one
-//! the body held *over* the step, best read as the value at the step's middle.
-//! Samples are built accordingly:
+//! The engines pushval runs integrate with symplectic (semi-implicit) Euler: a
+//! step first updates the velocities, then moves the poses with the new
+//! velocities. So the pose after a step is a value *at* the step's end, while
+//! the angular velocity after a step is the one the body held *over* the step,
+//! best read as the value at the step's middle. Samples are built accordingly:
 //!
 //! * `x`, `y`, `θ` at a sample time: linear interpolation between the poses at
 //!   the two step ends around it (exact for the engine's piecewise-linear motion);
@@ -14,18 +14,20 @@
 //!   start (end). A sample at a switch time belongs to the segment that starts
 //!   there, so its ω is the engine's ω just after the switch impulse.
 
-use pushval_model::{Problem, Sample, SegmentReport};
+use pushval_model::{Problem, Sample, SegmentReport, Trajectory};
 
 /// One engine step, or (the first record of a history) the initial state.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepRecord {
     /// Index of the push segment the step belongs to.
     pub segment: usize,
-    /// Start and end time of the step (s); equal for the initial-state record.
+    /// Start time of the step (s); equal to `t1` for the initial-state record.
     pub t0: f64,
+    /// End time of the step (s).
     pub t1: f64,
-    /// World position of the centre of mass at `t1` (m).
+    /// World x of the centre of mass at `t1` (m).
     pub x: f64,
+    /// World y of the centre of mass at `t1` (m).
     pub y: f64,
     /// Object angle at `t1`, unwrapped (rad).
     pub theta: f64,
@@ -35,26 +37,13 @@ pub struct StepRecord {
 }
 
 impl StepRecord {
-    fn is_step(&self) -> bool {
+    /// False for the initial-state record (zero length).
+    pub fn is_step(&self) -> bool {
         self.t1 > self.t0
     }
     fn mid(&self) -> f64 {
         0.5 * (self.t0 + self.t1)
     }
-}
-
-/// What the per-precision engine code hands back.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub(crate) struct RawRun {
-    pub history: Vec<StepRecord>,
-    pub steps: usize,
-    /// Time spent inside rapier's `step()`.
-    pub step_time: std::time::Duration,
-    /// Time of the whole stepping loop (rapier's steps and the adapter's work
-    /// around them).
-    pub loop_time: std::time::Duration,
-    pub max_drift: f64,
-    pub min_support_speed: f64,
 }
 
 /// The segment a time belongs to: a switch time belongs to the segment that
@@ -94,8 +83,9 @@ fn omega_in(steps: &[StepRecord], t: f64) -> f64 {
     }
 }
 
-/// Samples at `problem.sample_times()`.
-pub(crate) fn sample(problem: &Problem, history: &[StepRecord]) -> Vec<Sample> {
+/// Samples at `problem.sample_times()` from a history whose first record is
+/// the initial state (see the module docs for the reading).
+pub fn sample(problem: &Problem, history: &[StepRecord]) -> Vec<Sample> {
     let times = problem.segment_times();
     let ranges = segment_ranges(times.len(), history);
     problem
@@ -137,11 +127,7 @@ pub(crate) fn sample(problem: &Problem, history: &[StepRecord]) -> Vec<Sample> {
 }
 
 /// One report per segment: ω just after the switch into it and at its end.
-pub(crate) fn segment_reports(
-    problem: &Problem,
-    history: &[StepRecord],
-    _samples: &[Sample],
-) -> Vec<SegmentReport> {
+pub fn segment_reports(problem: &Problem, history: &[StepRecord]) -> Vec<SegmentReport> {
     let times = problem.segment_times();
     let ranges = segment_ranges(times.len(), history);
     times
@@ -162,8 +148,8 @@ pub(crate) fn segment_reports(
 }
 
 /// Per segment, the time-weighted mean of the step ω over the steps that lie
-/// in the last `fraction` of the segment.
-pub(crate) fn tail_omega(problem: &Problem, history: &[StepRecord], fraction: f64) -> Vec<f64> {
+/// in the last `fraction` of the segment: a cheap steady-ω estimate.
+pub fn step_tail_omega(problem: &Problem, history: &[StepRecord], fraction: f64) -> Vec<f64> {
     let times = problem.segment_times();
     let ranges = segment_ranges(times.len(), history);
     times
@@ -183,6 +169,67 @@ pub(crate) fn tail_omega(problem: &Problem, history: &[StepRecord], fraction: f6
             } else {
                 steps.last().map(|r| r.omega).unwrap_or(f64::NAN)
             }
+        })
+        .collect()
+}
+
+/// Samples and segment reports of a history ([`sample`], [`segment_reports`]).
+pub fn resample(problem: &Problem, history: &[StepRecord]) -> (Vec<Sample>, Vec<SegmentReport>) {
+    (sample(problem, history), segment_reports(problem, history))
+}
+
+/// A trajectory named `model` from a history, with the step count in its
+/// statistics.
+pub fn trajectory_from_steps(model: &str, problem: &Problem, history: &[StepRecord]) -> Trajectory {
+    let (samples, segments) = resample(problem, history);
+    let mut trajectory = Trajectory {
+        model: model.to_string(),
+        samples,
+        segments,
+        ..Default::default()
+    };
+    let steps = history.iter().filter(|r| r.is_step()).count();
+    trajectory.stats.steps = steps;
+    trajectory.stats.rhs_evals = steps;
+    trajectory
+}
+
+/// Per segment of `problem`, the mean of ω over the last `fraction` of the
+/// segment, from any trajectory's samples (trapezoidal rule over the samples in
+/// `[t_end − fraction·duration, t_end]`; the sample at a switch time belongs to
+/// the segment it starts, so the segment's end value is read just before it).
+/// `None` where fewer than two samples fall in the window.
+pub fn tail_mean_omega(
+    problem: &Problem,
+    trajectory: &Trajectory,
+    fraction: f64,
+) -> Vec<Option<f64>> {
+    problem
+        .segment_times()
+        .iter()
+        .enumerate()
+        .map(|(j, &(t0, t1))| {
+            let from = t1 - fraction * (t1 - t0);
+            let last = j + 1 == problem.pushes.len();
+            let tol = 1e-9 * (t1 - t0).max(1.0);
+            let pts: Vec<(f64, f64)> = trajectory
+                .samples
+                .iter()
+                .filter(|s| s.t >= from - tol && (s.t < t1 - tol || (last && s.t <= t1 + tol)))
+                .map(|s| (s.t, s.omega))
+                .collect();
+            if pts.len() < 2 {
+                return None;
+            }
+            let span = pts[pts.len() - 1].0 - pts[0].0;
+            if span <= 0.0 {
+                return None;
+            }
+            let area: f64 = pts
+                .windows(2)
+                .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
+                .sum();
+            Some(area / span)
         })
         .collect()
 }

@@ -10,9 +10,10 @@ use std::time::{Duration, Instant};
 
 use super::rapier::prelude::*;
 
-use crate::history::{RawRun, StepRecord};
 use crate::idioms::{support_force, LawContext};
+use crate::RawRun;
 use crate::{EngineSettings, FrictionModel, FrictionVelocity};
+use pushval_engine::StepRecord;
 use pushval_model::{ModelError, Problem};
 
 /// Sliding speeds (m/s) at or below this give no friction force (the direction

@@ -9,7 +9,7 @@
 mod common;
 
 use pushval_model::Trajectory;
-use pushval_rapier::{EngineSettings, Precision, RapierSimulator};
+use pushval_rapier2d::{EngineSettings, Precision, RapierSimulator};
 
 fn run(from_rest: bool, precision: Precision, colliders: bool) -> Trajectory {
     RapierSimulator::new(EngineSettings {

@@ -61,8 +61,11 @@ use std::time::{Duration, Instant};
 
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
+mod engine;
 pub mod predict;
 mod world;
+
+pub use engine::{models, Rapier3dModel, ENGINE_CRATE};
 
 /// Which of rapier3d's friction models the contact solver uses
 /// (`IntegrationParameters::friction_model`).
@@ -311,6 +314,7 @@ impl Rapier3dRun {
 /// The rapier3d engine as a [`Simulator`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Rapier3dSimulator {
+    /// How it runs.
     pub settings: Rapier3dSettings,
 }
 

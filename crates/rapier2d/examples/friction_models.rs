@@ -15,10 +15,10 @@ use pushval_model::{
     Body, DynamicModel, Initial, Problem, Push, SegmentDynamics, Simulator, Support, Switching,
     Vec2,
 };
-use pushval_rapier::idioms::{
+use pushval_rapier2d::idioms::{
     lock_angles, predicted_angle_history, predicted_mean_omega, stop_gain,
 };
-use pushval_rapier::{EngineRun, EngineSettings, FrictionModel, RapierSimulator};
+use pushval_rapier2d::{EngineSettings, FrictionModel, RapierRun, RapierSimulator};
 
 const MU: f64 = 0.5;
 const G: f64 = 9.81;
@@ -65,7 +65,7 @@ fn problem(body: &Body, push: Push, theta0: f64) -> Problem {
     }
 }
 
-fn engine(p: &Problem, model: FrictionModel, dt: f64) -> EngineRun {
+fn engine(p: &Problem, model: FrictionModel, dt: f64) -> RapierRun {
     RapierSimulator::new(EngineSettings {
         dt,
         friction_model: model,
@@ -86,7 +86,7 @@ struct Measured {
     jitter: f64,
 }
 
-fn measure(run: &EngineRun) -> Measured {
+fn measure(run: &RapierRun) -> Measured {
     let steps: Vec<_> = run.history.iter().filter(|r| r.t1 > r.t0).collect();
     let t_end = steps.last().unwrap().t1;
     let half: Vec<_> = steps.iter().filter(|r| r.t0 >= 0.5 * t_end).collect();
@@ -454,7 +454,7 @@ fn main() {
     let mut theta_csv = String::from("theta,omega_box_frozen_game_dt,omega_disk_frozen_game_dt\n");
     for j in 0..=90 {
         let th = FRAC_PI_2 * j as f64 / 90.0;
-        let b = pushval_rapier::idioms::predicted_steady_omega(
+        let b = pushval_rapier2d::idioms::predicted_steady_omega(
             FrictionModel::ImpulseBox,
             &body,
             &push,
@@ -462,7 +462,7 @@ fn main() {
             th,
             0.0,
         );
-        let d = pushval_rapier::idioms::predicted_steady_omega(
+        let d = pushval_rapier2d::idioms::predicted_steady_omega(
             FrictionModel::ImpulseDisk,
             &body,
             &push,
@@ -491,7 +491,7 @@ fn main() {
     write(&out.join("box_engine_history_game_dt.csv"), &eng_theta);
     let frozen: Vec<f64> = (0..360)
         .filter_map(|j| {
-            pushval_rapier::idioms::predicted_steady_omega(
+            pushval_rapier2d::idioms::predicted_steady_omega(
                 FrictionModel::ImpulseBox,
                 &body,
                 &push,

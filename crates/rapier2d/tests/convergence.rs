@@ -5,7 +5,7 @@
 mod common;
 
 use pushval_model::{DynamicModel, Simulator};
-use pushval_rapier::{
+use pushval_rapier2d::{
     tail_mean_omega, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
 };
 

@@ -9,7 +9,7 @@ use std::f64::consts::FRAC_PI_4;
 use pushval_model::{
     Body, DynamicModel, Initial, Problem, Push, Simulator, Support, Switching, Vec2,
 };
-use pushval_rapier::{
+use pushval_rapier2d::{
     tail_mean_omega, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
 };
 

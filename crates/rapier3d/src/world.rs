@@ -2,7 +2,8 @@
 
 use std::f64::consts::{PI, TAU};
 
-use pushval_model::{ModelError, Problem, Sample, SegmentReport, SolverStats, Trajectory};
+use pushval_engine::StepRecord;
+use pushval_model::{ModelError, Problem, SolverStats, Trajectory};
 use rapier3d_f64::prelude::*;
 
 use crate::predict::{tilt_inertia, Scene};
@@ -417,8 +418,8 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         tail_slip.push(min_slip);
         t_seg += push.duration;
     }
-    let samples = sample(problem, &history);
-    let segments = segment_reports(problem, &history);
+    let records: Vec<StepRecord> = history.iter().map(record).collect();
+    let (samples, segments) = pushval_engine::resample(problem, &records);
     let trajectory = Trajectory {
         model: String::new(),
         samples,
@@ -453,91 +454,15 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
     })
 }
 
-fn mid(r: &Step3d) -> f64 {
-    0.5 * (r.t0 + r.t1)
-}
-
-/// The steps (not the initial record) of segment `j`.
-fn segment_steps(history: &[Step3d], j: usize) -> &[Step3d] {
-    let a = history.partition_point(|r| r.segment < j || r.t1 <= r.t0);
-    let b = history.partition_point(|r| r.segment <= j);
-    &history[a..b.max(a)]
-}
-
-/// ω at `t` from one segment's steps: linear between step middles,
-/// extrapolated from the first (last) two near the segment's ends.
-fn omega_in(steps: &[Step3d], t: f64) -> f64 {
-    match steps.len() {
-        0 => f64::NAN,
-        1 => steps[0].omega,
-        n => {
-            let k = steps.partition_point(|r| mid(r) <= t).clamp(1, n - 1);
-            let (a, b) = (&steps[k - 1], &steps[k]);
-            let s = (t - mid(a)) / (mid(b) - mid(a));
-            a.omega + s * (b.omega - a.omega)
-        }
+/// The shared resampler's view of a step.
+fn record(r: &Step3d) -> StepRecord {
+    StepRecord {
+        segment: r.segment,
+        t0: r.t0,
+        t1: r.t1,
+        x: r.x,
+        y: r.y,
+        theta: r.theta,
+        omega: r.omega,
     }
-}
-
-/// Samples at the problem's sample times: pose interpolated between step
-/// ends, ω between step middles within the segment the time belongs to (a
-/// switch time belongs to the segment it starts).
-fn sample(problem: &Problem, history: &[Step3d]) -> Vec<Sample> {
-    let times = problem.segment_times();
-    let tol = 1e-12 * problem.duration().max(1.0);
-    problem
-        .sample_times()
-        .into_iter()
-        .map(|t| {
-            let k = history.partition_point(|r| r.t1 <= t);
-            let (x, y, theta) = if k == 0 {
-                (history[0].x, history[0].y, history[0].theta)
-            } else if k >= history.len() {
-                let r = &history[history.len() - 1];
-                (r.x, r.y, r.theta)
-            } else {
-                let (a, b) = (&history[k - 1], &history[k]);
-                let s = if b.t1 > a.t1 {
-                    (t - a.t1) / (b.t1 - a.t1)
-                } else {
-                    1.0
-                };
-                (
-                    a.x + s * (b.x - a.x),
-                    a.y + s * (b.y - a.y),
-                    a.theta + s * (b.theta - a.theta),
-                )
-            };
-            let j = times
-                .iter()
-                .position(|&(_, t1)| t < t1 - tol)
-                .unwrap_or(times.len() - 1);
-            Sample {
-                t,
-                x,
-                y,
-                theta,
-                omega: omega_in(segment_steps(history, j), t),
-            }
-        })
-        .collect()
-}
-
-fn segment_reports(problem: &Problem, history: &[Step3d]) -> Vec<SegmentReport> {
-    problem
-        .segment_times()
-        .iter()
-        .enumerate()
-        .map(|(j, &(t0, t1))| {
-            let st = segment_steps(history, j);
-            SegmentReport {
-                index: j,
-                t_start: t0,
-                t_end: t1,
-                omega_start: omega_in(st, t0),
-                omega_end: omega_in(st, t1),
-                settled_at: None,
-            }
-        })
-        .collect()
 }

@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release -p pushval-rapier --example timing [FILE] [REPEATS]`
 
-use pushval_rapier::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
+use pushval_rapier2d::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -32,7 +32,7 @@ fn main() {
             let _ = sim.run(&problem).unwrap();
             let runs: Vec<_> = (0..repeats).map(|_| sim.run(&problem).unwrap()).collect();
             let n = runs[0].steps as f64;
-            let min = |f: &dyn Fn(&pushval_rapier::EngineRun) -> f64| {
+            let min = |f: &dyn Fn(&pushval_rapier2d::RapierRun) -> f64| {
                 runs.iter().map(f).fold(f64::INFINITY, f64::min)
             };
             let rapier = min(&|r| r.rapier_step_time.as_secs_f64());

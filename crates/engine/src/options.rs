@@ -1,0 +1,104 @@
+//! The scenario's `[engine]` table, as the engines read it.
+
+use std::collections::BTreeMap;
+
+/// The `[engine]` table of a scenario: the time step every engine reads, and
+/// the other keys by name, for the engines that read them. The scenario
+/// loader checks `dt`; each engine checks the keys it reads
+/// ([`crate::Engine::option_keys`]) and the command line refuses keys no
+/// engine reads.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EngineOptions {
+    /// `[engine] dt` (s), kept exactly when set.
+    pub dt: Option<f64>,
+    /// The other keys with their values.
+    pub values: BTreeMap<String, serde_json::Value>,
+}
+
+/// A bad `[engine]` value: the key (without the `engine.` prefix) and what
+/// is wrong with it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OptionError {
+    /// The key, e.g. `precision`.
+    pub key: String,
+    /// What is wrong, e.g. `unknown value "f16"; expected "f64" or "f32"`.
+    pub problem: String,
+}
+
+impl std::fmt::Display for OptionError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "engine.{}: {}", self.key, self.problem)
+    }
+}
+
+impl std::error::Error for OptionError {}
+
+impl EngineOptions {
+    fn bad(key: &str, problem: String) -> OptionError {
+        OptionError {
+            key: key.into(),
+            problem,
+        }
+    }
+
+    /// A string key that must be one of `allowed`; None when absent.
+    pub fn choice(
+        &self,
+        key: &str,
+        allowed: &[&'static str],
+    ) -> Result<Option<&'static str>, OptionError> {
+        let Some(v) = self.values.get(key) else {
+            return Ok(None);
+        };
+        let expected = allowed
+            .iter()
+            .map(|a| format!("\"{a}\""))
+            .collect::<Vec<_>>()
+            .join(", ");
+        match v.as_str() {
+            Some(s) => allowed
+                .iter()
+                .find(|a| **a == s)
+                .copied()
+                .map(Some)
+                .ok_or_else(|| {
+                    Self::bad(
+                        key,
+                        format!("unknown value \"{s}\"; expected one of {expected}"),
+                    )
+                }),
+            None => Err(Self::bad(
+                key,
+                format!("must be a string, one of {expected}; got {v}"),
+            )),
+        }
+    }
+
+    /// An integer key that must be ≥ `min`; None when absent.
+    pub fn integer(&self, key: &str, min: u64) -> Result<Option<usize>, OptionError> {
+        let Some(v) = self.values.get(key) else {
+            return Ok(None);
+        };
+        match v.as_u64() {
+            Some(n) if n >= min => Ok(Some(n as usize)),
+            _ => Err(Self::bad(
+                key,
+                format!("must be an integer >= {min}, got {v}"),
+            )),
+        }
+    }
+
+    /// A finite number key that must be > 0; None when absent.
+    pub fn positive(&self, key: &str) -> Result<Option<f64>, OptionError> {
+        let Some(v) = self.values.get(key) else {
+            return Ok(None);
+        };
+        match v.as_f64() {
+            Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x)),
+            _ => Err(Self::bad(
+                key,
+                format!("must be a finite number > 0, got {v}"),
+            )),
+        }
+    }
+}

@@ -1,0 +1,123 @@
+//! The MuJoCo models as pushval engine plug-ins: `mujoco_pyramidal` and
+//! `mujoco_elliptic`, the plate on sphere feet on a floor with MuJoCo's own
+//! contact friction. Without the `mujoco` feature they are listed but not
+//! available.
+
+use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_model::{ModelError, Problem};
+
+use crate::{Cone, MujocoSettings, MujocoSimulator, AVAILABLE};
+
+/// The engine crate and version this adapter is built against (the
+/// `mujoco-rs` entry of the workspace's Cargo.toml, whose build metadata
+/// names the MuJoCo library it binds; a test checks it against Cargo.lock).
+pub const ENGINE_CRATE: EngineCrate = EngineCrate {
+    name: "mujoco-rs",
+    version: "7.0.0+mj-3.17.0",
+};
+
+/// One MuJoCo model (a friction cone).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MujocoModel {
+    /// The settings of a run (its `timestep` is replaced by the run's dt).
+    pub settings: MujocoSettings,
+}
+
+fn build(cone: Cone, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
+    let mut settings = MujocoSettings {
+        cone,
+        ..Default::default()
+    };
+    if let Some(dt) = opts.dt {
+        settings.timestep = dt;
+    }
+    Ok(Box::new(MujocoModel { settings }))
+}
+
+/// The MuJoCo models: the crate's entries in pushval's engine registry.
+pub fn models() -> Vec<ModelEntry> {
+    vec![
+        ModelEntry {
+            name: "mujoco_pyramidal",
+            build: |o| build(Cone::Pyramidal, o),
+        },
+        ModelEntry {
+            name: "mujoco_elliptic",
+            build: |o| build(Cone::Elliptic, o),
+        },
+    ]
+}
+
+impl Engine for MujocoModel {
+    fn name(&self) -> &'static str {
+        match self.settings.cone {
+            Cone::Pyramidal => "mujoco_pyramidal",
+            Cone::Elliptic => "mujoco_elliptic",
+        }
+    }
+    fn description(&self) -> &'static str {
+        match self.settings.cone {
+            Cone::Pyramidal => {
+                "plate on sphere feet on a floor, MuJoCo's soft contacts, pyramidal friction cone"
+            }
+            Cone::Elliptic => {
+                "plate on sphere feet on a floor, MuJoCo's soft contacts, elliptic friction cone"
+            }
+        }
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-mujoco"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        ENGINE_CRATE
+    }
+    /// Semi-implicit Euler: first order.
+    fn order(&self) -> f64 {
+        1.0
+    }
+    fn availability(&self) -> Result<(), String> {
+        if AVAILABLE {
+            Ok(())
+        } else {
+            Err(
+                "build with --features mujoco (and run scripts/setup-mujoco.sh for libmujoco.so)"
+                    .into(),
+            )
+        }
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.timestep
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = MujocoSettings {
+            timestep: dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": dt,
+            "timestep": dt,
+            "cone": s.cone.as_str(),
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = MujocoSimulator::new(MujocoSettings {
+            timestep: dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        Ok(EngineRun {
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_pusher_gap": r.max_pusher_gap,
+                "max_penetration": r.max_penetration,
+                "max_tilt": r.max_tilt,
+            }),
+            trajectory: r.trajectory,
+        })
+    }
+}

@@ -1,0 +1,219 @@
+//! The rapier2d models as pushval engine plug-ins: `rapier2d` (per-support
+//! Coulomb forces, gated by default) and the four 2-D friction idioms.
+
+use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_model::{ModelError, Problem};
+
+use crate::{EngineSettings, FrictionModel, FrictionVelocity, Precision, RapierSimulator};
+
+/// The engine crate and version this adapter is built against (the
+/// `rapier2d-f64` and `rapier2d` entries of the workspace's Cargo.toml; a
+/// test checks it against Cargo.lock).
+pub const ENGINE_CRATE: EngineCrate = EngineCrate {
+    name: "rapier2d-f64",
+    version: "0.36.1",
+};
+
+/// Slip speed (m/s) below which the regularised idioms go linear / tanh
+/// (see results/friction_models/).
+const IDIOM_SLIP_SPEED: f64 = 0.01;
+
+/// One rapier2d model: a friction law and the scenario's engine settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rapier2dModel {
+    name: &'static str,
+    description: &'static str,
+    /// The settings of a run (its `dt` is replaced by the run's).
+    pub settings: EngineSettings,
+}
+
+impl Rapier2dModel {
+    /// The model with the given name and settings.
+    pub fn new(name: &'static str, description: &'static str, settings: EngineSettings) -> Self {
+        Self {
+            name,
+            description,
+            settings,
+        }
+    }
+}
+
+/// The `[engine]` keys the rapier2d models read, besides `dt`.
+const OPTION_KEYS: &[&str] = &["solver_iterations", "precision", "friction_velocity"];
+
+/// The settings the `[engine]` table asks for, over the adapter's defaults.
+pub fn settings_from(opts: &EngineOptions) -> Result<EngineSettings, OptionError> {
+    let mut s = EngineSettings::default();
+    if let Some(dt) = opts.dt {
+        s.dt = dt;
+    }
+    if let Some(n) = opts.integer("solver_iterations", 1)? {
+        s.solver_iterations = n;
+    }
+    if let Some(p) = opts.choice("precision", &["f64", "f32"])? {
+        s.precision = if p == "f32" {
+            Precision::F32
+        } else {
+            Precision::F64
+        };
+    }
+    let modes = FrictionVelocity::ALL.map(|m| m.as_str());
+    if let Some(m) = opts.choice("friction_velocity", &modes)? {
+        s.friction_velocity = FrictionVelocity::ALL
+            .into_iter()
+            .find(|f| f.as_str() == m)
+            .expect("choice is one of ALL");
+    }
+    Ok(s)
+}
+
+fn build(
+    name: &'static str,
+    description: &'static str,
+    friction_model: FrictionModel,
+    opts: &EngineOptions,
+) -> Result<Box<dyn Engine>, OptionError> {
+    let settings = EngineSettings {
+        friction_model,
+        ..settings_from(opts)?
+    };
+    Ok(Box::new(Rapier2dModel::new(name, description, settings)))
+}
+
+/// The rapier2d models, one row each: the crate's entries in pushval's
+/// engine registry.
+pub fn models() -> Vec<ModelEntry> {
+    vec![
+        ModelEntry {
+            name: "rapier2d",
+            build: |o| {
+                build(
+                    "rapier2d",
+                    "top-down rigid body, kinematic pusher through a revolute joint, Coulomb force at every support",
+                    FrictionModel::Coulomb,
+                    o,
+                )
+            },
+        },
+        ModelEntry {
+            name: "rapier2d_impulse_disk",
+            build: |o| {
+                build(
+                    "rapier2d_impulse_disk",
+                    "2-D friction-joint idiom: per-support impulse capped in length at mu N dt",
+                    FrictionModel::ImpulseDisk,
+                    o,
+                )
+            },
+        },
+        ModelEntry {
+            name: "rapier2d_impulse_box",
+            build: |o| {
+                build(
+                    "rapier2d_impulse_box",
+                    "2-D friction-joint idiom: per-support impulse capped per world axis",
+                    FrictionModel::ImpulseBox,
+                    o,
+                )
+            },
+        },
+        ModelEntry {
+            name: "rapier2d_regularised_linear",
+            build: |o| {
+                build(
+                    "rapier2d_regularised_linear",
+                    "Coulomb regularised linearly below 0.01 m/s",
+                    FrictionModel::RegularisedLinear {
+                        slip_speed: IDIOM_SLIP_SPEED,
+                    },
+                    o,
+                )
+            },
+        },
+        ModelEntry {
+            name: "rapier2d_regularised_tanh",
+            build: |o| {
+                build(
+                    "rapier2d_regularised_tanh",
+                    "Coulomb regularised by tanh(|u| / 0.01 m/s)",
+                    FrictionModel::RegularisedTanh {
+                        slip_speed: IDIOM_SLIP_SPEED,
+                    },
+                    o,
+                )
+            },
+        },
+    ]
+}
+
+impl Engine for Rapier2dModel {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+    fn description(&self) -> &'static str {
+        self.description
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-rapier2d"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        match self.settings.precision {
+            Precision::F64 => ENGINE_CRATE,
+            Precision::F32 => EngineCrate {
+                name: "rapier2d",
+                ..ENGINE_CRATE
+            },
+        }
+    }
+    /// Second order in leapfrog mode, first in the others (measured: see the
+    /// crate's README).
+    fn order(&self) -> f64 {
+        match self.settings.friction_velocity {
+            FrictionVelocity::Leapfrog => 2.0,
+            _ => 1.0,
+        }
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.dt
+    }
+    fn option_keys(&self) -> &'static [&'static str] {
+        OPTION_KEYS
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = EngineSettings {
+            dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": s.dt,
+            "solver_iterations": s.solver_iterations,
+            "pgs_iterations": s.pgs_iterations,
+            "precision": s.precision.as_str(),
+            "friction_velocity": s.friction_velocity.as_str(),
+            "friction_model": s.friction_model.as_str(),
+            "switch_step_fraction": s.switch_step_fraction,
+            "colliders": s.colliders,
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = RapierSimulator::new(EngineSettings {
+            dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        let mut trajectory = r.trajectory;
+        trajectory.model = self.name.to_string();
+        Ok(EngineRun {
+            trajectory,
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "max_joint_drift": r.max_joint_drift,
+                "steps": r.steps,
+            }),
+        })
+    }
+}

@@ -1,0 +1,111 @@
+//! The rapier3d models as pushval engine plug-ins: `rapier3d` (rapier's
+//! `FrictionModel::Coulomb`) and `rapier3d_simplified` (its default,
+//! `Simplified`), the plate on ball feet on a ground plane.
+
+use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_model::{ModelError, Problem};
+
+use crate::{ContactFriction, Rapier3dSettings, Rapier3dSimulator};
+
+/// The engine crate and version this adapter is built against (the
+/// `rapier3d-f64` entry of the workspace's Cargo.toml; a test checks it
+/// against Cargo.lock).
+pub const ENGINE_CRATE: EngineCrate = EngineCrate {
+    name: "rapier3d-f64",
+    version: "0.36.1",
+};
+
+/// One rapier3d model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rapier3dModel {
+    /// The settings of a run (its `dt` is replaced by the run's).
+    pub settings: Rapier3dSettings,
+}
+
+fn build(friction: ContactFriction, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
+    let mut settings = Rapier3dSettings {
+        friction,
+        ..Default::default()
+    };
+    if let Some(dt) = opts.dt {
+        settings.dt = dt;
+    }
+    Ok(Box::new(Rapier3dModel { settings }))
+}
+
+/// The rapier3d models: the crate's entries in pushval's engine registry.
+pub fn models() -> Vec<ModelEntry> {
+    vec![
+        ModelEntry {
+            name: "rapier3d",
+            build: |o| build(ContactFriction::Coulomb, o),
+        },
+        ModelEntry {
+            name: "rapier3d_simplified",
+            build: |o| build(ContactFriction::Simplified, o),
+        },
+    ]
+}
+
+impl Engine for Rapier3dModel {
+    fn name(&self) -> &'static str {
+        match self.settings.friction {
+            ContactFriction::Coulomb => "rapier3d",
+            ContactFriction::Simplified => "rapier3d_simplified",
+        }
+    }
+    fn description(&self) -> &'static str {
+        match self.settings.friction {
+            ContactFriction::Coulomb => {
+                "plate on ball feet on a ground plane, rapier's own contact friction (FrictionModel::Coulomb)"
+            }
+            ContactFriction::Simplified => {
+                "plate on ball feet on a ground plane, rapier's default FrictionModel::Simplified"
+            }
+        }
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-rapier3d"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        ENGINE_CRATE
+    }
+    /// Symplectic Euler with the pusher at the mid-step heading: first order.
+    fn order(&self) -> f64 {
+        1.0
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.dt
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = Rapier3dSettings {
+            dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": s.dt,
+            "friction_model": s.friction.as_str(),
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = Rapier3dSimulator::new(Rapier3dSettings {
+            dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        Ok(EngineRun {
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_joint_drift": r.max_joint_drift,
+                "max_tilt": r.max_tilt,
+                "max_lift": r.max_lift,
+            }),
+            trajectory: r.trajectory,
+        })
+    }
+}

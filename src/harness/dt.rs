@@ -1,0 +1,362 @@
+//! The gated engine's time step (the dt ladder and its self-convergence
+//! estimate) and the convergence check (2 dt / 4 dt reruns, observed order,
+//! Richardson). Both go through [`Engine`] and name no engine.
+
+use std::time::{Duration, Instant};
+
+use pushval_engine::{Engine, EngineRun};
+use pushval_model::{ModelError, Problem, Trajectory};
+use pushval_scenario::Scenario;
+
+use super::{rel_err, tail_omega, Convergence, SegmentInfo};
+
+/// The largest engine time step the automatic choice tries (s): 1/60 s,
+/// rapier's own default step and the usual game-engine frame. Coarser steps
+/// would put several 0.01 s samples inside one step and stop resolving the
+/// relaxation times of the shipped scenes (τ ≈ 0.05–0.3 s).
+pub const DT_LADDER_TOP: f64 = 1.0 / 60.0;
+
+/// No rung of the automatic ladder is below this (s). Eight rungs, 1/60 s to
+/// 1/7680 s ≈ 1.3e-4 s: at the bottom a second-order step is 16 000 times
+/// more accurate than at the top and a 10 s scene takes 77 000 steps (about
+/// 0.2 s); a scene that needs less than that has a problem worth seeing
+/// rather than a step to shrink.
+pub const DT_FLOOR: f64 = 1e-4;
+
+/// The share of each `[tolerance]` figure the engine's own discretisation
+/// error may use up at the automatic step. The gate compares engine and
+/// model, so the engine's error eats into the tolerance a model error must
+/// exceed to be caught: at 1/4 a model error of 5/4 of the tolerance always
+/// fails the gate, and at most 1/4 is hidden. The margin also covers the
+/// estimate itself, which assumes the asymptotic order: at the coarse rungs
+/// the observed order can be off (the convergence check reports it) and the
+/// estimate off by a factor of 2 or so.
+pub const DT_FRACTION: f64 = 0.25;
+
+/// The rungs of the automatic time-step ladder, largest first:
+/// `DT_LADDER_TOP / 2^k` down to [`DT_FLOOR`].
+pub fn dt_ladder() -> Vec<f64> {
+    std::iter::successors(Some(DT_LADDER_TOP), |h| Some(h / 2.0))
+        .take_while(|h| *h >= DT_FLOOR)
+        .collect()
+}
+
+/// Where the engine's time step came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DtSource {
+    /// `[engine] dt` in the scenario, kept exactly.
+    Scenario,
+    /// Chosen by [`choose_engine_dt`].
+    Automatic,
+}
+
+/// The engine's self-convergence error estimate at one time step h, from
+/// the runs at h and h/2 alone (never against the model): Richardson's
+/// `|X(h) − X(h/2)| · 2^p / (2^p − 1)` for the scheme's order p, for each
+/// gated figure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DtEstimate {
+    /// The time step h (s).
+    pub dt: f64,
+    /// Largest centre-of-mass distance over the samples (m).
+    pub position_max: f64,
+    /// Largest angle difference over the samples (rad).
+    pub theta_max: f64,
+    /// Largest relative steady-ω difference over the segments the gate
+    /// reads a steady ω from (tail means; denominator the run at h/2 with
+    /// [`rel_err`]'s floor); None when no segment settles.
+    pub omega_steady_rel_max: Option<f64>,
+    /// Whether every figure is within [`DT_FRACTION`] of its tolerance.
+    pub meets: bool,
+}
+
+/// How the engine's time step was chosen, for the outputs.
+#[derive(Debug, Clone)]
+pub struct DtChoice {
+    /// The time step the gated engine run uses (s).
+    pub dt: f64,
+    pub source: DtSource,
+    /// Automatic only: every rung tried, largest first; the last one is the
+    /// chosen one.
+    pub rungs: Vec<DtEstimate>,
+    /// Automatic only: false when not even the ladder's floor met the
+    /// criterion (the floor is used then).
+    pub met: bool,
+    /// The scheme's order used in the estimate.
+    pub order: f64,
+    /// Wall time of the search's engine runs (the chosen run and its h/2
+    /// partner included).
+    pub search_time: Duration,
+}
+
+impl DtChoice {
+    /// One line saying which dt and why.
+    pub fn reason(&self, sc: &Scenario) -> String {
+        let t = &sc.tolerance;
+        let f = DT_FRACTION;
+        let figures = |e: &DtEstimate| {
+            format!(
+                "position {:.2e} m, theta {:.2e} rad, steady omega {} (targets {:.2e} m, {:.2e} rad, {:.2e})",
+                e.position_max,
+                e.theta_max,
+                e.omega_steady_rel_max.map_or("-".into(), |w| format!("{w:.2e}")),
+                f * t.position_max,
+                f * t.theta_max,
+                f * t.omega_steady_rel
+            )
+        };
+        match (self.source, self.rungs.last()) {
+            (DtSource::Scenario, _) | (_, None) => {
+                format!("dt = {} s set by the scenario's [engine] dt", self.dt)
+            }
+            (DtSource::Automatic, Some(last)) => {
+                let mut s = if self.met {
+                    format!(
+                        "dt = {:.4e} s: the largest ladder rung whose self-convergence estimate is within {f} of the tolerances: {}",
+                        self.dt,
+                        figures(last)
+                    )
+                } else {
+                    format!(
+                        "dt = {:.4e} s (the ladder's floor) although its estimate misses {f} of the tolerances: {}",
+                        self.dt,
+                        figures(last)
+                    )
+                };
+                if self.rungs.len() >= 2 {
+                    let prev = &self.rungs[self.rungs.len() - 2];
+                    s.push_str(&format!("; {:.4e} s misses: {}", prev.dt, figures(prev)));
+                }
+                s
+            }
+        }
+    }
+
+    /// The record written into the engine's settings in `summary.json`.
+    pub fn json(&self, sc: &Scenario) -> serde_json::Value {
+        use crate::output::num;
+        let rungs: Vec<serde_json::Value> = self
+            .rungs
+            .iter()
+            .map(|e| {
+                serde_json::json!({
+                    "dt": num(e.dt),
+                    "position_max_estimate": num(e.position_max),
+                    "theta_max_estimate": num(e.theta_max),
+                    "omega_steady_rel_max_estimate": e.omega_steady_rel_max.map_or(serde_json::Value::Null, num),
+                    "meets": e.meets,
+                })
+            })
+            .collect();
+        let t = &sc.tolerance;
+        serde_json::json!({
+            "source": match self.source {
+                DtSource::Scenario => "scenario",
+                DtSource::Automatic => "automatic",
+            },
+            "reason": self.reason(sc),
+            "criterion": "Richardson self-convergence estimate |X(h) - X(h/2)| 2^p / (2^p - 1) of each gated figure within fraction x [tolerance]",
+            "fraction": DT_FRACTION,
+            "order": self.order,
+            "ladder": dt_ladder(),
+            "targets": {
+                "position_max": num(DT_FRACTION * t.position_max),
+                "theta_max": num(DT_FRACTION * t.theta_max),
+                "omega_steady_rel": num(DT_FRACTION * t.omega_steady_rel),
+            },
+            "met": self.met,
+            "rungs": rungs,
+            "search_wall_time_s": num(self.search_time.as_secs_f64()),
+        })
+    }
+}
+
+/// The self-convergence estimate at h from the runs at h (`coarse`) and
+/// h/2 (`fine`) of a scheme of order `order`.
+pub fn dt_estimate(
+    sc: &Scenario,
+    segments: &[SegmentInfo],
+    h: f64,
+    coarse: &Trajectory,
+    fine: &Trajectory,
+    order: f64,
+) -> DtEstimate {
+    let k = 2f64.powf(order) / (2f64.powf(order) - 1.0);
+    let mut position_max: f64 = 0.0;
+    let mut theta_max: f64 = 0.0;
+    for (a, b) in coarse.samples.iter().zip(&fine.samples) {
+        position_max = position_max.max(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt());
+        theta_max = theta_max.max((a.theta - b.theta).abs());
+    }
+    if coarse.samples.len() != fine.samples.len() {
+        position_max = f64::INFINITY;
+        theta_max = f64::INFINITY;
+    }
+    let mut omega: Option<f64> = None;
+    for s in segments.iter().filter(|s| s.settles()) {
+        let (Some(wc), Some(wf)) = (
+            tail_omega(coarse, s.t_start, s.t_end),
+            tail_omega(fine, s.t_start, s.t_end),
+        ) else {
+            continue;
+        };
+        let e = rel_err(wc, wf, s.speed, sc.froude_length());
+        omega = Some(omega.map_or(e, |m: f64| m.max(e)));
+    }
+    let (position_max, theta_max) = (k * position_max, k * theta_max);
+    let omega_steady_rel_max = omega.map(|e| k * e);
+    let t = &sc.tolerance;
+    let meets = position_max <= DT_FRACTION * t.position_max
+        && theta_max <= DT_FRACTION * t.theta_max
+        && omega_steady_rel_max.is_none_or(|e| e <= DT_FRACTION * t.omega_steady_rel);
+    DtEstimate {
+        dt: h,
+        position_max,
+        theta_max,
+        omega_steady_rel_max,
+        meets,
+    }
+}
+
+/// A gated engine's time step: the scenario's `[engine] dt` when
+/// set, otherwise the largest rung of [`dt_ladder`] whose self-convergence
+/// estimate ([`dt_estimate`], engine runs at h and h/2 only) is within
+/// [`DT_FRACTION`] of every `[tolerance]` figure, or the floor when none is.
+/// `segments` (from the dynamic model's run) only say which segments the
+/// gate reads a steady ω from. Returns the choice and every engine run
+/// made, for reuse.
+pub fn choose_engine_dt(
+    sc: &Scenario,
+    engine: &dyn Engine,
+    problem: &Problem,
+    segments: &[SegmentInfo],
+) -> Result<(DtChoice, Vec<EngineRun>), ModelError> {
+    let order = engine.order();
+    let start = Instant::now();
+    if let Some(dt) = sc.engine.dt {
+        return Ok((
+            DtChoice {
+                dt,
+                source: DtSource::Scenario,
+                rungs: Vec::new(),
+                met: true,
+                order,
+                search_time: Duration::ZERO,
+            },
+            Vec::new(),
+        ));
+    }
+    let ladder = dt_ladder();
+    let mut runs: Vec<EngineRun> = Vec::new();
+    let mut rungs = Vec::new();
+    let run_at = |dt: f64, runs: &mut Vec<EngineRun>| -> Result<usize, ModelError> {
+        if let Some(i) = runs.iter().position(|r| r.dt == dt) {
+            return Ok(i);
+        }
+        runs.push(engine.run(problem, dt)?);
+        Ok(runs.len() - 1)
+    };
+    let mut last_err = None;
+    let mut announced = false;
+    for (i, &h) in ladder.iter().enumerate() {
+        if !announced && start.elapsed() > Duration::from_secs(2) {
+            eprintln!(
+                "pushval: {}: choosing the engine time step (trying dt = {h:.3e} s, rung {} of {})",
+                sc.name,
+                i + 1,
+                ladder.len()
+            );
+            announced = true;
+        }
+        // A rung whose runs fail (blow up) does not meet the criterion.
+        let pair = run_at(h, &mut runs).and_then(|a| Ok((a, run_at(h / 2.0, &mut runs)?)));
+        let (a, b) = match pair {
+            Ok(p) => p,
+            Err(e) => {
+                last_err = Some(e);
+                continue;
+            }
+        };
+        let est = dt_estimate(
+            sc,
+            segments,
+            h,
+            &runs[a].trajectory,
+            &runs[b].trajectory,
+            order,
+        );
+        rungs.push(est);
+        if est.meets || i + 1 == ladder.len() {
+            return Ok((
+                DtChoice {
+                    dt: h,
+                    source: DtSource::Automatic,
+                    rungs,
+                    met: est.meets,
+                    order,
+                    search_time: start.elapsed(),
+                },
+                runs,
+            ));
+        }
+    }
+    Err(last_err.expect("the ladder's floor either returns or fails"))
+}
+
+/// Runs the engine at 2h and 4h beside the run at h and measures how its
+/// steady ω converges.
+#[allow(clippy::too_many_arguments)]
+pub fn engine_convergence(
+    sc: &Scenario,
+    engine: &dyn Engine,
+    problem: &Problem,
+    segments: &[SegmentInfo],
+    fine: &Trajectory,
+    reference: &Trajectory,
+    h: f64,
+    done: &[EngineRun],
+) -> Result<Convergence, ModelError> {
+    // Runs the search already made at 2h or 4h are reused (same settings,
+    // deterministic: the same trajectory).
+    let at = |dt: f64| -> Result<Trajectory, ModelError> {
+        match done.iter().find(|r| r.dt == dt) {
+            Some(r) => Ok(r.trajectory.clone()),
+            None => engine.run(problem, dt).map(|r| r.trajectory),
+        }
+    };
+    let mid = at(2.0 * h)?;
+    let coarse = at(4.0 * h)?;
+    let order = engine.order();
+    let mut out = Convergence {
+        expected_order: order,
+        dts: [4.0 * h, 2.0 * h, h],
+        orders: Vec::new(),
+        richardson1_rel_max: 0.0,
+        richardson2_rel_max: 0.0,
+        plain_rel_max: 0.0,
+    };
+    for s in segments.iter().filter(|s| s.settles()) {
+        // The same reading (tail mean) of the dynamic model: within 1e-6 of ω*
+        // on a settled segment, and free of the residual transient.
+        let Some(ws) = tail_omega(reference, s.t_start, s.t_end) else {
+            continue;
+        };
+        let w = |tr: &Trajectory| tail_omega(tr, s.t_start, s.t_end);
+        let (Some(w1), Some(w2), Some(w4)) = (w(fine), w(&mid), w(&coarse)) else {
+            continue;
+        };
+        let p = ((w4 - w2).abs() / (w2 - w1).abs()).log2();
+        out.orders.push((s.index, p));
+        // Richardson with the scheme's order p, then once more for p + 1.
+        let k1 = 2f64.powf(order) - 1.0;
+        let k2 = 2f64.powf(order + 1.0) - 1.0;
+        let r1 = w1 + (w1 - w2) / k1;
+        let r1_coarse = w2 + (w2 - w4) / k1;
+        let r2 = r1 + (r1 - r1_coarse) / k2;
+        let e = |x: f64| rel_err(x, ws, s.speed, sc.froude_length());
+        out.richardson1_rel_max = out.richardson1_rel_max.max(e(r1));
+        out.richardson2_rel_max = out.richardson2_rel_max.max(e(r2));
+        out.plain_rel_max = out.plain_rel_max.max(e(w1));
+    }
+    Ok(out)
+}

@@ -1,0 +1,536 @@
+//! Running and comparing the models of one scenario.
+
+use std::time::{Duration, Instant};
+
+use pushval_engine::{Engine, EngineRun};
+use pushval_model::{
+    kinematic, limit_surface, DynamicModel, InertialTerm, Integrator, KinematicModel,
+    LimitSurfaceModel, ModelError, Problem, RootKind, SegmentDynamics, Simulator, SteadyState,
+    Trajectory,
+};
+use pushval_scenario::Scenario;
+
+use crate::registry;
+
+mod dt;
+
+pub use dt::{
+    choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, DtChoice, DtEstimate, DtSource,
+    DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
+};
+
+/// Settings of a harness run.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    /// Tolerance of the dynamic model's adaptive integrator. Default 1e-10.
+    pub model_tol: f64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self { model_tol: 1e-10 }
+    }
+}
+
+/// What one model produced.
+#[derive(Debug, Clone)]
+pub struct ModelRun {
+    /// The model's name (`"dynamic"`, `"rapier2d"`, …).
+    pub name: String,
+    /// Whether it is an engine model (from the registry).
+    pub engine: bool,
+    pub trajectory: Trajectory,
+    /// The settings that produced it, for the outputs.
+    pub settings: serde_json::Value,
+    /// Wall time of the run.
+    pub elapsed: Duration,
+    /// Engine diagnostics (joint drift, steps, convergence in dt); null for
+    /// the analytic models.
+    pub diagnostics: serde_json::Value,
+}
+
+/// The steady-state analysis of one push segment.
+#[derive(Debug, Clone)]
+pub struct SegmentInfo {
+    pub index: usize,
+    pub t_start: f64,
+    pub t_end: f64,
+    pub speed: f64,
+    pub phi: f64,
+    pub froude: f64,
+    /// `v_c ψ(φ)` (rad/s), None where ψ does not exist.
+    pub omega_kinematic: Option<f64>,
+    /// The ellipsoidal limit surface's ω (rad/s).
+    pub omega_limit_surface: f64,
+    /// All roots of ω̇, sorted, with their stability.
+    pub steady_states: Vec<SteadyState>,
+    /// The steady state the dynamic run converges to in this segment (None: runaway).
+    pub omega_steady: Option<SteadyState>,
+    /// ω at the start of the segment, just after the switch (rad/s).
+    pub omega_start: f64,
+    /// Relative distance of the dynamic model's tail-mean ω (last 20 % of the
+    /// segment) from ω*, with the floor of [`rel_err`]; None without a root.
+    pub tail_deviation: Option<f64>,
+}
+
+impl SegmentInfo {
+    /// Relaxation time τ (s) of the steady state reached, if smooth and stable.
+    pub fn tau(&self) -> Option<f64> {
+        self.omega_steady.and_then(|s| s.tau)
+    }
+    /// Whether a steady ω can be read off the segment's tail: a smooth stable
+    /// root, and the dynamic model's tail mean within 1e-6 (relative) of it.
+    pub fn settles(&self) -> bool {
+        matches!(
+            self.omega_steady,
+            Some(SteadyState {
+                kind: RootKind::Stable,
+                tau: Some(_),
+                ..
+            })
+        ) && self.tail_deviation.is_some_and(|d| d <= SETTLED_REL)
+    }
+}
+
+/// Largest relative deviation of the dynamic model's tail-mean ω from ω* for
+/// a segment to count as settled (100 times below the tightest engine target).
+pub const SETTLED_REL: f64 = 1e-6;
+
+/// One model measured against the dynamic model.
+#[derive(Debug, Clone)]
+pub struct Comparison {
+    pub model: String,
+    /// Largest centre-of-mass distance at the common samples (m).
+    pub position_max: f64,
+    /// Largest angle difference (rad).
+    pub theta_max: f64,
+    /// Largest relative steady-ω error over the settling segments (None when
+    /// no segment settles).
+    pub omega_steady_rel_max: Option<f64>,
+    /// Some(pass) when gated by the scenario's tolerance; None when informational.
+    pub pass: Option<bool>,
+    /// The figures that exceeded their tolerance.
+    pub failed: Vec<String>,
+    /// Why there is no comparison (the model failed to run), if so.
+    pub error: Option<String>,
+    /// Engine runs only: the steady ω extrapolated to dt → 0.
+    pub convergence: Option<Convergence>,
+}
+
+/// How an engine's steady ω converges as its time step shrinks: runs at 4h,
+/// 2h and h (h the gated run's step; runs the time-step search made are
+/// reused), the observed order `p = log2(|ω(4h) − ω(2h)| / |ω(2h) − ω(h)|)`, and Richardson extrapolations
+/// to dt → 0 with the scheme's expected order p: `ω(h) + (ω(h) − ω(2h)) / (2^p − 1)`,
+/// and the same applied again for the order p + 1 term.
+#[derive(Debug, Clone)]
+pub struct Convergence {
+    /// The order the friction-velocity scheme should show (1, or 2 for leapfrog).
+    pub expected_order: f64,
+    /// The three time steps (s), largest first.
+    pub dts: [f64; 3],
+    /// Observed order per settled segment.
+    pub orders: Vec<(usize, f64)>,
+    /// Largest relative error of the extrapolation at the expected order,
+    /// against the dynamic model's tail-mean ω (within 1e-6 of ω*).
+    pub richardson1_rel_max: f64,
+    /// The same after removing the next order as well.
+    pub richardson2_rel_max: f64,
+    /// The same for the plain run at h.
+    pub plain_rel_max: f64,
+}
+
+impl Convergence {
+    /// Median observed order over the settled segments.
+    pub fn order(&self) -> Option<f64> {
+        let mut o: Vec<f64> = self
+            .orders
+            .iter()
+            .map(|p| p.1)
+            .filter(|p| p.is_finite())
+            .collect();
+        o.sort_by(f64::total_cmp);
+        (!o.is_empty()).then(|| o[o.len() / 2])
+    }
+}
+
+/// Everything a scenario run produced.
+#[derive(Debug, Clone)]
+pub struct ScenarioReport {
+    pub scenario: Scenario,
+    pub segments: Vec<SegmentInfo>,
+    pub runs: Vec<ModelRun>,
+    pub comparisons: Vec<Comparison>,
+}
+
+impl ScenarioReport {
+    /// The dynamic model's run (always present).
+    pub fn dynamic(&self) -> &ModelRun {
+        self.runs
+            .iter()
+            .find(|r| r.name == "dynamic")
+            .expect("the dynamic model always runs")
+    }
+    /// False when a gated comparison failed.
+    pub fn pass(&self) -> bool {
+        self.comparisons.iter().all(|c| c.pass != Some(false))
+    }
+}
+
+/// The engine the report's figures draw beside the models: the scenario's
+/// first gated engine (the default gate when it gates none), with its
+/// `[engine]` settings.
+pub fn reference_engine(sc: &Scenario) -> Box<dyn Engine> {
+    let name = sc
+        .gate
+        .first()
+        .map_or(pushval_scenario::DEFAULT_GATE[0], String::as_str);
+    registry::engine(name, &sc.engine)
+}
+
+/// The analytic model called `name`, with its settings record; None for an
+/// engine model.
+fn analytic(name: &str, opts: &RunOptions) -> Option<(Box<dyn Simulator>, serde_json::Value)> {
+    match name {
+        "dynamic" => Some((
+            Box::new(DynamicModel {
+                integrator: Integrator::Dop853 {
+                    tol: opts.model_tol,
+                },
+                ..Default::default()
+            }),
+            serde_json::json!({"integrator": "dop853", "tolerance": opts.model_tol, "skip_settled": true}),
+        )),
+        "kinematic" => Some((Box::new(KinematicModel), serde_json::json!({}))),
+        "limit_surface" => Some((Box::new(LimitSurfaceModel), serde_json::json!({}))),
+        _ => None,
+    }
+}
+
+/// Steady ω per segment read off a trajectory: the mean ω over the last 20 %
+/// of the segment (samples strictly before its end).
+pub fn tail_omega(tr: &Trajectory, t_start: f64, t_end: f64) -> Option<f64> {
+    let from = t_end - 0.2 * (t_end - t_start);
+    let eps = 1e-9 * (t_end - t_start);
+    let w: Vec<f64> = tr
+        .samples
+        .iter()
+        .filter(|s| s.t >= from - eps && s.t < t_end - eps)
+        .map(|s| s.omega)
+        .collect();
+    (!w.is_empty()).then(|| w.iter().sum::<f64>() / w.len() as f64)
+}
+
+/// The steady-state analysis of every segment, following ω across switches.
+pub fn analyse_segments(
+    sc: &Scenario,
+    problem: &Problem,
+    dynamic: &Trajectory,
+) -> Vec<SegmentInfo> {
+    analyse_segments_with(sc, problem, dynamic, InertialTerm::Derived)
+}
+
+/// [`analyse_segments`] for a chosen reading of the inertial term.
+pub fn analyse_segments_with(
+    sc: &Scenario,
+    problem: &Problem,
+    dynamic: &Trajectory,
+    term: InertialTerm,
+) -> Vec<SegmentInfo> {
+    problem
+        .pushes
+        .iter()
+        .zip(problem.segment_times())
+        .enumerate()
+        .map(|(j, (push, (t0, t1)))| {
+            let seg = SegmentDynamics::with_inertial_term(&problem.body, push, term);
+            let roots = if push.speed > 0.0 {
+                seg.steady_states()
+            } else {
+                vec![]
+            };
+            let omega_start = dynamic.segments.get(j).map_or(0.0, |s| s.omega_start);
+            let omega_steady = if push.speed > 0.0 {
+                seg.attractor(&roots, omega_start)
+            } else {
+                None
+            };
+            let tail_deviation = omega_steady.and_then(|r| {
+                tail_omega(dynamic, t0, t1)
+                    .map(|w| rel_err(w, r.omega, push.speed, sc.froude_length()))
+            });
+            SegmentInfo {
+                index: j,
+                t_start: t0,
+                t_end: t1,
+                speed: push.speed,
+                phi: push.phi,
+                froude: sc.froude(push.speed),
+                omega_kinematic: kinematic::omega(&problem.body, push),
+                omega_limit_surface: limit_surface::omega(&problem.body, push),
+                omega_steady,
+                steady_states: roots,
+                omega_start,
+                tail_deviation,
+            }
+        })
+        .collect()
+}
+
+pub use pushval_engine::rel_err;
+
+/// Compares a model run with the dynamic model.
+pub fn compare(
+    sc: &Scenario,
+    segments: &[SegmentInfo],
+    reference: &Trajectory,
+    run: &ModelRun,
+    gated: bool,
+) -> Comparison {
+    let steady = if run.engine {
+        SteadyRead::TailMean
+    } else {
+        SteadyRead::SegmentEnd
+    };
+    compare_trajectory(
+        sc,
+        segments,
+        reference,
+        &run.name,
+        &run.trajectory,
+        steady,
+        gated,
+    )
+}
+
+/// How a trajectory's steady ω per segment is read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SteadyRead {
+    /// ω at the segment's end (analytic models: exact).
+    SegmentEnd,
+    /// Mean ω over the segment's last 20 % (engines, outside trajectories).
+    TailMean,
+}
+
+/// Compares any trajectory, named `name`, with a reference at common sample
+/// times, and its steady ω with the roots ω* of the settled segments.
+pub fn compare_trajectory(
+    sc: &Scenario,
+    segments: &[SegmentInfo],
+    reference: &Trajectory,
+    name: &str,
+    tr: &Trajectory,
+    steady: SteadyRead,
+    gated: bool,
+) -> Comparison {
+    let mut position_max: f64 = 0.0;
+    let mut theta_max: f64 = 0.0;
+    for (a, b) in tr.samples.iter().zip(&reference.samples) {
+        position_max = position_max.max(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt());
+        theta_max = theta_max.max((a.theta - b.theta).abs());
+    }
+    if tr.samples.len() != reference.samples.len() {
+        position_max = f64::INFINITY;
+        theta_max = f64::INFINITY;
+    }
+    let mut omega_rel: Option<f64> = None;
+    for s in segments.iter().filter(|s| s.settles()) {
+        let ws = s.omega_steady.expect("settles implies a root").omega;
+        let w = match steady {
+            SteadyRead::SegmentEnd => tr.segments.get(s.index).map(|r| r.omega_end),
+            SteadyRead::TailMean => tail_omega(tr, s.t_start, s.t_end),
+        };
+        if let Some(w) = w {
+            let e = rel_err(w, ws, s.speed, sc.froude_length());
+            omega_rel = Some(omega_rel.map_or(e, |m: f64| m.max(e)));
+        }
+    }
+    let tol = &sc.tolerance;
+    let mut failed = Vec::new();
+    if gated {
+        if !(position_max <= tol.position_max) {
+            failed.push(format!(
+                "position_max {position_max:.3e} m > {:.3e} m",
+                tol.position_max
+            ));
+        }
+        if !(theta_max <= tol.theta_max) {
+            failed.push(format!(
+                "theta_max {theta_max:.3e} rad > {:.3e} rad",
+                tol.theta_max
+            ));
+        }
+        if let Some(e) = omega_rel {
+            if !(e <= tol.omega_steady_rel) {
+                failed.push(format!(
+                    "omega_steady_rel_max {e:.3e} > {:.3e}",
+                    tol.omega_steady_rel
+                ));
+            }
+        }
+    }
+    Comparison {
+        model: name.into(),
+        position_max,
+        theta_max,
+        omega_steady_rel_max: omega_rel,
+        pass: gated.then_some(failed.is_empty()),
+        failed,
+        error: None,
+        convergence: None,
+    }
+}
+
+/// Runs every model the scenario asks for (the dynamic model always, as the
+/// reference) and compares each with the dynamic model. The engines named in
+/// `[run] gate` are gated by the scenario's `[tolerance]` at the time step
+/// [`choose_engine_dt`] picks, with the convergence check beside them; the
+/// other engines and the quasi-static models are informational; the dynamic
+/// row checks the integrated ω against the roots. The scenario must have
+/// passed [`crate::registry::check`].
+pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, ModelError> {
+    let problem = sc.problem();
+    let mut names: Vec<&str> = vec!["dynamic"];
+    names.extend(
+        sc.models
+            .iter()
+            .map(String::as_str)
+            .filter(|m| *m != "dynamic"),
+    );
+    let mut runs: Vec<ModelRun> = Vec::new();
+    let mut unavailable: Vec<(String, String)> = Vec::new();
+    let mut failures: Vec<(String, String)> = Vec::new();
+    // Per gated engine: the engine, its time step and the runs its choice made.
+    let mut gated_runs: Vec<(Box<dyn Engine>, f64, Vec<EngineRun>)> = Vec::new();
+    for name in names {
+        let gated = sc.gate.iter().any(|g| g == name);
+        if let Some((sim, settings)) = analytic(name, opts) {
+            let t0 = Instant::now();
+            match sim.simulate(&problem) {
+                Ok(trajectory) => runs.push(ModelRun {
+                    name: name.to_string(),
+                    engine: false,
+                    trajectory,
+                    settings,
+                    elapsed: t0.elapsed(),
+                    diagnostics: serde_json::Value::Null,
+                }),
+                Err(e) if name == "dynamic" => return Err(e),
+                Err(e) => failures.push((name.to_string(), e.to_string())),
+            }
+            continue;
+        }
+        let engine = registry::engine(name, &sc.engine);
+        if let Err(why) = engine.availability() {
+            unavailable.push((name.to_string(), why));
+            continue;
+        }
+        let result = if gated {
+            // The dynamic model ran first: its segments say which ones the
+            // gate reads a steady ω from.
+            let segments = analyse_segments(sc, &problem, &runs[0].trajectory);
+            choose_engine_dt(sc, engine.as_ref(), &problem, &segments).and_then(|(choice, done)| {
+                let run = match done.iter().find(|r| r.dt == choice.dt) {
+                    Some(r) => r.clone(),
+                    None => engine.run(&problem, choice.dt)?,
+                };
+                let mut settings = engine.settings(choice.dt);
+                settings["dt_source"] = serde_json::json!(match choice.source {
+                    DtSource::Scenario => "scenario",
+                    DtSource::Automatic => "automatic",
+                });
+                settings["dt_choice"] = choice.json(sc);
+                Ok((run, settings, Some(done)))
+            })
+        } else {
+            // Informational rows keep the adapter's step (or the scenario's):
+            // their findings (results/friction_models/) are stated at it.
+            let dt = engine.default_dt();
+            engine.run(&problem, dt).map(|run| {
+                let mut settings = engine.settings(dt);
+                settings["dt_source"] = serde_json::json!(if sc.engine.dt.is_some() {
+                    "scenario"
+                } else {
+                    "adapter default"
+                });
+                (run, settings, None)
+            })
+        };
+        match result {
+            Ok((run, settings, done)) => {
+                if let Some(done) = done {
+                    gated_runs.push((engine, run.dt, done));
+                }
+                runs.push(ModelRun {
+                    name: name.to_string(),
+                    engine: true,
+                    elapsed: run.wall_time,
+                    diagnostics: run.diagnostics,
+                    trajectory: run.trajectory,
+                    settings,
+                });
+            }
+            Err(e) => failures.push((name.to_string(), e.to_string())),
+        }
+    }
+    let reference = runs[0].trajectory.clone();
+    let segments = analyse_segments(sc, &problem, &reference);
+    let mut comparisons: Vec<Comparison> = runs
+        .iter()
+        .map(|r| {
+            let gated = r.engine && sc.gate.contains(&r.name);
+            compare(sc, &segments, &reference, r, gated)
+        })
+        .collect();
+    for (engine, h, done) in &gated_runs {
+        let run = runs
+            .iter()
+            .find(|r| r.name == engine.name())
+            .expect("a gated run is among the runs");
+        let conv = engine_convergence(
+            sc,
+            engine.as_ref(),
+            &problem,
+            &segments,
+            &run.trajectory,
+            &reference,
+            *h,
+            done,
+        )?;
+        for c in comparisons.iter_mut().filter(|c| c.model == engine.name()) {
+            c.convergence = Some(conv.clone());
+        }
+    }
+    for (name, e) in failures {
+        // An engine that blows up fails the gate and says where; an
+        // informational model's failure is reported without failing it.
+        let gated = sc.gate.contains(&name);
+        comparisons.push(Comparison {
+            model: name,
+            position_max: f64::NAN,
+            theta_max: f64::NAN,
+            omega_steady_rel_max: None,
+            pass: gated.then_some(false),
+            failed: vec![format!("run failed: {e}")],
+            error: Some(e),
+            convergence: None,
+        });
+    }
+    for (name, why) in unavailable {
+        comparisons.push(Comparison {
+            model: name,
+            position_max: f64::NAN,
+            theta_max: f64::NAN,
+            omega_steady_rel_max: None,
+            pass: None,
+            failed: vec![],
+            error: Some(format!("not available in this build: {why}")),
+            convergence: None,
+        });
+    }
+    Ok(ScenarioReport {
+        scenario: sc.clone(),
+        segments,
+        runs,
+        comparisons,
+    })
+}
