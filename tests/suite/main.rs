@@ -5,6 +5,7 @@ mod bad_input;
 mod cli;
 mod common;
 mod corpus;
+mod engines;
 mod gate;
 mod integrators;
 mod physics;
