@@ -66,6 +66,8 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "phi": num(s.phi),
                 "froude": num(s.froude),
                 "omega_kinematic": opt(s.omega_kinematic),
+                "kappa": opt(s.kappa),
+                "kappa_slope": opt(s.kappa_slope),
                 "omega_limit_surface": num(s.omega_limit_surface),
                 "omega_steady": opt(s.omega_steady.map(|r| r.omega)),
                 "tau": opt(s.tau()),

@@ -62,6 +62,13 @@ pub struct SegmentInfo {
     pub omega_kinematic: Option<f64>,
     /// The ellipsoidal limit surface's ω (rad/s).
     pub omega_limit_surface: f64,
+    /// κ = ω*/ω_kinematic (the steady state reached over the kinematic ω);
+    /// None where either is missing or ω_kinematic = 0 (|ω_kinematic| L ≤
+    /// 1e-12 v_c, rounding).
+    pub kappa: Option<f64>,
+    /// dκ/dFr as Fr → 0, in closed form (`pushval_model::kappa`); None where
+    /// ω_kinematic = 0 or the kinematic root is a pivot.
+    pub kappa_slope: Option<f64>,
     /// All roots of ω̇, sorted, with their stability.
     pub steady_states: Vec<SteadyState>,
     /// The steady state the dynamic run converges to in this segment (None: runaway).
@@ -258,6 +265,18 @@ pub fn analyse_segments_with(
                 tail_omega(dynamic, t0, t1)
                     .map(|w| rel_err(w, r.omega, push.speed, sc.froude_length()))
             });
+            let omega_kinematic = kinematic::omega(&problem.body, push);
+            // ω_kinematic = 0 within rounding (a push through the centre of
+            // friction): κ is undefined there.
+            let has_kinematic = omega_kinematic
+                .is_some_and(|w| w.abs() * sc.froude_length() > 1e-12 * push.speed);
+            let kappa = match (omega_steady, omega_kinematic) {
+                (Some(s), Some(k)) if has_kinematic => Some(s.omega / k),
+                _ => None,
+            };
+            let kappa_slope = has_kinematic
+                .then(|| pushval_model::kappa_series(&problem.body, push.phi).map(|k| k.kappa1))
+                .flatten();
             SegmentInfo {
                 index: j,
                 t_start: t0,
@@ -265,7 +284,9 @@ pub fn analyse_segments_with(
                 speed: push.speed,
                 phi: push.phi,
                 froude: sc.froude(push.speed),
-                omega_kinematic: kinematic::omega(&problem.body, push),
+                omega_kinematic,
+                kappa,
+                kappa_slope,
                 omega_limit_surface: limit_surface::omega(&problem.body, push),
                 omega_steady,
                 steady_states: roots,

@@ -7,6 +7,7 @@ mod common;
 mod corpus;
 mod engines;
 mod gate;
+mod kappa;
 mod integrators;
 mod physics;
 mod properties;
