@@ -268,8 +268,8 @@ pub fn analyse_segments_with(
             let omega_kinematic = kinematic::omega(&problem.body, push);
             // ω_kinematic = 0 within rounding (a push through the centre of
             // friction): κ is undefined there.
-            let has_kinematic = omega_kinematic
-                .is_some_and(|w| w.abs() * sc.froude_length() > 1e-12 * push.speed);
+            let has_kinematic =
+                omega_kinematic.is_some_and(|w| w.abs() * sc.froude_length() > 1e-12 * push.speed);
             let kappa = match (omega_steady, omega_kinematic) {
                 (Some(s), Some(k)) if has_kinematic => Some(s.omega / k),
                 _ => None,

@@ -32,12 +32,24 @@ fn kappa_slope_is_the_small_froude_limit_of_the_exact_kappa() {
         let (Some(k1), Some(k2), Some(slope)) = (a.kappa, b.kappa, a.kappa_slope) else {
             continue;
         };
-        assert_eq!(a.kappa_slope, b.kappa_slope, "the slope does not depend on speed");
+        assert_eq!(
+            a.kappa_slope, b.kappa_slope,
+            "the slope does not depend on speed"
+        );
         let e1 = ((k1 - 1.0) / fr1 - slope).abs();
         let e2 = ((k2 - 1.0) / fr2 - slope).abs();
         // (κ − 1)/Fr − κ1 = κ2 Fr + O(Fr²): halves with Fr.
-        assert!(e1 < 0.05 * slope.abs(), "segment {}: {e1} vs slope {slope}", a.index);
-        assert!((e1 / e2 - 2.0).abs() < 0.05, "segment {}: ratio {}", a.index, e1 / e2);
+        assert!(
+            e1 < 0.05 * slope.abs(),
+            "segment {}: {e1} vs slope {slope}",
+            a.index
+        );
+        assert!(
+            (e1 / e2 - 2.0).abs() < 0.05,
+            "segment {}: ratio {}",
+            a.index,
+            e1 / e2
+        );
         checked += 1;
     }
     assert!(checked >= 3, "only {checked} segments with a kinematic ω");
@@ -50,11 +62,18 @@ fn summary_carries_kappa_where_the_kinematic_omega_exists() {
     let r = run_scenario(&sc, &RunOptions::default()).unwrap();
     let summary = pushval::output::summary(&r);
     let mut nulls = 0;
-    for (s, j) in r.segments.iter().zip(summary["segments"].as_array().unwrap()) {
+    for (s, j) in r
+        .segments
+        .iter()
+        .zip(summary["segments"].as_array().unwrap())
+    {
         let l = sc.froude_length();
         match (s.omega_kinematic, s.omega_steady) {
             (Some(k), _) if k.abs() * l <= 1e-12 * s.speed || k.abs() * l >= 1e-9 * s.speed => {}
-            _ => panic!("segment {}: ω_kinematic within rounding of the threshold", s.index),
+            _ => panic!(
+                "segment {}: ω_kinematic within rounding of the threshold",
+                s.index
+            ),
         }
         match (s.omega_kinematic, s.omega_steady) {
             (Some(k), Some(w)) if k.abs() * l > 1e-12 * s.speed => {
