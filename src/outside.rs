@@ -139,6 +139,9 @@ pub fn compare_outside(
                 samples.len()
             );
         }
+        if let Some(w) = start_mismatch(&sc, &report, name, samples) {
+            eprintln!("warning: {}: {w}", file.display());
+        }
         let tr = Trajectory {
             model: name.clone(),
             samples: samples.clone(),
@@ -159,4 +162,61 @@ pub fn compare_outside(
         }
     }
     Ok((report, out))
+}
+
+/// Whether an outside trajectory starts as the scenario does: its first
+/// sample's pose and ω, and its first step's displacement, against the
+/// dynamic model's. The commonest mistake is a run that starts at rest where
+/// the scenario starts already moving with the pusher (`from_rest = false`),
+/// or the other way round. Returns a message saying what differs.
+pub fn start_mismatch(
+    sc: &Scenario,
+    report: &ScenarioReport,
+    name: &str,
+    samples: &[Sample],
+) -> Option<String> {
+    let model = &report.dynamic().trajectory.samples;
+    if samples.len() < 2 || model.len() < 2 {
+        return None;
+    }
+    let (a0, a1, b0, b1) = (&samples[0], &samples[1], &model[0], &model[1]);
+    let tol = &sc.tolerance;
+    let init = &sc.initial;
+    let state = if init.from_rest {
+        "at rest when the pusher starts (from_rest = true)".to_string()
+    } else {
+        format!(
+            "moving with the pusher at omega = {} rad/s (from_rest = false)",
+            init.omega
+        )
+    };
+    let mut what = Vec::new();
+    let dp0 = ((a0.x - b0.x).powi(2) + (a0.y - b0.y).powi(2)).sqrt();
+    if dp0 > tol.position_max || (a0.theta - b0.theta).abs() > tol.theta_max {
+        what.push(format!(
+            "its first sample is at ({:.4}, {:.4}) m, theta = {:.4} rad; the scenario's [initial] is ({:.4}, {:.4}) m, theta = {:.4} rad",
+            a0.x, a0.y, a0.theta, b0.x, b0.y, b0.theta
+        ));
+    }
+    let w_scale = b0.omega.abs().max(b1.omega.abs()).max(1e-3);
+    if (a0.omega - b0.omega).abs() > 0.1 * w_scale {
+        what.push(format!(
+            "its omega at t = 0 is {:.4} rad/s, the model's {:.4} rad/s",
+            a0.omega, b0.omega
+        ));
+    }
+    let step = |p: &Sample, q: &Sample| ((q.x - p.x).powi(2) + (q.y - p.y).powi(2)).sqrt();
+    let (sa, sb) = (step(a0, a1), step(b0, b1));
+    if (sa - sb).abs() > 0.25 * sb.max(1e-12) && (sa - sb).abs() > 0.1 * tol.position_max {
+        what.push(format!(
+            "its centre of mass moves {sa:.3e} m over the first {} s, the model's {sb:.3e} m",
+            sc.sample_dt
+        ));
+    }
+    (!what.is_empty()).then(|| {
+        format!(
+            "model `{name}` does not start as the scenario does: {}. The scenario starts {state}; check [initial] (a trajectory that starts at rest where the scenario starts sliding with the pusher is the commonest cause)",
+            what.join("; ")
+        )
+    })
 }

@@ -5,8 +5,8 @@ use std::time::{Duration, Instant};
 use pushval_engine::{Engine, EngineRun};
 use pushval_model::{
     kinematic, limit_surface, DynamicModel, InertialTerm, Integrator, KinematicModel,
-    LimitSurfaceModel, ModelError, Problem, RootKind, SegmentDynamics, Simulator, SteadyState,
-    Trajectory,
+    LimitSurfaceModel, ModelError, Problem, RootKind, Sample, SegmentDynamics, Simulator,
+    SteadyState, Trajectory,
 };
 use pushval_scenario::Scenario;
 
@@ -354,6 +354,7 @@ pub fn compare_trajectory(
         theta_max = f64::INFINITY;
     }
     let mut omega_rel: Option<f64> = None;
+    let mut steady_errors: Vec<(usize, f64)> = Vec::new();
     for s in segments.iter().filter(|s| s.settles()) {
         let ws = s.omega_steady.expect("settles implies a root").omega;
         let w = match steady {
@@ -363,27 +364,55 @@ pub fn compare_trajectory(
         if let Some(w) = w {
             let e = rel_err(w, ws, s.speed, sc.froude_length());
             omega_rel = Some(omega_rel.map_or(e, |m: f64| m.max(e)));
+            steady_errors.push((s.index, e));
         }
     }
     let tol = &sc.tolerance;
     let mut failed = Vec::new();
     if gated {
+        // Where each failing figure first exceeds its tolerance: the first
+        // sample time and its segment (a switch time belongs to the segment
+        // it starts), or the first settled segment past the steady tolerance.
+        let times = sc.problem().segment_times();
+        let segment_of = |t: f64| {
+            times
+                .iter()
+                .position(|&(_, t1)| t < t1 - 1e-9 * t1.max(1.0))
+                .unwrap_or(times.len().saturating_sub(1))
+        };
+        let first = |exceeds: &dyn Fn(&Sample, &Sample) -> bool| {
+            tr.samples
+                .iter()
+                .zip(&reference.samples)
+                .find(|(a, b)| exceeds(a, b))
+                .map_or(String::new(), |(a, _)| {
+                    format!(" (first at t = {:.3} s, segment {})", a.t, segment_of(a.t))
+                })
+        };
         if !(position_max <= tol.position_max) {
+            let at = first(&|a, b| {
+                !(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt() <= tol.position_max)
+            });
             failed.push(format!(
-                "position_max {position_max:.3e} m > {:.3e} m",
+                "position_max {position_max:.3e} m > {:.3e} m{at}",
                 tol.position_max
             ));
         }
         if !(theta_max <= tol.theta_max) {
+            let at = first(&|a, b| !((a.theta - b.theta).abs() <= tol.theta_max));
             failed.push(format!(
-                "theta_max {theta_max:.3e} rad > {:.3e} rad",
+                "theta_max {theta_max:.3e} rad > {:.3e} rad{at}",
                 tol.theta_max
             ));
         }
         if let Some(e) = omega_rel {
             if !(e <= tol.omega_steady_rel) {
+                let at = steady_errors
+                    .iter()
+                    .find(|(_, e)| !(*e <= tol.omega_steady_rel))
+                    .map_or(String::new(), |(j, _)| format!(" (first in segment {j})"));
                 failed.push(format!(
-                    "omega_steady_rel_max {e:.3e} > {:.3e}",
+                    "omega_steady_rel_max {e:.3e} > {:.3e}{at}",
                     tol.omega_steady_rel
                 ));
             }

@@ -130,6 +130,10 @@ fn compare_gates_an_outside_trajectory() {
         "{}",
         String::from_utf8_lossy(&st.stdout)
     );
+    assert!(
+        !String::from_utf8_lossy(&st.stderr).contains("warning"),
+        "the model's own start is the scenario's"
+    );
     let bad = dir.path().join("bad.csv");
     std::fs::write(&bad, pick("kinematic")).unwrap();
     let st = pushval()
@@ -140,7 +144,13 @@ fn compare_gates_an_outside_trajectory() {
         .output()
         .unwrap();
     assert_eq!(st.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&st.stderr).contains("mine vs dynamic: position_max"));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(err.contains("mine vs dynamic: position_max"), "{err}");
+    // Where it first fails: the kinematic model departs in the first segment.
+    assert!(
+        err.contains("(first at t = ") && err.contains(", segment 0)"),
+        "{err}"
+    );
     let broken = dir.path().join("broken.csv");
     std::fs::write(&broken, "model,t,x,y,theta,omega\nmine,0,0,0,zero,0\n").unwrap();
     let st = pushval()
@@ -174,4 +184,53 @@ fn junit_report_names_the_failing_figure() {
     assert_eq!(x.matches("<testcase ").count(), 4, "{x}");
     assert_eq!(x.matches("<failure ").count(), 1);
     assert!(x.contains("name=\"rapier2d\"") && x.contains("theta_max"));
+}
+
+/// The commonest mistake: an outside run that starts at rest where the
+/// scenario starts already sliding with the pusher. `compare` warns and
+/// says what to check, and the failure says when and in which segment the
+/// trajectory first leaves the tolerance.
+#[test]
+fn compare_warns_when_the_outside_run_starts_differently() {
+    let dir = tempfile::tempdir().unwrap();
+    let scen = root().join("scenarios/paper-square-v1.0.toml");
+    let text = std::fs::read_to_string(&scen).unwrap();
+    assert!(!text.contains("from_rest"));
+    // The same scene started at rest (the pusher's impulse sets it moving).
+    let at_rest = dir.path().join("at-rest.toml");
+    std::fs::write(&at_rest, format!("{text}\n[initial]\nfrom_rest = true\n")).unwrap();
+    let out = dir.path().join("run");
+    let st = pushval()
+        .args(["run"])
+        .arg(&at_rest)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    let mut mine = String::from("model,t,x,y,theta,omega\n");
+    for l in csv.lines().filter(|l| l.starts_with("dynamic,")) {
+        mine.push_str(&l.replacen("dynamic", "mine", 1));
+        mine.push('\n');
+    }
+    let path = dir.path().join("mine.csv");
+    std::fs::write(&path, mine).unwrap();
+    let st = pushval()
+        .arg("compare")
+        .arg(&scen)
+        .arg("--trajectory")
+        .arg(&path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("warning:") && err.contains("does not start as the scenario does"),
+        "{err}"
+    );
+    assert!(err.contains("from_rest = false"), "{err}");
 }
