@@ -1,0 +1,225 @@
+//! Every engine's cost against its accuracy. For each engine model in this
+//! build (through the registry and the `Engine` trait; nothing here names an
+//! engine) and each time step of a ladder, the scene of
+//! `scenarios/friction-engines.toml` (the paper plate pushed at a corner,
+//! 0.5 m/s, φ = π/4 + 0.3, 6 s) is run repeatedly and measured side by side
+//! in one process:
+//!
+//! * cost: the median thread CPU time of the run, per simulated second;
+//! * accuracy against the dynamic model: the relative steady-ω error (mean
+//!   ω over the last 20 % of the push against the root ω*) and the largest
+//!   centre-of-mass distance over the samples (m).
+//!
+//! Writes `results/engine_work_precision.csv` (one row per engine, mode and
+//! dt), `results/engine_work_precision.svg` and
+//! `results/engine_work_precision_summary.csv`: per engine, the cheapest
+//! row at ≤ 1e-3 relative steady-ω error (if any) and the exponent b of
+//! cost ∝ dt^(−b) fitted over the ladder.
+//!
+//! `cargo bench --bench engine_work_precision` (add `-- --quick` for one
+//! repeat and a shorter ladder). With `--features mujoco` the MuJoCo rows are
+//! measured too.
+
+use std::time::Duration;
+
+use pushval::harness::{analyse_segments, rel_err, tail_omega};
+use pushval::registry;
+use pushval_model::{DynamicModel, Simulator};
+
+/// The steady-ω error at which the summary names the cheapest engine.
+const TARGET: f64 = 1e-3;
+
+/// CPU time of the calling thread (`CLOCK_THREAD_CPUTIME_ID`): not inflated
+/// by other processes waiting for the same cores.
+fn thread_cpu_time() -> Duration {
+    let ts = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
+}
+
+struct Row {
+    engine: String,
+    version: String,
+    dt: f64,
+    cpu_per_sim_s: f64,
+    omega_rel: f64,
+    position: f64,
+    steps: usize,
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sc = registry::load(root.join("scenarios/friction-engines.toml")).expect("scenario loads");
+    let problem = sc.problem();
+    let duration = problem.duration();
+    let reference = DynamicModel::default()
+        .simulate(&problem)
+        .expect("model runs");
+    let segments = analyse_segments(&sc, &problem, &reference);
+    let seg = &segments[0];
+    let w_star = seg.omega_steady.expect("the push settles").omega;
+    let ladder: Vec<f64> = if quick {
+        vec![1.0 / 60.0, 1.0 / 240.0]
+    } else {
+        vec![
+            1.0 / 60.0,
+            1.0 / 120.0,
+            1.0 / 240.0,
+            1.0 / 480.0,
+            1.0 / 960.0,
+            1.0 / 1920.0,
+        ]
+    };
+    let repeats = if quick { 1 } else { 5 };
+    let mut rows = Vec::new();
+    for entry in registry::entries() {
+        let engine = (entry.build)(&Default::default()).expect("default options");
+        if let Err(why) = engine.availability() {
+            eprintln!("{}: skipped ({why})", entry.name);
+            continue;
+        }
+        for &dt in &ladder {
+            let mut times = Vec::new();
+            let mut last = None;
+            for _ in 0..repeats {
+                let t0 = thread_cpu_time();
+                let r = engine.run(&problem, dt);
+                times.push((thread_cpu_time() - t0).as_secs_f64());
+                last = Some(r);
+            }
+            let run = match last.expect("ran") {
+                Ok(r) => r,
+                Err(e) => {
+                    eprintln!("{} at dt = {dt:.3e}: {e}", entry.name);
+                    continue;
+                }
+            };
+            times.sort_by(f64::total_cmp);
+            let tr = &run.trajectory;
+            let w = tail_omega(tr, seg.t_start, seg.t_end).unwrap_or(f64::NAN);
+            let position = tr
+                .samples
+                .iter()
+                .zip(&reference.samples)
+                .map(|(p, q)| ((p.x - q.x).powi(2) + (p.y - q.y).powi(2)).sqrt())
+                .fold(0.0, f64::max);
+            let row = Row {
+                engine: entry.name.to_string(),
+                version: engine.version(),
+                dt,
+                cpu_per_sim_s: times[times.len() / 2] / duration,
+                omega_rel: rel_err(w, w_star, seg.speed, sc.froude_length()),
+                position,
+                steps: run.steps,
+            };
+            eprintln!(
+                "{:28} dt {:.3e}  {:.3e} s/s  omega {:.2e}  position {:.2e} m",
+                row.engine, row.dt, row.cpu_per_sim_s, row.omega_rel, row.position
+            );
+            rows.push(row);
+        }
+    }
+    if quick {
+        return;
+    }
+    let mut csv = String::from(
+        "engine,version,dt_s,cpu_s_per_simulated_s,omega_steady_rel_err,position_err_m,steps\n",
+    );
+    for r in &rows {
+        csv.push_str(&format!(
+            "{},{},{:.6e},{:.4e},{:.4e},{:.4e},{}\n",
+            r.engine, r.version, r.dt, r.cpu_per_sim_s, r.omega_rel, r.position, r.steps
+        ));
+    }
+    let mut names: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();
+    names.dedup();
+    let mut summary = String::from(
+        "engine,cheapest_dt_at_1e-3_s,cheapest_cpu_s_per_simulated_s_at_1e-3,cost_exponent_b\n",
+    );
+    for name in &names {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.engine == *name).collect();
+        let best = mine
+            .iter()
+            .filter(|r| r.omega_rel <= TARGET)
+            .min_by(|a, b| a.cpu_per_sim_s.total_cmp(&b.cpu_per_sim_s));
+        // Least-squares slope of ln(cost) against ln(1/dt).
+        let pts: Vec<(f64, f64)> = mine
+            .iter()
+            .map(|r| ((1.0 / r.dt).ln(), r.cpu_per_sim_s.ln()))
+            .collect();
+        let n = pts.len() as f64;
+        let (mx, my) = (
+            pts.iter().map(|p| p.0).sum::<f64>() / n,
+            pts.iter().map(|p| p.1).sum::<f64>() / n,
+        );
+        let b = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+            / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+        summary.push_str(&format!(
+            "{name},{},{},{b:.3}\n",
+            best.map_or("".into(), |r| format!("{:.6e}", r.dt)),
+            best.map_or("".into(), |r| format!("{:.4e}", r.cpu_per_sim_s)),
+        ));
+    }
+    let out = root.join("results");
+    pushval::output::write_atomic(&out.join("engine_work_precision.csv"), csv.as_bytes())
+        .expect("write csv");
+    pushval::output::write_atomic(
+        &out.join("engine_work_precision_summary.csv"),
+        summary.as_bytes(),
+    )
+    .expect("write summary");
+    pushval::output::write_atomic(
+        &out.join("engine_work_precision.svg"),
+        figure(&rows, &names).as_bytes(),
+    )
+    .expect("write svg");
+    print!("{summary}");
+}
+
+/// Log–log figure: steady-ω error (left) and position error (right)
+/// against CPU time per simulated second, one line per engine model.
+fn figure(rows: &[Row], names: &[&str]) -> String {
+    use pushval::report::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
+    let panel = |title: &str, ylabel: &str, pick: &dyn Fn(&Row) -> f64| {
+        let mut p = Panel::new(
+            title,
+            Axis::log("CPU time per simulated second (s/s)"),
+            Axis::log(ylabel),
+        )
+        .legend(Legend::UpperRight);
+        for (k, name) in names.iter().enumerate() {
+            let mut pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.engine == *name)
+                .map(|r| (r.cpu_per_sim_s, pick(r).max(1e-12)))
+                .filter(|p| p.1.is_finite())
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let stroke = if k < PALETTE.len() {
+                Stroke::Solid
+            } else {
+                Stroke::Dashed
+            };
+            p = p.series(Series::new(*name, PALETTE[k % PALETTE.len()], stroke).points(pts));
+        }
+        p
+    };
+    let fig = Figure {
+        size: (1400, 620),
+        cols: 2,
+        panels: vec![
+            panel(
+                "Engines: steady-ω error against cost (paper plate, 0.5 m/s, 6 s)",
+                "relative steady-ω error vs the dynamic model",
+                &|r| r.omega_rel,
+            ),
+            panel(
+                "Engines: position error against cost",
+                "max CM position error vs the dynamic model (m)",
+                &|r| r.position,
+            ),
+        ],
+        key: None,
+    };
+    pushval::report::plot::render(&fig).expect("figure renders")
+}
