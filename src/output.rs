@@ -103,6 +103,7 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "wall_time_s": run.map_or(Value::Null, |r| num(r.elapsed.as_secs_f64())),
                 "rhs_evals": run.map(|r| r.trajectory.stats.rhs_evals),
                 "diagnostics": run.map_or(Value::Null, |r| r.diagnostics.clone()),
+                "tolerance": c.tolerance.as_ref().map_or(Value::Null, |t| t.json()),
                 "convergence": c.convergence.as_ref().map_or(Value::Null, |v| json!({
                     "dts": v.dts,
                     "expected_order": v.expected_order,
@@ -132,9 +133,9 @@ pub fn summary(report: &ScenarioReport) -> Value {
             "froude_length": num(sc.froude_length()),
             "effective_mu": num(sc.effective_mu()),
             "tolerance": {
-                "omega_steady_rel": num(sc.tolerance.omega_steady_rel),
-                "position_max": num(sc.tolerance.position_max),
-                "theta_max": num(sc.tolerance.theta_max),
+                "omega_steady_rel": limit(sc.tolerance.omega_steady_rel),
+                "position_max": limit(sc.tolerance.position_max),
+                "theta_max": limit(sc.tolerance.theta_max),
             },
         },
         "segments": segments,
@@ -244,6 +245,18 @@ pub fn table(reports: &[ScenarioReport]) -> String {
                 notes.push(e.clone());
             }
             notes.extend(c.failed.iter().cloned());
+            if let (Some(t), true) = (&c.tolerance, c.failed.is_empty()) {
+                let src = |k: usize| t.source[k].as_str();
+                notes.push(format!(
+                    "tolerance {} m ({}), {} rad ({}), {} ({})",
+                    fmt_e(t.value.position_max),
+                    src(0),
+                    fmt_e(t.value.theta_max),
+                    src(1),
+                    fmt_e(t.value.omega_steady_rel),
+                    src(2)
+                ));
+            }
             if c.model == "dynamic" && !flags.is_empty() {
                 notes.push(format!("assumptions fail: {}", flags.join(", ")));
             }
@@ -342,4 +355,9 @@ pub fn junit(reports: &[ScenarioReport]) -> String {
     format!(
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"pushval\" tests=\"{cases}\" failures=\"{failures}\">\n{body}</testsuites>\n"
     )
+}
+
+/// A `[tolerance]` figure as the file gives it: its number, or `"auto"`.
+fn limit(l: pushval_scenario::Limit) -> Value {
+    l.value().map_or(Value::from("auto"), num)
 }

@@ -9,7 +9,8 @@ use pushval_model::{Sample, Trajectory};
 use pushval_scenario::Scenario;
 
 use crate::harness::{
-    compare_trajectory, run_scenario, Comparison, RunOptions, ScenarioReport, SteadyRead,
+    compare_trajectory, run_scenario, tolerance, Comparison, Resolved, RunOptions, ScenarioReport,
+    SteadyRead,
 };
 
 /// The trajectories of an outside CSV file, per value of its `model` column.
@@ -121,6 +122,7 @@ pub fn compare_outside(
         .chain(sc.gate.iter().cloned())
         .collect();
     let report = run_scenario(&sc, &RunOptions::default()).context("running the models")?;
+    let tol = outside_tolerance(&sc, &report);
     let times = sc.problem().sample_times();
     let mut out = Vec::new();
     for (name, samples) in &outside.runs {
@@ -139,7 +141,7 @@ pub fn compare_outside(
                 samples.len()
             );
         }
-        if let Some(w) = start_mismatch(&sc, &report, name, samples) {
+        if let Some(w) = start_mismatch(&sc, &tol, &report, name, samples) {
             eprintln!("warning: {}: {w}", file.display());
         }
         let tr = Trajectory {
@@ -148,6 +150,14 @@ pub fn compare_outside(
             ..Default::default()
         };
         for run in &report.runs {
+            // Against a gated engine: that engine's tolerances; against the
+            // dynamic model: the loosest of the gated engines'.
+            let own = report
+                .comparisons
+                .iter()
+                .find(|c| c.model == run.name)
+                .and_then(|c| c.tolerance.clone())
+                .unwrap_or_else(|| tol.clone());
             let mut c = compare_trajectory(
                 &sc,
                 &report.segments,
@@ -155,9 +165,10 @@ pub fn compare_outside(
                 name,
                 &tr,
                 SteadyRead::TailMean,
-                true,
+                Some(&own.value),
             );
             c.model = format!("{name} vs {}", run.name);
+            c.tolerance = Some(own);
             out.push(c);
         }
     }
@@ -171,6 +182,7 @@ pub fn compare_outside(
 /// or the other way round. Returns a message saying what differs.
 pub fn start_mismatch(
     sc: &Scenario,
+    tol: &Resolved,
     report: &ScenarioReport,
     name: &str,
     samples: &[Sample],
@@ -180,7 +192,7 @@ pub fn start_mismatch(
         return None;
     }
     let (a0, a1, b0, b1) = (&samples[0], &samples[1], &model[0], &model[1]);
-    let tol = &sc.tolerance;
+    let tol = &tol.value;
     let init = &sc.initial;
     let state = if init.from_rest {
         "at rest when the pusher starts (from_rest = true)".to_string()
@@ -219,4 +231,32 @@ pub fn start_mismatch(
             what.join("; ")
         )
     })
+}
+
+/// The tolerances an outside trajectory is held to against the dynamic
+/// model, resolved as `validate` resolves them: the loosest of the gated
+/// engines' (each figure separately), or, with no gated engine, the
+/// scenario's numbers and the auto rule without an engine estimate.
+pub fn outside_tolerance(sc: &Scenario, report: &ScenarioReport) -> Resolved {
+    let gated: Vec<&Resolved> = report
+        .comparisons
+        .iter()
+        .filter_map(|c| c.tolerance.as_ref())
+        .collect();
+    let Some(first) = gated.first() else {
+        let problem = sc.problem();
+        let model = tolerance::model_error(
+            &problem,
+            &report.dynamic().trajectory,
+            RunOptions::default().model_tol,
+        );
+        return tolerance::resolve(sc, None, model);
+    };
+    let mut out = (*first).clone();
+    for r in &gated[1..] {
+        out.value.position_max = out.value.position_max.max(r.value.position_max);
+        out.value.theta_max = out.value.theta_max.max(r.value.theta_max);
+        out.value.omega_steady_rel = out.value.omega_steady_rel.max(r.value.omega_steady_rel);
+    }
+    out
 }

@@ -8,6 +8,7 @@ use pushval_engine::{Engine, EngineRun};
 use pushval_model::{ModelError, Problem, Trajectory};
 use pushval_scenario::Scenario;
 
+use super::tolerance::{ladder_targets, Figures};
 use super::{rel_err, tail_omega, Convergence, SegmentInfo};
 
 /// The largest engine time step the automatic choice tries (s): 1/60 s,
@@ -66,7 +67,8 @@ pub struct DtEstimate {
     /// reads a steady ω from (tail means; denominator the run at h/2 with
     /// [`rel_err`]'s floor); None when no segment settles.
     pub omega_steady_rel_max: Option<f64>,
-    /// Whether every figure is within [`DT_FRACTION`] of its tolerance.
+    /// Whether every figure is within its ladder target
+    /// ([`DT_FRACTION`] of a number in `[tolerance]`, or the auto target).
     pub meets: bool,
 }
 
@@ -84,6 +86,8 @@ pub struct DtChoice {
     pub met: bool,
     /// The scheme's order used in the estimate.
     pub order: f64,
+    /// What each figure's estimate had to be within.
+    pub targets: Figures,
     /// Wall time of the search's engine runs (the chosen run and its h/2
     /// partner included).
     pub search_time: Duration,
@@ -91,34 +95,36 @@ pub struct DtChoice {
 
 impl DtChoice {
     /// One line saying which dt and why.
-    pub fn reason(&self, sc: &Scenario) -> String {
-        let t = &sc.tolerance;
-        let f = DT_FRACTION;
+    pub fn reason(&self) -> String {
+        let t = &self.targets;
         let figures = |e: &DtEstimate| {
             format!(
                 "position {:.2e} m, theta {:.2e} rad, steady omega {} (targets {:.2e} m, {:.2e} rad, {:.2e})",
                 e.position_max,
                 e.theta_max,
                 e.omega_steady_rel_max.map_or("-".into(), |w| format!("{w:.2e}")),
-                f * t.position_max,
-                f * t.theta_max,
-                f * t.omega_steady_rel
+                t.position_max,
+                t.theta_max,
+                t.omega_steady_rel
             )
         };
         match (self.source, self.rungs.last()) {
-            (DtSource::Scenario, _) | (_, None) => {
-                format!("dt = {} s set by the scenario's [engine] dt", self.dt)
-            }
+            (DtSource::Scenario, last) => format!(
+                "dt = {} s set by the scenario's [engine] dt{}",
+                self.dt,
+                last.map_or(String::new(), |e| format!("; estimate {}", figures(e)))
+            ),
+            (_, None) => format!("dt = {} s", self.dt),
             (DtSource::Automatic, Some(last)) => {
                 let mut s = if self.met {
                     format!(
-                        "dt = {:.4e} s: the largest ladder rung whose self-convergence estimate is within {f} of the tolerances: {}",
+                        "dt = {:.4e} s: the largest ladder rung whose self-convergence estimate meets its targets: {}",
                         self.dt,
                         figures(last)
                     )
                 } else {
                     format!(
-                        "dt = {:.4e} s (the ladder's floor) although its estimate misses {f} of the tolerances: {}",
+                        "dt = {:.4e} s (the ladder's floor) although its estimate misses its targets: {}",
                         self.dt,
                         figures(last)
                     )
@@ -133,7 +139,7 @@ impl DtChoice {
     }
 
     /// The record written into the engine's settings in `summary.json`.
-    pub fn json(&self, sc: &Scenario) -> serde_json::Value {
+    pub fn json(&self) -> serde_json::Value {
         use crate::output::num;
         let rungs: Vec<serde_json::Value> = self
             .rungs
@@ -148,21 +154,21 @@ impl DtChoice {
                 })
             })
             .collect();
-        let t = &sc.tolerance;
+        let t = &self.targets;
         serde_json::json!({
             "source": match self.source {
                 DtSource::Scenario => "scenario",
                 DtSource::Automatic => "automatic",
             },
-            "reason": self.reason(sc),
-            "criterion": "Richardson self-convergence estimate |X(h) - X(h/2)| 2^p / (2^p - 1) of each gated figure within fraction x [tolerance]",
+            "reason": self.reason(),
+            "criterion": "Richardson self-convergence estimate |X(h) - X(h/2)| 2^p / (2^p - 1) of each gated figure within its target: fraction x [tolerance] for a number, the auto target for \"auto\"",
             "fraction": DT_FRACTION,
             "order": self.order,
             "ladder": dt_ladder(),
             "targets": {
-                "position_max": num(DT_FRACTION * t.position_max),
-                "theta_max": num(DT_FRACTION * t.theta_max),
-                "omega_steady_rel": num(DT_FRACTION * t.omega_steady_rel),
+                "position_max": num(t.position_max),
+                "theta_max": num(t.theta_max),
+                "omega_steady_rel": num(t.omega_steady_rel),
             },
             "met": self.met,
             "rungs": rungs,
@@ -205,10 +211,10 @@ pub fn dt_estimate(
     }
     let (position_max, theta_max) = (k * position_max, k * theta_max);
     let omega_steady_rel_max = omega.map(|e| k * e);
-    let t = &sc.tolerance;
-    let meets = position_max <= DT_FRACTION * t.position_max
-        && theta_max <= DT_FRACTION * t.theta_max
-        && omega_steady_rel_max.is_none_or(|e| e <= DT_FRACTION * t.omega_steady_rel);
+    let t = ladder_targets(sc, DT_FRACTION);
+    let meets = position_max <= t.position_max
+        && theta_max <= t.theta_max
+        && omega_steady_rel_max.is_none_or(|e| e <= t.omega_steady_rel);
     DtEstimate {
         dt: h,
         position_max,
@@ -232,18 +238,24 @@ pub fn choose_engine_dt(
     segments: &[SegmentInfo],
 ) -> Result<(DtChoice, Vec<EngineRun>), ModelError> {
     let order = engine.order();
+    let targets = ladder_targets(sc, DT_FRACTION);
     let start = Instant::now();
     if let Some(dt) = sc.engine.dt {
+        // Kept exactly; the run at dt/2 gives the estimate an auto tolerance
+        // needs.
+        let (a, b) = (engine.run(problem, dt)?, engine.run(problem, dt / 2.0)?);
+        let est = dt_estimate(sc, segments, dt, &a.trajectory, &b.trajectory, order);
         return Ok((
             DtChoice {
                 dt,
                 source: DtSource::Scenario,
-                rungs: Vec::new(),
-                met: true,
+                met: est.meets,
+                rungs: vec![est],
                 order,
-                search_time: Duration::ZERO,
+                targets,
+                search_time: start.elapsed(),
             },
-            Vec::new(),
+            vec![a, b],
         ));
     }
     let ladder = dt_ladder();
@@ -294,6 +306,7 @@ pub fn choose_engine_dt(
                     rungs,
                     met: est.meets,
                     order,
+                    targets,
                     search_time: start.elapsed(),
                 },
                 runs,

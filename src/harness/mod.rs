@@ -13,11 +13,13 @@ use pushval_scenario::Scenario;
 use crate::registry;
 
 mod dt;
+pub mod tolerance;
 
 pub use dt::{
     choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, DtChoice, DtEstimate, DtSource,
     DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
 };
+pub use tolerance::{Figures, Resolved};
 
 /// Settings of a harness run.
 #[derive(Debug, Clone, Copy)]
@@ -122,6 +124,8 @@ pub struct Comparison {
     pub error: Option<String>,
     /// Engine runs only: the steady ω extrapolated to dt → 0.
     pub convergence: Option<Convergence>,
+    /// Gated rows: the tolerances asserted and where they came from.
+    pub tolerance: Option<Resolved>,
 }
 
 /// How an engine's steady ω converges as its time step shrinks: runs at 4h,
@@ -305,7 +309,7 @@ pub fn compare(
     segments: &[SegmentInfo],
     reference: &Trajectory,
     run: &ModelRun,
-    gated: bool,
+    tol: Option<&Figures>,
 ) -> Comparison {
     let steady = if run.engine {
         SteadyRead::TailMean
@@ -319,7 +323,7 @@ pub fn compare(
         &run.name,
         &run.trajectory,
         steady,
-        gated,
+        tol,
     )
 }
 
@@ -341,7 +345,7 @@ pub fn compare_trajectory(
     name: &str,
     tr: &Trajectory,
     steady: SteadyRead,
-    gated: bool,
+    tol: Option<&Figures>,
 ) -> Comparison {
     let mut position_max: f64 = 0.0;
     let mut theta_max: f64 = 0.0;
@@ -367,9 +371,9 @@ pub fn compare_trajectory(
             steady_errors.push((s.index, e));
         }
     }
-    let tol = &sc.tolerance;
+    let gated = tol.is_some();
     let mut failed = Vec::new();
-    if gated {
+    if let Some(tol) = tol {
         // Where each failing figure first exceeds its tolerance: the first
         // sample time and its segment (a switch time belongs to the segment
         // it starts), or the first settled segment past the steady tolerance.
@@ -427,6 +431,7 @@ pub fn compare_trajectory(
         failed,
         error: None,
         convergence: None,
+        tolerance: None,
     }
 }
 
@@ -450,7 +455,7 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
     let mut unavailable: Vec<(String, String)> = Vec::new();
     let mut failures: Vec<(String, String)> = Vec::new();
     // Per gated engine: the engine, its time step and the runs its choice made.
-    let mut gated_runs: Vec<(Box<dyn Engine>, f64, Vec<EngineRun>)> = Vec::new();
+    let mut gated_runs: Vec<(Box<dyn Engine>, DtChoice, Vec<EngineRun>)> = Vec::new();
     for name in names {
         let gated = sc.gate.iter().any(|g| g == name);
         if let Some((sim, settings)) = analytic(name, opts) {
@@ -488,8 +493,8 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
                     DtSource::Scenario => "scenario",
                     DtSource::Automatic => "automatic",
                 });
-                settings["dt_choice"] = choice.json(sc);
-                Ok((run, settings, Some(done)))
+                settings["dt_choice"] = choice.json();
+                Ok((run, settings, Some((choice, done))))
             })
         } else {
             // Informational rows keep the adapter's step (or the scenario's):
@@ -507,8 +512,8 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
         };
         match result {
             Ok((run, settings, done)) => {
-                if let Some(done) = done {
-                    gated_runs.push((engine, run.dt, done));
+                if let Some((choice, done)) = done {
+                    gated_runs.push((engine, choice, done));
                 }
                 runs.push(ModelRun {
                     name: name.to_string(),
@@ -524,14 +529,24 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
     }
     let reference = runs[0].trajectory.clone();
     let segments = analyse_segments(sc, &problem, &reference);
+    let model_error = tolerance::model_error(&problem, &reference, opts.model_tol);
+    let resolved = |name: &str| {
+        gated_runs
+            .iter()
+            .find(|g| g.0.name() == name)
+            .map(|(_, choice, _)| tolerance::resolve(sc, choice.rungs.last(), model_error))
+    };
     let mut comparisons: Vec<Comparison> = runs
         .iter()
         .map(|r| {
-            let gated = r.engine && sc.gate.contains(&r.name);
-            compare(sc, &segments, &reference, r, gated)
+            let tol = resolved(&r.name);
+            let mut c = compare(sc, &segments, &reference, r, tol.as_ref().map(|t| &t.value));
+            c.tolerance = tol;
+            c
         })
         .collect();
-    for (engine, h, done) in &gated_runs {
+    for (engine, choice, done) in &gated_runs {
+        let h = choice.dt;
         let run = runs
             .iter()
             .find(|r| r.name == engine.name())
@@ -543,7 +558,7 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             &segments,
             &run.trajectory,
             &reference,
-            *h,
+            h,
             done,
         )?;
         for c in comparisons.iter_mut().filter(|c| c.model == engine.name()) {
@@ -563,6 +578,7 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             failed: vec![format!("run failed: {e}")],
             error: Some(e),
             convergence: None,
+            tolerance: None,
         });
     }
     for (name, why) in unavailable {
@@ -575,6 +591,7 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             failed: vec![],
             error: Some(format!("not available in this build: {why}")),
             convergence: None,
+            tolerance: None,
         });
     }
     Ok(ScenarioReport {

@@ -16,4 +16,6 @@ mod scene;
 pub use error::ScenarioError;
 pub use geometry::{polygon_mass_properties, PolygonProperties};
 pub use pushval_engine::EngineOptions;
-pub use scene::{Scenario, SupportLoad, Tolerance, ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS};
+pub use scene::{
+    Limit, Scenario, SupportLoad, Tolerance, ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS,
+};

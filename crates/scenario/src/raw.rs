@@ -137,9 +137,17 @@ pub struct RawRun {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawTolerance {
-    pub omega_steady_rel: Option<f64>,
-    pub position_max: Option<f64>,
-    pub theta_max: Option<f64>,
+    pub omega_steady_rel: Option<RawLimit>,
+    pub position_max: Option<RawLimit>,
+    pub theta_max: Option<RawLimit>,
+}
+
+/// A tolerance figure as written: a number, or a word (`"auto"`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum RawLimit {
+    Number(f64),
+    Word(String),
 }
 
 /// `[engine]`: `dt` for every engine, the other keys for the engines that

@@ -9,7 +9,7 @@ use crate::geometry::{
     boundary_distance, contains, convex_hull, grid_supports, polygon_mass_properties,
     self_intersection,
 };
-use crate::raw::{PerPoint, RawLoad, RawScenario};
+use crate::raw::{PerPoint, RawLimit, RawLoad, RawScenario};
 use crate::ScenarioError;
 
 /// The analytic models every build has, in output order; the engine models
@@ -22,25 +22,38 @@ pub const DEFAULT_MODELS: [&str; 4] = ["dynamic", "kinematic", "limit_surface", 
 /// The engines a scenario gates when `[run] gate` is absent.
 pub const DEFAULT_GATE: [&str; 1] = ["rapier2d"];
 
-/// `[tolerance]`: what `validate` asserts between an engine and the dynamic model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerance {
-    /// Relative error of the steady ω per segment. Default 0.005.
-    pub omega_steady_rel: f64,
-    /// Largest centre-of-mass position difference (m). Default 0.005.
-    pub position_max: f64,
-    /// Largest angle difference (rad). Default 0.01.
-    pub theta_max: f64,
+/// One `[tolerance]` figure: a number, or derived from the gated engine's
+/// own accuracy (`"auto"`, and the default when the key is absent).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Limit {
+    /// The number in the file (its unit is the figure's).
+    Value(f64),
+    /// A stated multiple of the gated engine's self-convergence estimate,
+    /// plus the model's own error (resolved by the harness).
+    #[default]
+    Auto,
 }
 
-impl Default for Tolerance {
-    fn default() -> Self {
-        Self {
-            omega_steady_rel: 0.005,
-            position_max: 0.005,
-            theta_max: 0.01,
+impl Limit {
+    /// The number, None for `Auto`.
+    pub fn value(self) -> Option<f64> {
+        match self {
+            Limit::Value(v) => Some(v),
+            Limit::Auto => None,
         }
     }
+}
+
+/// `[tolerance]`: what `validate` asserts between a gated engine and the
+/// dynamic model.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Tolerance {
+    /// Relative error of the steady ω per settled segment.
+    pub omega_steady_rel: Limit,
+    /// Largest centre-of-mass position difference (m).
+    pub position_max: Limit,
+    /// Largest angle difference (rad).
+    pub theta_max: Limit,
 }
 
 /// One support as the scenario defines it.
@@ -570,23 +583,19 @@ impl Scenario {
             }
         }
         let rt = raw.tolerance.unwrap_or_default();
-        let d = Tolerance::default();
+        let limit = |key: &str, v: Option<RawLimit>| match v {
+            None => Ok(Limit::Auto),
+            Some(RawLimit::Number(x)) => finite_pos(file, key, x).map(Limit::Value),
+            Some(RawLimit::Word(w)) if w == "auto" => Ok(Limit::Auto),
+            Some(RawLimit::Word(w)) => Err(err(
+                key,
+                format!("must be a finite number > 0 or \"auto\", got \"{w}\""),
+            )),
+        };
         let tolerance = Tolerance {
-            omega_steady_rel: finite_pos(
-                file,
-                "tolerance.omega_steady_rel",
-                rt.omega_steady_rel.unwrap_or(d.omega_steady_rel),
-            )?,
-            position_max: finite_pos(
-                file,
-                "tolerance.position_max",
-                rt.position_max.unwrap_or(d.position_max),
-            )?,
-            theta_max: finite_pos(
-                file,
-                "tolerance.theta_max",
-                rt.theta_max.unwrap_or(d.theta_max),
-            )?,
+            omega_steady_rel: limit("tolerance.omega_steady_rel", rt.omega_steady_rel)?,
+            position_max: limit("tolerance.position_max", rt.position_max)?,
+            theta_max: limit("tolerance.theta_max", rt.theta_max)?,
         };
         let mut engine = EngineOptions::default();
         for (key, value) in raw.engine.unwrap_or_default() {
