@@ -5,6 +5,7 @@
 pub mod harness;
 pub mod output;
 pub mod outside;
+pub mod power;
 pub mod registry;
 pub mod report;
 pub mod stress;

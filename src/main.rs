@@ -74,6 +74,16 @@ enum Command {
     /// List every engine model: crate, engine version, order, whether it can
     /// be gated and whether this build has it.
     Engines,
+    /// Measure the gate's power: the smallest model error of each kind the
+    /// default gate (and `compare`) catches; write OUT/gate_power.{csv,svg}.
+    Power {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        /// Only the paper scenario at 1 m/s, coarser bisection (for tests).
+        #[arg(long)]
+        quick: bool,
+    },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
         file: PathBuf,
@@ -230,6 +240,7 @@ fn main() -> ExitCode {
         None => validate(Vec::new(), false, None),
         Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Power { out, quick }) => pushval::power::cli(&out, quick),
         Some(Command::Engines) => {
             print!("{}", pushval::engines_table());
             Ok(ExitCode::SUCCESS)

@@ -10,6 +10,7 @@ mod gate;
 mod integrators;
 mod kappa;
 mod physics;
+mod power;
 mod properties;
 mod report;
 mod scenarios;

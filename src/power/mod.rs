@@ -1,0 +1,631 @@
+//! `pushval power`: the smallest model error the CI gate catches.
+//!
+//! For each shipped scenario that gates an engine, and each engine variant
+//! (the scenario's gate as shipped, rapier2d in its body-velocity mode, and
+//! every other Coulomb engine in the registry that this build has), the gate
+//! is run once: the engine at the time step and with the tolerances
+//! `validate` resolves. Then each kind of error is injected into the model
+//! (the engine stays right), and the smallest magnitude that makes the gate
+//! fail is found by bisection on a log scale, for either sign; the same
+//! perturbed trajectory is also handed to `compare` as an outside trajectory
+//! (gated against the dynamic model and the engine, with `compare`'s
+//! tolerances). Writes `OUT/gate_power.csv` and `OUT/gate_power.svg`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Context;
+use pushval_model::{DynamicModel, Integrator, Simulator, Switching, Trajectory, Vec2};
+use pushval_scenario::Scenario;
+
+use crate::harness::{
+    compare_trajectory, run_scenario, Figures, Resolved, RunOptions, SegmentInfo, SteadyRead,
+};
+use crate::report::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
+
+pub mod law;
+
+/// A kind of model error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// I_cm scaled by 1 + m.
+    InertiaCm,
+    /// Every support's μ scaled by 1 + m.
+    MuAll,
+    /// The first support's μ scaled by 1 + m.
+    MuOne,
+    /// The normal loads redistributed (least change) to move the centre of
+    /// friction by m (m) along the object's x axis.
+    CenterOfFriction,
+    /// The contact point moved by m (m) along the polygon edge it lies on.
+    ContactOffset,
+    /// The centre of mass moved by m (m) along the object's x axis.
+    CmOffset,
+    /// Every push direction φ biased by m (rad).
+    PhiBias,
+    /// Continuous instead of impulsive switching (binary).
+    Switching,
+    /// The support friction direction blended towards −K⁻¹u with weight m
+    /// ([`law`]; m = 1 is the game-engine law).
+    KinvLaw,
+    /// The trajectory's clock shifted by m (s).
+    TimeShift,
+}
+
+impl ErrorKind {
+    /// Every kind, in output order.
+    pub const ALL: [ErrorKind; 10] = [
+        ErrorKind::InertiaCm,
+        ErrorKind::MuAll,
+        ErrorKind::MuOne,
+        ErrorKind::CenterOfFriction,
+        ErrorKind::ContactOffset,
+        ErrorKind::CmOffset,
+        ErrorKind::PhiBias,
+        ErrorKind::Switching,
+        ErrorKind::KinvLaw,
+        ErrorKind::TimeShift,
+    ];
+    /// The name in the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorKind::InertiaCm => "inertia_cm",
+            ErrorKind::MuAll => "mu_all",
+            ErrorKind::MuOne => "mu_one_support",
+            ErrorKind::CenterOfFriction => "center_of_friction",
+            ErrorKind::ContactOffset => "contact_offset",
+            ErrorKind::CmOffset => "cm_offset",
+            ErrorKind::PhiBias => "phi_bias",
+            ErrorKind::Switching => "continuous_switching",
+            ErrorKind::KinvLaw => "kinv_friction_law",
+            ErrorKind::TimeShift => "time_shift",
+        }
+    }
+    /// The magnitude's unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            ErrorKind::InertiaCm | ErrorKind::MuAll | ErrorKind::MuOne => "relative",
+            ErrorKind::CenterOfFriction | ErrorKind::ContactOffset | ErrorKind::CmOffset => "m",
+            ErrorKind::PhiBias => "rad",
+            ErrorKind::Switching => "binary",
+            ErrorKind::KinvLaw => "blend weight",
+            ErrorKind::TimeShift => "s",
+        }
+    }
+    /// The magnitudes searched, smallest and largest.
+    fn range(self) -> (f64, f64) {
+        match self {
+            ErrorKind::InertiaCm | ErrorKind::MuAll | ErrorKind::MuOne => (1e-6, 0.5),
+            ErrorKind::CenterOfFriction | ErrorKind::ContactOffset | ErrorKind::CmOffset => {
+                (1e-7, 0.02)
+            }
+            ErrorKind::PhiBias => (1e-7, 0.2),
+            ErrorKind::Switching => (1.0, 1.0),
+            ErrorKind::KinvLaw => (1e-6, 1.0),
+            ErrorKind::TimeShift => (1e-6, 0.5),
+        }
+    }
+    /// The target: the default gate must catch this magnitude.
+    pub fn target(self) -> Option<f64> {
+        match self {
+            ErrorKind::InertiaCm | ErrorKind::MuAll => Some(0.005),
+            ErrorKind::ContactOffset | ErrorKind::CenterOfFriction => Some(5e-4),
+            _ => None,
+        }
+    }
+    /// Whether the kind has a sign (binary and blend kinds have one side).
+    fn signed(self) -> bool {
+        !matches!(self, ErrorKind::Switching | ErrorKind::KinvLaw)
+    }
+}
+
+/// The model the harness runs (the gate's reference), for perturbed problems.
+fn model() -> DynamicModel {
+    DynamicModel {
+        integrator: Integrator::Dop853 {
+            tol: RunOptions::default().model_tol,
+        },
+        ..Default::default()
+    }
+}
+
+/// Least-change redistribution of the support friction magnitudes
+/// `F_i = μ_i N_i` that moves their centre by `shift` (object frame, m) and
+/// keeps their sum: `ΔF = Aᵀ (A Aᵀ)⁺ b` with rows `1`, `x_i`, `y_i`.
+fn shift_center_of_friction(sc: &mut Scenario, shift: Vec2) -> Option<()> {
+    let n = sc.supports.len();
+    let f: Vec<f64> = sc.supports.iter().map(|s| s.mu * s.load).collect();
+    let total: f64 = f.iter().sum();
+    let a = nalgebra::DMatrix::from_fn(3, n, |r, c| match r {
+        0 => 1.0,
+        1 => sc.supports[c].position.x,
+        _ => sc.supports[c].position.y,
+    });
+    let b = nalgebra::DVector::from_vec(vec![0.0, total * shift.x, total * shift.y]);
+    let aat = &a * a.transpose();
+    let y = aat.pseudo_inverse(1e-14).ok()? * b;
+    let df = a.transpose() * y;
+    for (s, (fi, d)) in sc.supports.iter_mut().zip(f.iter().zip(df.iter())) {
+        let fnew = fi + d;
+        if !(fnew > 0.0) {
+            return None;
+        }
+        s.load = fnew / s.mu;
+    }
+    Some(())
+}
+
+/// Unit tangent of the polygon edge nearest the contact point.
+fn contact_tangent(sc: &Scenario) -> Vec2 {
+    let p = sc.contact;
+    let n = sc.polygon.len();
+    let mut best = (f64::INFINITY, Vec2::new(1.0, 0.0));
+    for k in 0..n {
+        let (a, b) = (sc.polygon[k], sc.polygon[(k + 1) % n]);
+        let e = b - a;
+        let s = ((p - a).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
+        let d = (a + s * e - p).norm();
+        if d < best.0 - 1e-12 {
+            best = (d, e / e.norm());
+        }
+    }
+    best.1
+}
+
+/// The model's trajectory with error `kind` of magnitude `m` (signed) injected;
+/// None where the error cannot be made (e.g. a load would turn negative).
+pub fn inject(sc: &Scenario, kind: ErrorKind, m: f64) -> Option<Trajectory> {
+    let mut s = sc.clone();
+    match kind {
+        ErrorKind::InertiaCm => s.inertia_cm *= 1.0 + m,
+        ErrorKind::MuAll => s.supports.iter_mut().for_each(|p| p.mu *= 1.0 + m),
+        ErrorKind::MuOne => s.supports[0].mu *= 1.0 + m,
+        ErrorKind::CenterOfFriction => shift_center_of_friction(&mut s, Vec2::new(m, 0.0))?,
+        ErrorKind::ContactOffset => s.contact += m * contact_tangent(sc),
+        ErrorKind::CmOffset => s.center_of_mass += Vec2::new(m, 0.0),
+        ErrorKind::PhiBias => s.pushes.iter_mut().for_each(|p| p.phi += m),
+        ErrorKind::Switching => {
+            s.switching = match sc.switching {
+                Switching::Impulsive => Switching::Continuous,
+                Switching::Continuous => Switching::Impulsive,
+            }
+        }
+        ErrorKind::KinvLaw => return Some(law::simulate(&sc.problem(), m)),
+        ErrorKind::TimeShift => return Some(time_shifted(sc, m)),
+    }
+    if !(s.inertia_cm > 0.0) || s.supports.iter().any(|p| !(p.mu > 0.0)) {
+        return None;
+    }
+    model().simulate(&s.problem()).ok()
+}
+
+/// The model's trajectory seen through a clock shifted by `delay` (s):
+/// `X(t − delay)`, the state at t = 0 held before it. Sampled from a run 20
+/// times finer than the scenario's samples (linear interpolation error below
+/// 1e-7 m on the shipped scenes).
+fn time_shifted(sc: &Scenario, delay: f64) -> Trajectory {
+    let mut problem = sc.problem();
+    let times = problem.sample_times();
+    if let Some(last) = problem.pushes.last_mut() {
+        last.duration += delay.abs();
+    }
+    problem.sample_dt = sc.sample_dt / 20.0;
+    let fine = model().simulate(&problem).expect("the model runs");
+    let at = |t: f64| {
+        let t = t.max(0.0);
+        let k = fine
+            .samples
+            .partition_point(|s| s.t <= t)
+            .clamp(1, fine.samples.len() - 1);
+        let (a, b) = (&fine.samples[k - 1], &fine.samples[k]);
+        let u = if b.t > a.t {
+            (t - a.t) / (b.t - a.t)
+        } else {
+            0.0
+        };
+        let l = |p: f64, q: f64| p + u * (q - p);
+        pushval_model::Sample {
+            t,
+            x: l(a.x, b.x),
+            y: l(a.y, b.y),
+            theta: l(a.theta, b.theta),
+            omega: l(a.omega, b.omega),
+        }
+    };
+    let samples = times
+        .iter()
+        .map(|&t| pushval_model::Sample { t, ..at(t - delay) })
+        .collect();
+    let mut reference = model().simulate(&sc.problem()).expect("the model runs");
+    reference.samples = samples;
+    reference.model = format!("time_shift[{delay}]");
+    reference
+}
+
+/// One gate as `validate` runs it: the true model, the engine's run and the
+/// tolerances it is held to.
+pub struct Gate {
+    sc: Scenario,
+    engine: String,
+    segments: Vec<SegmentInfo>,
+    reference: Trajectory,
+    engine_run: Trajectory,
+    tolerance: Resolved,
+    outside_tolerance: Resolved,
+    dt: f64,
+    seconds: f64,
+}
+
+impl Gate {
+    /// Runs the gate of `sc` (its first gated engine).
+    pub fn new(sc: &Scenario) -> anyhow::Result<Self> {
+        let start = Instant::now();
+        let report = run_scenario(sc, &RunOptions::default())
+            .with_context(|| format!("{}: running the gate", sc.name))?;
+        let seconds = start.elapsed().as_secs_f64();
+        let name = sc.gate.first().context("the scenario gates no engine")?;
+        let c = report
+            .comparisons
+            .iter()
+            .find(|c| &c.model == name)
+            .context("the gated engine ran")?;
+        anyhow::ensure!(
+            c.pass == Some(true),
+            "{}: the gate fails without any injected error: {:?}",
+            sc.name,
+            c.failed
+        );
+        let run = report
+            .runs
+            .iter()
+            .find(|r| &r.name == name)
+            .context("engine run")?;
+        let outside_tolerance = crate::outside::outside_tolerance(sc, &report);
+        Ok(Self {
+            sc: sc.clone(),
+            engine: name.clone(),
+            segments: report.segments.clone(),
+            reference: report.dynamic().trajectory.clone(),
+            engine_run: run.trajectory.clone(),
+            tolerance: c
+                .tolerance
+                .clone()
+                .context("a gated row has its tolerance")?,
+            outside_tolerance,
+            dt: run.settings["dt"].as_f64().unwrap_or(f64::NAN),
+            seconds,
+        })
+    }
+
+    /// The gate with the perturbed model as its reference: does it fail?
+    pub fn catches(&self, pert: &Trajectory) -> bool {
+        self.check(pert).pass == Some(false)
+    }
+
+    /// The gate's comparison with the perturbed model as its reference.
+    pub fn check(&self, pert: &Trajectory) -> crate::harness::Comparison {
+        let mut segs = self.segments.clone();
+        for s in segs.iter_mut() {
+            if let (Some(root), Some(r)) = (s.omega_steady.as_mut(), pert.segments.get(s.index)) {
+                root.omega = r.omega_end;
+            }
+        }
+        compare_trajectory(
+            &self.sc,
+            &segs,
+            pert,
+            &self.engine,
+            &self.engine_run,
+            SteadyRead::TailMean,
+            Some(&self.tolerance.value),
+        )
+    }
+
+    /// `compare` with the perturbed trajectory as the outside one: does it fail?
+    pub fn compare_catches(&self, pert: &Trajectory) -> bool {
+        let fails = |reference: &Trajectory, tol: &Figures| {
+            compare_trajectory(
+                &self.sc,
+                &self.segments,
+                reference,
+                "outside",
+                pert,
+                SteadyRead::TailMean,
+                Some(tol),
+            )
+            .pass
+                == Some(false)
+        };
+        fails(&self.reference, &self.outside_tolerance.value)
+            || fails(&self.engine_run, &self.tolerance.value)
+    }
+
+    /// The smallest magnitude of `sign` × kind that `caught` flags, assuming
+    /// every larger one is caught too (bisection on a log scale, `iters`
+    /// halvings); None when the largest searched is not caught.
+    fn smallest(
+        &self,
+        kind: ErrorKind,
+        sign: f64,
+        iters: usize,
+        caught: &dyn Fn(&Self, &Trajectory) -> bool,
+    ) -> Option<f64> {
+        let test = |m: f64| inject(&self.sc, kind, sign * m).is_some_and(|t| caught(self, &t));
+        let (lo, hi) = kind.range();
+        if !test(hi) {
+            return None;
+        }
+        if lo == hi || test(lo) {
+            return Some(lo);
+        }
+        let (mut a, mut b) = (lo.ln(), hi.ln());
+        for _ in 0..iters {
+            let m = 0.5 * (a + b);
+            if test(m.exp()) {
+                b = m;
+            } else {
+                a = m;
+            }
+        }
+        Some(b.exp())
+    }
+}
+
+/// One row of gate_power.csv.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// Scenario name.
+    pub scenario: String,
+    /// The gated engine and its mode.
+    pub engine: String,
+    /// The error kind.
+    pub kind: ErrorKind,
+    /// Smallest magnitude `validate` catches with + and − sign.
+    pub plus: Option<f64>,
+    /// See `plus`.
+    pub minus: Option<f64>,
+    /// The same for `compare` (both signs; the larger).
+    pub compare: Option<f64>,
+    /// The gate's tolerances.
+    pub tolerance: Figures,
+    /// The engine's time step (s).
+    pub dt: f64,
+    /// Wall time of the gate (the engine runs, the ladder, the comparison) (s).
+    pub gate_seconds: f64,
+}
+
+impl Row {
+    /// The smallest magnitude caught with either sign (the larger of the two).
+    pub fn both(&self) -> Option<f64> {
+        if self.kind.signed() {
+            Some(self.plus?.max(self.minus?))
+        } else {
+            self.plus
+        }
+    }
+}
+
+/// The engine variants of a scenario: its gate as shipped, rapier2d's
+/// body-velocity mode (independent of the model's contact kinematics), and
+/// every other engine named in `extra` that this build has.
+fn variants(sc: &Scenario, extra: &[&str]) -> Vec<(String, Scenario)> {
+    let mut out = Vec::new();
+    let Some(first) = sc.gate.first() else {
+        return out;
+    };
+    let label = |s: &Scenario, name: &str| {
+        let mode = s
+            .engine
+            .values
+            .get("friction_velocity")
+            .and_then(|v| v.as_str());
+        match (name, mode) {
+            ("rapier2d", m) => format!("rapier2d[{}]", m.unwrap_or("leapfrog")),
+            (n, _) => n.to_string(),
+        }
+    };
+    out.push((label(sc, first), sc.clone()));
+    if first == "rapier2d" && !sc.engine.values.contains_key("friction_velocity") {
+        let mut body = sc.clone();
+        body.engine
+            .values
+            .insert("friction_velocity".into(), serde_json::json!("body"));
+        out.push((label(&body, "rapier2d"), body));
+    }
+    for name in extra {
+        if let Some(e) = crate::registry::entry(name) {
+            if e.default_engine().availability().is_ok() {
+                let mut s = sc.clone();
+                s.gate = vec![name.to_string()];
+                if !s.models.iter().any(|m| m == name) {
+                    s.models.push(name.to_string());
+                }
+                out.push((name.to_string(), s));
+            }
+        }
+    }
+    out
+}
+
+/// The gate-power table for the given scenarios.
+pub fn measure(scenarios: &[Scenario], extra: &[&str], iters: usize) -> anyhow::Result<Vec<Row>> {
+    let mut rows = Vec::new();
+    for sc in scenarios.iter().filter(|s| !s.gate.is_empty()) {
+        for (label, variant) in variants(sc, extra) {
+            let mut v = variant.clone();
+            // Only what the gate needs: the model and the gated engine.
+            v.models = std::iter::once("dynamic".to_string())
+                .chain(v.gate.iter().cloned())
+                .collect();
+            let gate = Gate::new(&v)?;
+            for kind in ErrorKind::ALL {
+                let (plus, minus) = (
+                    gate.smallest(kind, 1.0, iters, &Gate::catches),
+                    if kind.signed() {
+                        gate.smallest(kind, -1.0, iters, &Gate::catches)
+                    } else {
+                        None
+                    },
+                );
+                let compare = {
+                    let p = gate.smallest(kind, 1.0, iters, &Gate::compare_catches);
+                    if kind.signed() {
+                        p.zip(gate.smallest(kind, -1.0, iters, &Gate::compare_catches))
+                            .map(|(a, b)| a.max(b))
+                    } else {
+                        p
+                    }
+                };
+                rows.push(Row {
+                    scenario: sc.name.clone(),
+                    engine: label.clone(),
+                    kind,
+                    plus,
+                    minus,
+                    compare,
+                    tolerance: gate.tolerance.value,
+                    dt: gate.dt,
+                    gate_seconds: gate.seconds,
+                });
+            }
+        }
+    }
+    Ok(rows)
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or("not caught".into(), |x| format!("{x:.3e}"))
+}
+
+/// The CSV text.
+pub fn csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "scenario,engine,kind,unit,smallest_caught,smallest_caught_plus,smallest_caught_minus,smallest_caught_by_compare,target,meets_target,tolerance_position_m,tolerance_theta_rad,tolerance_omega_rel,engine_dt_s,gate_wall_time_s\n",
+    );
+    for r in rows {
+        let meets = match (r.kind.target(), r.both()) {
+            (Some(t), Some(b)) => (b <= t).to_string(),
+            (Some(_), None) => "false".into(),
+            (None, _) => "".into(),
+        };
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{:.3e},{:.3e},{:.3e},{:.4e},{:.3}\n",
+            r.scenario,
+            r.engine,
+            r.kind.name(),
+            r.kind.unit(),
+            opt(r.both()),
+            opt(r.plus),
+            if r.kind.signed() {
+                opt(r.minus)
+            } else {
+                String::new()
+            },
+            opt(r.compare),
+            r.kind.target().map_or(String::new(), |t| format!("{t:e}")),
+            meets,
+            r.tolerance.position_max,
+            r.tolerance.theta_max,
+            r.tolerance.omega_steady_rel,
+            r.dt,
+            r.gate_seconds
+        ));
+    }
+    s
+}
+
+/// One panel per kind: the smallest magnitude caught (log) per scenario,
+/// one series per engine variant; the target as a grey line where there is
+/// one.
+pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
+    let mut scenarios: Vec<&str> = rows.iter().map(|r| r.scenario.as_str()).collect();
+    scenarios.dedup();
+    let mut engines: Vec<&str> = Vec::new();
+    for r in rows {
+        if !engines.contains(&r.engine.as_str()) {
+            engines.push(&r.engine);
+        }
+    }
+    let mut panels = Vec::new();
+    for kind in ErrorKind::ALL
+        .into_iter()
+        .filter(|k| *k != ErrorKind::Switching)
+    {
+        let mut p = Panel::new(
+            format!("{} ({})", kind.name(), kind.unit()),
+            Axis::lin("scenario #"),
+            Axis::log("smallest magnitude caught"),
+        )
+        .legend(Legend::UpperRight);
+        for (k, e) in engines.iter().enumerate() {
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.kind == kind && r.engine == *e)
+                .filter_map(|r| {
+                    let i = scenarios.iter().position(|s| *s == r.scenario)? as f64;
+                    r.both().map(|m| (i, m))
+                })
+                .collect();
+            p = p.series(Series::new(*e, PALETTE[k % PALETTE.len()], Stroke::Dots).points(pts));
+        }
+        if let Some(t) = kind.target() {
+            let n = scenarios.len().max(2) as f64 - 1.0;
+            p = p.series(
+                Series::new("target", crate::report::plot::GREY, Stroke::Dashed)
+                    .points(vec![(0.0, t), (n, t)]),
+            );
+        }
+        panels.push(p);
+    }
+    crate::report::plot::render(&Figure {
+        size: (1800, 760),
+        cols: 5,
+        panels,
+        key: None,
+    })
+}
+
+/// `pushval power`: measure and write OUT/gate_power.{csv,svg}.
+pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {
+    let dir = crate::report::default_scenario_dir();
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    if quick {
+        files.retain(|f| f.ends_with("paper-square-v1.0.toml"));
+    }
+    let scenarios = files
+        .iter()
+        .map(crate::registry::load)
+        .collect::<Result<Vec<_>, _>>()?;
+    let start = Instant::now();
+    let rows = measure(
+        &scenarios,
+        &["box2d", "avian2d"],
+        if quick { 8 } else { 16 },
+    )?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    crate::output::write_atomic(&out.join("gate_power.csv"), csv(&rows).as_bytes())?;
+    crate::output::write_atomic(&out.join("gate_power.svg"), figure(&rows)?.as_bytes())?;
+    for r in rows.iter().filter(|r| r.kind.target().is_some()) {
+        println!(
+            "{:24} {:20} {:20} caught from {} (target {:e})",
+            r.scenario,
+            r.engine,
+            r.kind.name(),
+            opt(r.both()),
+            r.kind.target().unwrap_or(f64::NAN)
+        );
+    }
+    println!(
+        "{} rows in {:.1} s; wrote {} and {}",
+        rows.len(),
+        start.elapsed().as_secs_f64(),
+        out.join("gate_power.csv").display(),
+        out.join("gate_power.svg").display()
+    );
+    Ok(std::process::ExitCode::SUCCESS)
+}
