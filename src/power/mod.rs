@@ -32,7 +32,9 @@ pub enum ErrorKind {
     InertiaCm,
     /// Every support's μ scaled by 1 + m.
     MuAll,
-    /// The first support's μ scaled by 1 + m.
+    /// μ of the support farthest from the contact scaled by 1 + m (a
+    /// support under the contact point has no moment about it and changes
+    /// nothing but the pusher force).
     MuOne,
     /// The normal loads redistributed (least change) to move the centre of
     /// friction by m (m) along the object's x axis.
@@ -179,7 +181,15 @@ pub fn inject(sc: &Scenario, kind: ErrorKind, m: f64) -> Option<Trajectory> {
     match kind {
         ErrorKind::InertiaCm => s.inertia_cm *= 1.0 + m,
         ErrorKind::MuAll => s.supports.iter_mut().for_each(|p| p.mu *= 1.0 + m),
-        ErrorKind::MuOne => s.supports[0].mu *= 1.0 + m,
+        ErrorKind::MuOne => {
+            let far = (0..s.supports.len())
+                .max_by(|&a, &b| {
+                    let d = |i: usize| (s.supports[i].position - s.contact).norm();
+                    d(a).total_cmp(&d(b))
+                })
+                .expect("a scenario has supports");
+            s.supports[far].mu *= 1.0 + m;
+        }
         ErrorKind::CenterOfFriction => shift_center_of_friction(&mut s, Vec2::new(m, 0.0))?,
         ErrorKind::ContactOffset => s.contact += m * contact_tangent(sc),
         ErrorKind::CmOffset => s.center_of_mass += Vec2::new(m, 0.0),
@@ -458,7 +468,7 @@ pub fn measure(scenarios: &[Scenario], extra: &[&str], iters: usize) -> anyhow::
                 .chain(v.gate.iter().cloned())
                 .collect();
             let gate = Gate::new(&v)?;
-            for kind in ErrorKind::ALL {
+            for kind in ErrorKind::ALL.into_iter().filter(|k| applies(sc, *k)) {
                 let (plus, minus) = (
                     gate.smallest(kind, 1.0, iters, &Gate::catches),
                     if kind.signed() {
@@ -495,6 +505,12 @@ pub fn measure(scenarios: &[Scenario], extra: &[&str], iters: usize) -> anyhow::
 
 fn opt(v: Option<f64>) -> String {
     v.map_or("not caught".into(), |x| format!("{x:.3e}"))
+}
+
+/// Whether the kind can show at all in the scenario: switching needs a
+/// switch (more than one push, or a start from rest).
+pub fn applies(sc: &Scenario, kind: ErrorKind) -> bool {
+    kind != ErrorKind::Switching || sc.pushes.len() > 1 || sc.initial.from_rest
 }
 
 /// The CSV text.
