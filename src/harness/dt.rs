@@ -52,8 +52,8 @@ pub enum DtSource {
 }
 
 /// The engine's self-convergence error estimate at one time step h, from
-/// the runs at h and h/2 alone (never against the model): Richardson's
-/// `|X(h) − X(h/2)| · 2^p / (2^p − 1)` for the scheme's order p, for each
+/// the runs at 2h and h alone (never against the model): Richardson's
+/// `|X(2h) − X(h)| / (2^p − 1)` for the scheme's order p, for each
 /// gated figure.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DtEstimate {
@@ -64,7 +64,7 @@ pub struct DtEstimate {
     /// Largest angle difference over the samples (rad).
     pub theta_max: f64,
     /// Largest relative steady-ω difference over the segments the gate
-    /// reads a steady ω from (tail means; denominator the run at h/2 with
+    /// reads a steady ω from (tail means; denominator the run at h with
     /// [`rel_err`]'s floor); None when no segment settles.
     pub omega_steady_rel_max: Option<f64>,
     /// Whether every figure is within its ladder target
@@ -88,7 +88,7 @@ pub struct DtChoice {
     pub order: f64,
     /// What each figure's estimate had to be within.
     pub targets: Figures,
-    /// Wall time of the search's engine runs (the chosen run and its h/2
+    /// Wall time of the search's engine runs (the chosen run and its 2h
     /// partner included).
     pub search_time: Duration,
 }
@@ -161,7 +161,7 @@ impl DtChoice {
                 DtSource::Automatic => "automatic",
             },
             "reason": self.reason(),
-            "criterion": "Richardson self-convergence estimate |X(h) - X(h/2)| 2^p / (2^p - 1) of each gated figure within its target: fraction x [tolerance] for a number, the auto target for \"auto\"",
+            "criterion": "Richardson self-convergence estimate |X(2h) - X(h)| / (2^p - 1) of the run at h, each gated figure within its target: fraction x [tolerance] for a number, the auto target for \"auto\"",
             "fraction": DT_FRACTION,
             "order": self.order,
             "ladder": dt_ladder(),
@@ -177,8 +177,8 @@ impl DtChoice {
     }
 }
 
-/// The self-convergence estimate at h from the runs at h (`coarse`) and
-/// h/2 (`fine`) of a scheme of order `order`.
+/// The self-convergence estimate of the run at h (`fine`) from it and the
+/// run at 2h (`coarse`) of a scheme of order `order`.
 pub fn dt_estimate(
     sc: &Scenario,
     segments: &[SegmentInfo],
@@ -187,7 +187,8 @@ pub fn dt_estimate(
     fine: &Trajectory,
     order: f64,
 ) -> DtEstimate {
-    let k = 2f64.powf(order) / (2f64.powf(order) - 1.0);
+    // Richardson: the finer run's error is |X(2h) − X(h)| / (2^p − 1).
+    let k = 1.0 / (2f64.powf(order) - 1.0);
     let mut position_max: f64 = 0.0;
     let mut theta_max: f64 = 0.0;
     for (a, b) in coarse.samples.iter().zip(&fine.samples) {
@@ -226,7 +227,7 @@ pub fn dt_estimate(
 
 /// A gated engine's time step: the scenario's `[engine] dt` when
 /// set, otherwise the largest rung of [`dt_ladder`] whose self-convergence
-/// estimate ([`dt_estimate`], engine runs at h and h/2 only) is within
+/// estimate ([`dt_estimate`], engine runs at 2h and h only) is within
 /// [`DT_FRACTION`] of every `[tolerance]` figure, or the floor when none is.
 /// `segments` (from the dynamic model's run) only say which segments the
 /// gate reads a steady ω from. Returns the choice and every engine run
@@ -241,9 +242,9 @@ pub fn choose_engine_dt(
     let targets = ladder_targets(sc, DT_FRACTION);
     let start = Instant::now();
     if let Some(dt) = sc.engine.dt {
-        // Kept exactly; the run at dt/2 gives the estimate an auto tolerance
-        // needs.
-        let (a, b) = (engine.run(problem, dt)?, engine.run(problem, dt / 2.0)?);
+        // Kept exactly; the run at 2 dt gives the estimate an auto tolerance
+        // needs (and is the convergence check's first partner).
+        let (a, b) = (engine.run(problem, 2.0 * dt)?, engine.run(problem, dt)?);
         let est = dt_estimate(sc, segments, dt, &a.trajectory, &b.trajectory, order);
         return Ok((
             DtChoice {
@@ -281,7 +282,7 @@ pub fn choose_engine_dt(
             announced = true;
         }
         // A rung whose runs fail (blow up) does not meet the criterion.
-        let pair = run_at(h, &mut runs).and_then(|a| Ok((a, run_at(h / 2.0, &mut runs)?)));
+        let pair = run_at(2.0 * h, &mut runs).and_then(|a| Ok((a, run_at(h, &mut runs)?)));
         let (a, b) = match pair {
             Ok(p) => p,
             Err(e) => {

@@ -25,11 +25,11 @@ pub struct Figures {
 /// self-convergence estimate at the chosen step is at most this. Small enough
 /// that model errors of a fraction of a per cent move the trajectory past the
 /// resulting tolerance (results/gate_power.csv), large enough that a
-/// second-order engine reaches it at about 1/1000 s on the shipped scenes.
+/// second-order engine reaches it at 1/2000 s or so on the shipped scenes.
 pub const AUTO_TARGET: Figures = Figures {
-    position_max: 1e-5,
-    theta_max: 1e-5,
-    omega_steady_rel: 1e-5,
+    position_max: 2e-6,
+    theta_max: 2e-6,
+    omega_steady_rel: 2e-6,
 };
 
 /// An `"auto"` tolerance is this multiple of the engine's self-convergence
