@@ -9,6 +9,7 @@ pub mod power;
 pub mod registry;
 pub mod report;
 pub mod stress;
+pub mod study;
 
 pub use harness::{run_scenario, Comparison, ModelRun, RunOptions, ScenarioReport, SegmentInfo};
 pub use registry::engines_table;

@@ -71,6 +71,25 @@ enum Command {
         #[arg(long)]
         merge: bool,
     },
+    /// Regenerate results/friction_models/: where each engine's own friction
+    /// disagrees with Coulomb support friction, and the closed forms that
+    /// explain it.
+    Study {
+        /// idioms, rapier3d, mujoco (needs --features mujoco) or all.
+        name: String,
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "results/friction_models")]
+        out: PathBuf,
+        /// Reduced grids (for tests).
+        #[arg(long)]
+        quick: bool,
+        /// Compute only part K of N of each study's runs into OUT/parts/ (batch schedulers).
+        #[arg(long, value_name = "K/N", conflicts_with = "merge")]
+        shard: Option<pushval::report::Shard>,
+        /// Build the outputs from the parts in OUT/parts/ instead of running the engines.
+        #[arg(long)]
+        merge: bool,
+    },
     /// List every engine model: crate, engine version, order, whether it can
     /// be gated and whether this build has it.
     Engines,
@@ -253,6 +272,13 @@ fn main() -> ExitCode {
             shard,
             merge,
         }) => pushval::report::cli(out, quick, shard, merge),
+        Some(Command::Study {
+            name,
+            out,
+            quick,
+            shard,
+            merge,
+        }) => pushval::study::cli(&name, out, quick, shard, merge),
     };
     match result {
         Ok(code) => code,

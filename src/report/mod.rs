@@ -6,50 +6,38 @@
 //! * [`paper`]: the seed paper's figures (φ(t), ω(t), x(t), y(t), the path),
 //!   each model run once and rapier2d drawn over the dynamic model, plus the
 //!   inertia and switching questions;
-//! * [`sweeps`]: maps and curves over parameter grids (κ against the Froude
-//!   number, τ, the kinematic model's validity map, the assumptions map).
-//!   The grid cells run in parallel (rayon) and can be split for a batch
-//!   scheduler: `--shard K/N` computes the K-th of N contiguous parts of the
-//!   cell list and writes `OUT/parts/sweep-K-of-N.csv`; `--merge` reads the
-//!   N parts and writes exactly the files a single run writes.
+//! * the sweeps: maps and curves over parameter grids (κ against the Froude
+//!   number, τ, the kinematic model's validity map, the assumptions map);
+//!   [`cells`] holds the grids and what each cell computes, [`figures`] what
+//!   is drawn and said from the cells' rows. The cells run in parallel
+//!   (rayon) and can be split for a batch scheduler ([`shard`]):
+//!   `--shard K/N` computes the K-th of N contiguous parts of the cell list
+//!   and writes `OUT/parts/sweep-K-of-N.csv`; `--merge` reads the N parts
+//!   and writes exactly the files a single run writes.
+//!
+//! [`plot`] draws every figure (also those of `pushval study` and
+//! `pushval stress`), and the writer, CSV and progress helpers here serve
+//! `pushval study` too.
 //!
 //! Output is deterministic: no time stamps, fixed grids, numbers printed with
 //! Rust's shortest round-trip formatting, files written through a temporary
 //! file and a rename.
 
+pub mod cells;
+pub mod figures;
 pub mod paper;
 pub mod plot;
-pub mod sweeps;
+pub mod shard;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 
 use anyhow::{bail, Context};
+use rayon::prelude::*;
 
 use crate::output::write_atomic;
-
-/// One part of N of the sweep cells: `K/N` with 1 ≤ K ≤ N.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Shard {
-    pub k: usize,
-    pub n: usize,
-}
-
-impl FromStr for Shard {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let (k, n) = s
-            .split_once('/')
-            .ok_or_else(|| format!("expected K/N (e.g. 2/8), got '{s}'"))?;
-        let k: usize = k.trim().parse().map_err(|_| format!("bad K in '{s}'"))?;
-        let n: usize = n.trim().parse().map_err(|_| format!("bad N in '{s}'"))?;
-        if n == 0 || k == 0 || k > n {
-            return Err(format!("need 1 <= K <= N, got '{s}'"));
-        }
-        Ok(Self { k, n })
-    }
-}
+pub use shard::Shard;
+use shard::{grid_name, shard_range, Parts};
 
 /// What `pushval report` does.
 #[derive(Debug, Clone)]
@@ -110,7 +98,8 @@ pub struct Writer {
 }
 
 impl Writer {
-    fn new(dir: &Path) -> anyhow::Result<Self> {
+    /// A writer into `dir` (created if missing).
+    pub fn new(dir: &Path) -> anyhow::Result<Self> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         Ok(Self {
             dir: dir.to_path_buf(),
@@ -132,6 +121,10 @@ impl Writer {
     pub fn figure(&mut self, name: &str, fig: &plot::Figure) -> anyhow::Result<()> {
         let svg = plot::render(fig).with_context(|| format!("drawing {name}"))?;
         self.file(name, svg.as_bytes())
+    }
+    /// The files written, in order (consumes the writer).
+    pub fn into_written(self) -> Vec<PathBuf> {
+        self.written
     }
 }
 
@@ -188,6 +181,36 @@ pub fn progress(len: u64, show: bool, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
+/// Evaluates `eval` on every item in parallel (rayon), keeping their order,
+/// with a [`progress`] bar named `what`.
+pub fn par_rows<T: Sync>(
+    items: &[T],
+    show_progress: bool,
+    what: &str,
+    eval: impl Fn(&T) -> Vec<f64> + Sync,
+) -> Vec<Vec<f64>> {
+    let bar = progress(items.len() as u64, show_progress, what);
+    let rows: Vec<Vec<f64>> = items
+        .par_iter()
+        .map(|t| {
+            let r = eval(t);
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    rows
+}
+
+/// The part files of the report's sweeps.
+fn sweep_parts(quick: bool) -> Parts<'static> {
+    Parts {
+        tag: "report sweep",
+        stem: "sweep",
+        grid: grid_name(quick),
+    }
+}
+
 /// What a report run did.
 #[derive(Debug, Clone)]
 pub struct Summary {
@@ -202,27 +225,29 @@ pub fn run(opts: &Options) -> anyhow::Result<Summary> {
     if opts.merge && opts.shard.is_some() {
         bail!("--shard and --merge exclude each other");
     }
-    let geoms = sweeps::geometries(&opts.scenarios)?;
-    let tasks = sweeps::tasks(&geoms, opts.quick);
+    let geoms = cells::geometries(&opts.scenarios)?;
+    let tasks = cells::tasks(&geoms, opts.quick);
+    let parts = sweep_parts(opts.quick);
     let mut w = Writer::new(&opts.out)?;
     if let Some(shard) = opts.shard {
-        let range = sweeps::shard_range(tasks.len(), shard);
-        let rows = sweeps::compute(&geoms, &tasks, range.clone(), opts.quick, opts.progress);
-        let text = sweeps::part_text(&tasks, range.clone(), &rows, shard, opts.quick);
-        w.file(&sweeps::part_name(shard), text.as_bytes())?;
+        let range = shard_range(tasks.len(), shard);
+        let rows = cells::compute(&geoms, &tasks, range.clone(), opts.quick, opts.progress);
+        let text = parts.text(tasks.len(), range.clone(), &rows, shard);
+        w.file(&parts.file_name(shard), text.as_bytes())?;
         return Ok(Summary {
             files: w.written,
             cells: range.len(),
         });
     }
     let (rows, cells) = if opts.merge {
-        (sweeps::merge_parts(&opts.out, &tasks, opts.quick)?, 0)
+        let width = |i: usize| Some(cells::width(&tasks[i]));
+        (parts.merge(&opts.out, tasks.len(), width)?, 0)
     } else {
-        let rows = sweeps::compute(&geoms, &tasks, 0..tasks.len(), opts.quick, opts.progress);
+        let rows = cells::compute(&geoms, &tasks, 0..tasks.len(), opts.quick, opts.progress);
         (rows, tasks.len())
     };
     let mut entries = paper::figures(&opts.scenarios, &mut w)?;
-    entries.extend(sweeps::figures(&geoms, &tasks, &rows, opts.quick, &mut w)?);
+    entries.extend(figures::figures(&geoms, &tasks, &rows, opts.quick, &mut w)?);
     w.file("README.md", readme(&entries, opts.quick).as_bytes())?;
     Ok(Summary {
         files: w.written,

@@ -1,11 +1,15 @@
-//! Figure drawing: line panels and coloured-grid maps, rendered to SVG text
-//! with plotters (no system fonts needed: the SVG names a generic font family
-//! and the viewer renders the text).
+//! Figure drawing for `pushval report`, `pushval study` and `pushval stress`:
+//! line plots (a [`Panel`] of [`Series`]) and heat maps ([`heat_map`]: a
+//! panel of coloured cells, with a [`Scale`] from value to colour and an
+//! optional mark written in each cell), rendered to SVG text with plotters
+//! (no system fonts needed: the SVG names a generic font family and the
+//! viewer renders the text).
 
 use anyhow::anyhow;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,6 +91,13 @@ pub struct Cell {
     pub color: RGBColor,
 }
 
+/// A short text written centred at a point of a panel (data coordinates).
+#[derive(Debug, Clone)]
+pub struct Mark {
+    pub at: (f64, f64),
+    pub text: String,
+}
+
 /// Where the legend goes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Legend {
@@ -105,6 +116,8 @@ pub struct Panel {
     pub y: Axis,
     pub series: Vec<Series>,
     pub cells: Vec<Cell>,
+    /// Texts drawn over the cells (a heat map's per-cell marks).
+    pub marks: Vec<Mark>,
     pub legend: Legend,
     /// Same scale on both axes (for x–y paths).
     pub equal_aspect: bool,
@@ -118,6 +131,7 @@ impl Panel {
             y,
             series: Vec::new(),
             cells: Vec::new(),
+            marks: Vec::new(),
             legend: Legend::UpperRight,
             equal_aspect: false,
         }
@@ -174,6 +188,147 @@ pub const PALETTE: [RGBColor; 10] = [
 ];
 
 const FONT: &str = "sans-serif";
+
+/// How a heat map turns a cell's value into a colour.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Scale {
+    /// The value is a class index (0, 1, …) into these colours.
+    Classes(Vec<RGBColor>),
+    /// `log10` of the value on a blue (decade `lo`) to red (decade `hi`)
+    /// ramp, clamped at both ends; zero and negative values are blue.
+    Log10 { lo: f64, hi: f64 },
+}
+
+impl Scale {
+    /// The colour of `value`; grey where it is NaN (or not a class).
+    pub fn color(&self, value: f64) -> RGBColor {
+        match self {
+            Scale::Classes(colors) => {
+                if value.is_nan() || value < 0.0 {
+                    return GREY;
+                }
+                colors.get(value as usize).copied().unwrap_or(GREY)
+            }
+            Scale::Log10 { lo, hi } => {
+                if value.is_nan() {
+                    return GREY;
+                }
+                let s = if value > 0.0 {
+                    ((value.log10() - lo) / (hi - lo)).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                RGBColor(
+                    (40.0 + 215.0 * s) as u8,
+                    (80.0 + 120.0 * (1.0 - (2.0 * s - 1.0).abs())) as u8,
+                    (255.0 * (1.0 - s)) as u8,
+                )
+            }
+        }
+    }
+
+    /// A key for the scale: for [`Scale::Log10`] one entry per decade from
+    /// `lo` to `hi` (the ends read ≤ and ≥), for [`Scale::Classes`] the
+    /// classes with `labels`; then `notes` (e.g. what a cell's mark means),
+    /// drawn with white swatches.
+    pub fn key(&self, title: &str, labels: &[&str], notes: &[String]) -> Key {
+        let mut entries: Vec<(String, RGBColor)> = match self {
+            Scale::Classes(colors) => labels
+                .iter()
+                .zip(colors)
+                .map(|(l, c)| (l.to_string(), *c))
+                .collect(),
+            Scale::Log10 { lo, hi } => {
+                let (a, b) = (lo.ceil() as i32, hi.floor() as i32);
+                (a..=b)
+                    .map(|d| {
+                        let label = if d == a {
+                            format!("≤ 1e{d}")
+                        } else if d == b {
+                            format!("≥ 1e{d}")
+                        } else {
+                            format!("1e{d}")
+                        };
+                        (label, self.color(10f64.powi(d)))
+                    })
+                    .collect()
+            }
+        };
+        entries.extend(notes.iter().map(|n| (n.clone(), WHITE)));
+        Key {
+            title: title.to_string(),
+            entries,
+        }
+    }
+}
+
+/// One cell of a heat map: its extent in data coordinates, its value and a
+/// mark written at its centre (empty: none).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapCell {
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+    pub value: f64,
+    pub mark: String,
+}
+
+/// The heat map: a panel with one filled rectangle per cell, coloured by
+/// `scale`, and each cell's mark written at its centre. Lines (e.g.
+/// contours) are added to it as series, like to any panel.
+pub fn heat_map(
+    title: impl Into<String>,
+    x: Axis,
+    y: Axis,
+    cells: &[MapCell],
+    scale: &Scale,
+) -> Panel {
+    let mut p = Panel::new(title, x, y);
+    for c in cells {
+        p.cells.push(Cell {
+            x: c.x,
+            y: c.y,
+            color: scale.color(c.value),
+        });
+        if !c.mark.is_empty() {
+            p.marks.push(Mark {
+                at: (0.5 * (c.x.0 + c.x.1), 0.5 * (c.y.0 + c.y.1)),
+                text: c.mark.clone(),
+            });
+        }
+    }
+    p
+}
+
+/// Cell extents around sorted grid values: the edges halfway between
+/// neighbours (in log10 on a log axis), the outer cells symmetric about their
+/// value. A single value gets half a unit (log: half a decade) either side.
+pub fn cell_edges(values: &[f64], log: bool) -> Vec<(f64, f64)> {
+    let t: Vec<f64> = values
+        .iter()
+        .map(|&v| if log { v.log10() } else { v })
+        .collect();
+    let back = |v: f64| if log { 10f64.powf(v) } else { v };
+    let n = t.len();
+    (0..n)
+        .map(|i| {
+            let lo = if i > 0 {
+                0.5 * (t[i - 1] + t[i])
+            } else if n > 1 {
+                t[0] - 0.5 * (t[1] - t[0])
+            } else {
+                t[0] - 0.5
+            };
+            let hi = if i + 1 < n {
+                0.5 * (t[i] + t[i + 1])
+            } else if n > 1 {
+                t[i] + 0.5 * (t[i] - t[i - 1])
+            } else {
+                t[0] + 0.5
+            };
+            (back(lo), back(hi))
+        })
+        .collect()
+}
 
 fn data_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -331,6 +486,19 @@ where
                 p.cells
                     .iter()
                     .map(|c| Rectangle::new([(c.x.0, c.y.0), (c.x.1, c.y.1)], c.color.filled())),
+            )
+            .map_err(err)?;
+    }
+    if !p.marks.is_empty() {
+        let style = (FONT, 12)
+            .into_font()
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        chart
+            .draw_series(
+                p.marks
+                    .iter()
+                    .map(|m| Text::new(m.text.clone(), m.at, style.clone())),
             )
             .map_err(err)?;
     }

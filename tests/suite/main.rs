@@ -15,3 +15,4 @@ mod properties;
 mod report;
 mod scenarios;
 mod stress;
+mod study;

@@ -1,0 +1,214 @@
+//! Splitting a fixed list of tasks over processes, and merging the parts:
+//! the shard I/O of `pushval report` and `pushval study`.
+//!
+//! A computation that can be split is a fixed list of tasks (fixed by its
+//! grid, `--quick` or full), each reduced to a row of numbers. `--shard K/N`
+//! computes the K-th of N contiguous parts of the list and writes
+//! `OUT/parts/NAME-K-of-N.csv`; `--merge` reads the N parts back into the
+//! rows of every task, from which the caller builds exactly the files a
+//! single run writes.
+//!
+//! # Format
+//!
+//! A part file is a header line
+//! `# pushval TAG part K/N grid=GRID tasks=T` (T the length of the whole
+//! list), then one line per task of the part, `index,value,...`, with the
+//! numbers in Rust's shortest round-trip form (so a merge reproduces the
+//! single run's numbers exactly; `NaN` and `inf` as Rust prints them).
+
+use std::ops::Range;
+use std::path::Path;
+use std::str::FromStr;
+
+use anyhow::{bail, Context};
+
+use super::num;
+
+/// One part of N of a task list: `K/N` with 1 ≤ K ≤ N.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub k: usize,
+    pub n: usize,
+}
+
+impl FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let (k, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("expected K/N (e.g. 2/8), got '{s}'"))?;
+        let k: usize = k.trim().parse().map_err(|_| format!("bad K in '{s}'"))?;
+        let n: usize = n.trim().parse().map_err(|_| format!("bad N in '{s}'"))?;
+        if n == 0 || k == 0 || k > n {
+            return Err(format!("need 1 <= K <= N, got '{s}'"));
+        }
+        Ok(Self { k, n })
+    }
+}
+
+/// What names a split computation in its part files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Parts<'a> {
+    /// What the header calls it, e.g. `report sweep` or `study idioms`.
+    pub tag: &'a str,
+    /// File name stem of its parts, e.g. `sweep` (`parts/sweep-K-of-N.csv`).
+    pub stem: &'a str,
+    /// The grid's name, `full` or `quick`: parts of different grids never merge.
+    pub grid: &'a str,
+}
+
+/// The grid name of a run: `quick` or `full`.
+pub fn grid_name(quick: bool) -> &'static str {
+    if quick {
+        "quick"
+    } else {
+        "full"
+    }
+}
+
+/// The part `shard` of `n` tasks: contiguous, sizes differing by at most one.
+pub fn shard_range(n: usize, shard: Shard) -> Range<usize> {
+    let lo = (shard.k - 1) * n / shard.n;
+    let hi = shard.k * n / shard.n;
+    lo..hi
+}
+
+impl Parts<'_> {
+    /// File name of a part, relative to the output folder.
+    pub fn file_name(&self, shard: Shard) -> String {
+        format!("parts/{}-{}-of-{}.csv", self.stem, shard.k, shard.n)
+    }
+
+    /// The part file of `rows`, the results of `tasks` `range` of a list of
+    /// `total` tasks (see the module's format).
+    pub fn text(
+        &self,
+        total: usize,
+        range: Range<usize>,
+        rows: &[Vec<f64>],
+        shard: Shard,
+    ) -> String {
+        let mut s = format!(
+            "# pushval {} part {}/{} grid={} tasks={}\n",
+            self.tag, shard.k, shard.n, self.grid, total
+        );
+        for (idx, row) in range.zip(rows) {
+            s.push_str(&idx.to_string());
+            for v in row {
+                s.push(',');
+                s.push_str(&num(*v));
+            }
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Reads every part in `OUT/parts/` and returns the rows of all `total`
+    /// tasks. `width(i)` is the number of values task `i` has, where fixed.
+    /// Refuses parts of another grid or split, a task in two parts, and a
+    /// missing part.
+    pub fn merge(
+        &self,
+        out: &Path,
+        total: usize,
+        width: impl Fn(usize) -> Option<usize>,
+    ) -> anyhow::Result<Vec<Vec<f64>>> {
+        let dir = out.join("parts");
+        let prefix = format!("{}-", self.stem);
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .with_context(|| format!("reading {} (run the shards first)", dir.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.starts_with(&prefix) && n.ends_with(".csv"))
+            })
+            .collect();
+        files.sort();
+        if files.is_empty() {
+            bail!(
+                "no part files ({}-K-of-N.csv) in {}",
+                self.stem,
+                dir.display()
+            );
+        }
+        let mut rows: Vec<Option<Vec<f64>>> = vec![None; total];
+        let mut seen: Vec<(usize, usize)> = Vec::new();
+        let head_prefix = format!("# pushval {} part ", self.tag);
+        for f in &files {
+            let text =
+                std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
+            let mut lines = text.lines();
+            let head = lines.next().unwrap_or_default();
+            let bad = || anyhow::anyhow!("{}: not a {} part file", f.display(), self.tag);
+            let rest = head.strip_prefix(&head_prefix).ok_or_else(bad)?;
+            let mut it = rest.split_whitespace();
+            let kn: Shard = it
+                .next()
+                .ok_or_else(bad)?
+                .parse()
+                .map_err(|e: String| anyhow::anyhow!("{}: {e}", f.display()))?;
+            let grid = it
+                .next()
+                .and_then(|s| s.strip_prefix("grid="))
+                .ok_or_else(bad)?;
+            let n_tasks: usize = it
+                .next()
+                .and_then(|s| s.strip_prefix("tasks="))
+                .and_then(|s| s.parse().ok())
+                .ok_or_else(bad)?;
+            if grid != self.grid || n_tasks != total {
+                bail!(
+                    "{}: computed on the {grid} grid ({n_tasks} tasks), but this merge wants the {} grid ({} tasks); pass --quick consistently",
+                    f.display(),
+                    self.grid,
+                    total
+                );
+            }
+            seen.push((kn.k, kn.n));
+            for (ln, line) in lines.enumerate() {
+                let mut fields = line.split(',');
+                let idx: usize = fields
+                    .next()
+                    .and_then(|s| s.parse().ok())
+                    .with_context(|| format!("{}: line {}: bad index", f.display(), ln + 2))?;
+                let vals: Vec<f64> = fields
+                    .map(|s| s.parse::<f64>())
+                    .collect::<Result<_, _>>()
+                    .with_context(|| format!("{}: line {}: bad number", f.display(), ln + 2))?;
+                let slot = rows
+                    .get_mut(idx)
+                    .with_context(|| format!("{}: task {idx} out of range", f.display()))?;
+                if width(idx).is_some_and(|w| w != vals.len()) {
+                    bail!("{}: task {idx} has {} values", f.display(), vals.len());
+                }
+                if slot.is_some() {
+                    bail!("{}: task {idx} appears in two parts", f.display());
+                }
+                *slot = Some(vals);
+            }
+        }
+        let n = seen[0].1;
+        if seen.iter().any(|&(_, m)| m != n) {
+            bail!(
+                "{} holds parts of different splits ({:?}); remove the stale ones",
+                dir.display(),
+                seen
+            );
+        }
+        let missing: Vec<usize> = (1..=n)
+            .filter(|k| !seen.iter().any(|s| s.0 == *k))
+            .collect();
+        if !missing.is_empty() {
+            bail!(
+                "missing parts {missing:?} of {n} of {} in {}",
+                self.stem,
+                dir.display()
+            );
+        }
+        rows.into_iter()
+            .enumerate()
+            .map(|(i, r)| r.with_context(|| format!("task {i} is in no part")))
+            .collect()
+    }
+}

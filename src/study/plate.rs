@@ -1,0 +1,108 @@
+//! The scene every study runs: the seed paper's plate, its push grids and
+//! the Coulomb model's answer for it.
+
+use std::f64::consts::FRAC_PI_4;
+
+use pushval_model::{Body, Initial, Problem, Push, SegmentDynamics, Support, Switching, Vec2};
+
+/// Friction coefficient of every support (dimensionless).
+pub const MU: f64 = 0.5;
+/// Gravity (m/s²).
+pub const G: f64 = 9.81;
+/// Mass of the plate (kg).
+pub const MASS: f64 = 1.0;
+/// Half the side of the square plate (m): the supports sit at its corners.
+pub const HALF: f64 = 0.125;
+/// The push direction of the studies' tables (rad).
+pub const PHI_TABLE: f64 = FRAC_PI_4 + 0.3;
+/// The pusher speeds of the studies' tables (m/s).
+pub const TABLE_SPEEDS: [f64; 3] = [0.2, 0.5, 1.0];
+/// The Froude numbers of the (Fr, φ) maps.
+pub const FRS: [f64; 7] = [0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0];
+/// The quick grid's Froude numbers (tests).
+pub const FRS_QUICK: [f64; 2] = [0.1, 1.0];
+/// Range of the maps' push directions (rad).
+pub const PHI_RANGE: (f64, f64) = (0.15, 1.42);
+
+/// The paper plate: a 2 HALF square of mass MASS on four corner supports
+/// with friction MU and equal loads (each `μ m g / 4`), pushed at the corner
+/// (−HALF, −HALF), geometric inertia `m (2 HALF)² / 6`.
+pub fn plate() -> Body {
+    let h = HALF;
+    let supports: Vec<Support> = [[-h, -h], [h, -h], [h, h], [-h, h]]
+        .iter()
+        .map(|c| Support {
+            position: Vec2::new(c[0], c[1]),
+            friction: MU * MASS * G / 4.0,
+        })
+        .collect();
+    let side = 2.0 * h;
+    Body::new(MASS, MASS * side * side / 6.0, Vec2::new(-h, -h), &supports)
+        .expect("the paper plate is a valid body")
+}
+
+/// One push of the paper plate at `speed` (m/s) in direction `phi` (rad) for
+/// `duration` (s), from θ = 0 moving with the pusher (ω = 0), samples every
+/// 10 ms. Studies that start elsewhere or push more than once change
+/// `initial` or `pushes`.
+pub fn paper_plate(speed: f64, phi: f64, duration: f64) -> Problem {
+    Problem {
+        body: plate(),
+        limits: Default::default(),
+        pushes: vec![Push {
+            duration,
+            speed,
+            phi,
+        }],
+        initial: Initial::default(),
+        switching: Switching::Impulsive,
+        sample_dt: 0.01,
+    }
+}
+
+/// L = |p_c − p_cm| (m), the length of the Froude number.
+pub fn length() -> f64 {
+    plate().contact().norm()
+}
+
+/// Pusher speed (m/s) of a Froude number `Fr = v_c²/(μ g L)`.
+pub fn speed_of(fr: f64) -> f64 {
+    (fr * MU * G * length()).sqrt()
+}
+
+/// Froude number of a pusher speed (m/s).
+pub fn froude(speed: f64) -> f64 {
+    speed * speed / (MU * G * length())
+}
+
+/// The maps' push directions (rad): 9 evenly spaced in [`PHI_RANGE`] (3 on
+/// the quick grid).
+pub fn phis(quick: bool) -> Vec<f64> {
+    let n = if quick { 3 } else { 9 };
+    let (lo, hi) = PHI_RANGE;
+    (0..n)
+        .map(|k| lo + k as f64 * (hi - lo) / (n - 1) as f64)
+        .collect()
+}
+
+/// The maps' Froude numbers.
+pub fn frs(quick: bool) -> &'static [f64] {
+    if quick {
+        &FRS_QUICK
+    } else {
+        &FRS
+    }
+}
+
+/// The Coulomb model's steady ω (rad/s) for `push`: the stable root the
+/// flow reaches from ω = 0 (NaN where there is none).
+pub fn coulomb_star(body: &Body, push: &Push) -> f64 {
+    let seg = SegmentDynamics::new(body, push);
+    let roots = seg.steady_states();
+    seg.attractor(&roots, 0.0).map_or(f64::NAN, |s| s.omega)
+}
+
+/// `|a − b| / |b|`.
+pub fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
