@@ -1,8 +1,10 @@
 //! `pushval report` (issue 4): the quick report writes files that parse, a
 //! sharded run merges into the same bytes as a single run, and the sweep
-//! figures agree with independent evaluations of the model: κ and the
-//! validity map's error recomputed by integrating the dynamic model's
-//! trajectory (not from the root finder or the report's RK4), κ → 1 as Fr → 0.
+//! figures agree with independent evaluations of the model: κ recomputed from
+//! a fixed-step RK4 of the moment balance written out here and a bisection
+//! for ψ (not from the root finders, nor the closed-form tail built on the
+//! root), the validity map's error by integrating the dynamic model's
+//! trajectory (not the report's RK4), κ → 1 as Fr → 0.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -10,7 +12,9 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 use pushval::report::{self, Options, Shard};
-use pushval_model::{DynamicModel, Initial, KinematicModel, Problem, Push, Simulator, Switching};
+use pushval_model::{
+    Body, DynamicModel, Initial, KinematicModel, Problem, Push, Simulator, Switching, Vec2,
+};
 
 use crate::common::{load, root};
 
@@ -194,6 +198,76 @@ fn geometry_file(name: &str) -> &'static str {
     }
 }
 
+/// `I_P ω̇` (N m) from the model's definition (DESIGN.md, "The model"), one
+/// support at a time: `Σ (p_i − p_c) × f_i + m v ω (p_c · n_φ)` with
+/// `f_i = −F_i u_i/|u_i|`, `u_i = v n_φ + ω D (p_i − p_c)`; `inertial` false
+/// leaves the friction moment alone (the kinematic model's, at v = 1).
+fn moment_by_definition(body: &Body, v: f64, phi: f64, w: f64, inertial: bool) -> f64 {
+    let pc = body.contact();
+    let n = Vec2::new(phi.cos(), phi.sin());
+    let mut m = if inertial {
+        body.mass() * v * w * pc.dot(&n)
+    } else {
+        0.0
+    };
+    for s in body.supports() {
+        let r = s.position - pc;
+        let u = n * v + Vec2::new(-r.y, r.x) * w;
+        let un = u.norm();
+        if un > 0.0 {
+            m -= s.friction * (r.x * u.y - r.y * u.x) / un;
+        }
+    }
+    m
+}
+
+/// ω reached from ω = 0 by classical RK4 of `ω̇ = moment / I_P` with step `h`,
+/// run until a step no longer changes ω (or 10⁶ steps).
+fn integrated_steady_omega(body: &Body, v: f64, phi: f64, h: f64) -> f64 {
+    let ip = body.inertia_contact();
+    let g = |w: f64| moment_by_definition(body, v, phi, w, true) / ip;
+    let mut w = 0.0;
+    for _ in 0..1_000_000 {
+        let k1 = g(w);
+        let k2 = g(w + 0.5 * h * k1);
+        let k3 = g(w + 0.5 * h * k2);
+        let k4 = g(w + h * k3);
+        let next = w + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        if (next - w).abs() <= 4e-16 * w.abs() {
+            return next;
+        }
+        w = next;
+    }
+    panic!("RK4 did not settle: ω = {w}, ω̇ = {}", g(w));
+}
+
+/// ψ: the root of the friction moment at unit speed. It is non-increasing in
+/// ψ (its derivative is `−Σ F_i (r_i · u_i)² / |u_i|³`), so one sign change,
+/// bracketed by doubling and then bisected down to adjacent floats.
+fn kinematic_psi_by_bisection(body: &Body, phi: f64) -> f64 {
+    let m = |psi: f64| moment_by_definition(body, 1.0, phi, psi, false);
+    let (mut lo, mut hi) = (-1.0, 1.0);
+    while m(lo) < 0.0 {
+        lo *= 2.0;
+        assert!(lo > -1e9, "no root below");
+    }
+    while m(hi) > 0.0 {
+        hi *= 2.0;
+        assert!(hi < 1e9, "no root above");
+    }
+    loop {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            return mid;
+        }
+        if m(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+}
+
 #[test]
 fn kappa_matches_integrated_trajectories_and_tends_to_one() {
     let rows = read_csv(&quick_dir().join("kappa.csv"));
@@ -208,8 +282,10 @@ fn kappa_matches_integrated_trajectories_and_tends_to_one() {
         assert!((1.0 - k).abs() <= fr_min, "{}: κ = {k}", r["geometry"]);
         assert!(k < 1.0);
     }
-    // Recompute a few cells: ω* as the end of a long dynamic run from ω = 0
-    // (many relaxation times), ψ from the kinematic model's ω / v.
+    // Recompute a few cells without the model's root finders or its
+    // closed-form tail (which is built on the same root): ω* by a fixed-step
+    // RK4 of the moment balance written out below, from ω = 0 until ω stops
+    // changing; ψ by bisection of the friction moment alone.
     let mut checked = 0;
     for r in &rows {
         let file = geometry_file(&r["geometry"]);
@@ -220,13 +296,24 @@ fn kappa_matches_integrated_trajectories_and_tends_to_one() {
         let sc = load(&root().join("scenarios").join(file));
         let (v, phi) = (val(r, "speed"), val(r, "phi"));
         assert!((sc.froude(v) - fr).abs() <= 1e-12 * fr);
-        let tau = val(r, "tau");
-        let p = one_push(&sc, v, phi, 60.0 * tau);
-        let dynamic = DynamicModel::default().simulate(&p).unwrap();
-        let kinematic = KinematicModel.simulate(&p).unwrap();
-        let w_end = dynamic.samples.last().unwrap().omega;
-        let w_kin = kinematic.samples.last().unwrap().omega;
-        let kappa = w_end / w_kin;
+        let body = sc.body();
+        // τ from the report only sets the step (RK4's fixed points are the
+        // roots of ω̇ whatever the step, and it is stable at τ/20).
+        let w_star = integrated_steady_omega(&body, v, phi, val(r, "tau") / 20.0);
+        let psi = kinematic_psi_by_bisection(&body, phi);
+        let kappa = w_star / (v * psi);
+        assert!(
+            (w_star - val(r, "omega_steady")).abs() <= 1e-9 * w_star.abs().max(v / 0.1),
+            "{} φ = {phi} Fr = {fr}: integrated ω* = {w_star}, report {}",
+            r["geometry"],
+            r["omega_steady"]
+        );
+        assert!(
+            (psi - val(r, "psi")).abs() <= 1e-10 * psi.abs().max(1.0),
+            "{} φ = {phi}: ψ = {psi}, report {}",
+            r["geometry"],
+            r["psi"]
+        );
         assert!(
             (kappa - val(r, "kappa")).abs() < 1e-8,
             "{} φ = {phi} Fr = {fr}: integrated κ = {kappa}, report {}",
