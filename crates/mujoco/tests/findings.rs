@@ -1,4 +1,4 @@
-//! The findings of `examples/friction_models_mujoco.rs`, asserted: if an
+//! The MuJoCo findings of `pushval study mujoco` (results/friction_models/mujoco/), asserted: if an
 //! explanation stops holding, these fail. Expected values come from the
 //! model (`pushval-model`) and closed forms, not from MuJoCo's output.
 #![cfg(feature = "mujoco")]
