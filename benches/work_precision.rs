@@ -26,7 +26,6 @@ use pushval_model::{
     DynamicModel, Integrator, Problem, Rotor, SegmentDynamics, Simulator, Switching, Trajectory,
     Vec2,
 };
-use pushval_rapier2d::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
 use pushval_scenario::Scenario;
 
 struct Row {
@@ -290,22 +289,25 @@ fn main() {
     } else {
         &[1.0 / 60.0, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5]
     };
-    for precision in [Precision::F64, Precision::F32] {
-        for mode in FrictionVelocity::ALL {
+    // The default gated engine through the registry, in each precision and
+    // friction-velocity mode its `[engine]` options offer.
+    let gate = pushval_scenario::DEFAULT_GATE[0];
+    for precision in ["f64", "f32"] {
+        for mode in ["body", "constraint", "midpoint", "leapfrog"] {
+            let mut options = pushval_engine::EngineOptions::default();
+            options
+                .values
+                .insert("precision".into(), serde_json::json!(precision));
+            options
+                .values
+                .insert("friction_velocity".into(), serde_json::json!(mode));
+            let engine = pushval::registry::engine(gate, &options);
             for &dt in dts {
-                let run = |dt: f64| {
-                    let settings = EngineSettings {
-                        dt,
-                        precision,
-                        friction_velocity: mode,
-                        ..Default::default()
-                    };
-                    RapierSimulator { settings }.simulate(&problem).unwrap()
-                };
+                let run = |dt: f64| engine.run(&problem, dt).unwrap().trajectory;
                 let r = if dt < 2e-4 { 1 } else { reps.min(5) };
                 let (d, tr) = time(r, || run(dt));
                 let (pe, oe) = errors(&sc, &segs, &reference, &tr, true);
-                let name = format!("rapier2d {} {}", precision.as_str(), mode.as_str());
+                let name = format!("{gate} {precision} {mode}");
                 rows.push(Row {
                     method: name.clone(),
                     family: "engine".into(),
@@ -318,11 +320,7 @@ fn main() {
                 // Richardson at the scheme's order p: x(h) + (x(h) − x(2h)) / (2^p − 1)
                 // on the common samples; its cost is both runs.
                 let (d2, tr2) = time(r, || run(2.0 * dt));
-                let k = if mode == FrictionVelocity::Leapfrog {
-                    3.0
-                } else {
-                    1.0
-                };
+                let k = 2f64.powf(engine.order()) - 1.0;
                 let mut rich = tr.clone();
                 for (s, c) in rich.samples.iter_mut().zip(&tr2.samples) {
                     s.x += (s.x - c.x) / k;

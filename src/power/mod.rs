@@ -516,7 +516,7 @@ pub fn applies(sc: &Scenario, kind: ErrorKind) -> bool {
 /// The CSV text.
 pub fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "scenario,engine,kind,unit,smallest_caught,smallest_caught_plus,smallest_caught_minus,smallest_caught_by_compare,target,meets_target,tolerance_position_m,tolerance_theta_rad,tolerance_omega_rel,engine_dt_s,gate_wall_time_s\n",
+        "scenario,engine,kind,unit,smallest_caught,smallest_caught_plus,smallest_caught_minus,smallest_caught_by_compare,at_search_floor,target,meets_target,tolerance_position_m,tolerance_theta_rad,tolerance_omega_rel,engine_dt_s,gate_wall_time_s\n",
     );
     for r in rows {
         let meets = match (r.kind.target(), r.both()) {
@@ -525,7 +525,7 @@ pub fn csv(rows: &[Row]) -> String {
             (None, _) => "".into(),
         };
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{:.3e},{:.3e},{:.3e},{:.4e},{:.3}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{:.3e},{:.3e},{:.3e},{:.4e},{:.3}\n",
             r.scenario,
             r.engine,
             r.kind.name(),
@@ -538,6 +538,11 @@ pub fn csv(rows: &[Row]) -> String {
                 String::new()
             },
             opt(r.compare),
+            // Caught at the smallest magnitude searched: the true threshold
+            // is at or below it.
+            r.kind != ErrorKind::Switching
+                && r.both()
+                    .is_some_and(|b| b <= r.kind.range().0 * (1.0 + 1e-12)),
             r.kind.target().map_or(String::new(), |t| format!("{t:e}")),
             meets,
             r.tolerance.position_max,
@@ -594,10 +599,17 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
         panels.push(p);
     }
     crate::report::plot::render(&Figure {
-        size: (1800, 760),
+        size: (2000, 760),
         cols: 5,
         panels,
-        key: None,
+        key: Some(crate::report::plot::Key {
+            title: "scenario #".into(),
+            entries: scenarios
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (format!("{i}: {s}"), crate::report::plot::GREY))
+                .collect(),
+        }),
     })
 }
 
