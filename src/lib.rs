@@ -2,6 +2,7 @@
 //! dynamic model, and writes the contract outputs (`summary.json`,
 //! `trajectory.csv`). The command line in `main.rs` is a thin layer over this.
 
+pub mod fit;
 pub mod harness;
 pub mod output;
 pub mod outside;

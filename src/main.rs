@@ -93,6 +93,42 @@ enum Command {
     /// List every engine model: crate, engine version, order, whether it can
     /// be gated and whether this build has it.
     Engines,
+    /// Estimate parameters of the scenario (μ scale, I_cm, centre of
+    /// friction, contact offset) from a trajectory by Levenberg–Marquardt;
+    /// write DIR/fit.json. Exit 1 when the fit does not converge or a
+    /// parameter is unidentifiable.
+    Fit {
+        file: PathBuf,
+        /// The trajectory: model,t,x,y,theta,omega on the scenario's time grid.
+        #[arg(long, value_name = "CSV")]
+        trajectory: PathBuf,
+        /// What to estimate: mu_scale, inertia_cm, center_of_friction, contact.
+        #[arg(long, value_name = "NAME[,NAME...]")]
+        params: String,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Which run of the CSV's `model` column (default: the only one).
+        #[arg(long, value_name = "NAME")]
+        model: Option<String>,
+        /// Noise level of x and y (m): weighs the position residuals.
+        #[arg(long, default_value_t = 1e-3, value_name = "M")]
+        sigma_position: f64,
+        /// Noise level of theta (rad): weighs the angle residuals.
+        #[arg(long, default_value_t = 1e-3, value_name = "RAD")]
+        sigma_theta: f64,
+    },
+    /// How well a push determines μ, I_cm and the centre of friction (Fisher
+    /// information, checked by repeated noisy fits); write
+    /// OUT/identifiability.{csv,svg} and OUT/fit.md.
+    FitStudy {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        /// Reduced grids (for tests).
+        #[arg(long)]
+        quick: bool,
+    },
     /// Measure the gate's power: the smallest model error of each kind the
     /// default gate (and `compare`) catches; write OUT/gate_power.{csv,svg}.
     Power {
@@ -260,6 +296,27 @@ fn main() -> ExitCode {
         Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
         Some(Command::Run { file, out }) => run(file, out),
         Some(Command::Power { out, quick }) => pushval::power::cli(&out, quick),
+        Some(Command::Fit {
+            file,
+            trajectory,
+            params,
+            out,
+            model,
+            sigma_position,
+            sigma_theta,
+        }) => pushval::fit::cli(&pushval::fit::Request {
+            scenario: file,
+            trajectory,
+            params,
+            out,
+            model,
+            settings: pushval::fit::Settings {
+                sigma_position,
+                sigma_theta,
+                ..Default::default()
+            },
+        }),
+        Some(Command::FitStudy { out, quick }) => pushval::fit::study::cli(&out, quick),
         Some(Command::Engines) => {
             print!("{}", pushval::engines_table());
             Ok(ExitCode::SUCCESS)

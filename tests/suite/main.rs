@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod corpus;
 mod engines;
+mod fit;
 mod gate;
 mod integrators;
 mod kappa;

@@ -1,0 +1,1060 @@
+//! `pushval fit-study`: how well a push determines μ, I_cm, the contact
+//! point and the centre of friction, from the Fisher information at the
+//! truth with the stated noise (1 mm on x and y, 1 mrad on θ, every 0.01 s
+//! sample), checked against repeated noisy fits. Writes
+//! `OUT/identifiability.csv`, `OUT/identifiability.svg` and `OUT/fit.md`.
+//!
+//! The object is the seed paper's plate (`scenarios/paper-square-v1.0.toml`:
+//! 0.25 m, 1 kg, four corner supports, μ 0.5, pushed at a corner), started
+//! as the paper does (moving with the pusher, ω = 0). Three sweeps, each
+//! from one base push of 1 m/s for 2 s at φ = π/4 + 0.3 (the file's first
+//! segment):
+//!
+//! * speed: 0.1–2 m/s, 2 s;
+//! * duration: 0.1–10 s at 1 m/s;
+//! * segments: 2 s at 1 m/s cut into k = 1…5 equal segments whose φ run
+//!   through the file's five angles in order.
+//!
+//! Three parameter sets ([`sets`]): `mu_scale, inertia_cm`; the same with
+//! `contact`; the same with `center_of_friction` (what a third unknown
+//! costs, and where it cannot be had at all).
+//!
+//! The answer to "what is the shortest push that gives μ within 1 % and
+//! I_cm within 2 %": at 2σ (95 %) of the Fisher std, fitting `mu_scale` and
+//! `inertia_cm` together, one segment from the paper's start, over the
+//! speeds 0.2–2 m/s and the file's φ other than π/4 (through the centre of
+//! mass: no turn). The information only grows with the duration (one more
+//! sample adds a positive semi-definite term), so bisection over whole
+//! sample steps finds the shortest duration exactly.
+
+use std::f64::consts::FRAC_PI_4;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use pushval_model::{Push, Simulator};
+use pushval_scenario::Scenario;
+
+use super::{fisher_at, fit, noise, Param, Parametrised, Settings};
+use crate::output::write_atomic;
+use crate::report::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
+
+/// The stated noise of the study on x and y (m).
+pub const SIGMA_POSITION: f64 = 1e-3;
+/// The stated noise of the study on θ (rad).
+pub const SIGMA_THETA: f64 = 1e-3;
+/// Noisy fits per check point.
+pub const FITS: usize = 40;
+/// The empirical std must lie within this factor of the Fisher std (either
+/// way). With 40 fits the sample std of a normal estimate lies within
+/// [0.78, 1.22] of the true std 95 % of the time and within [0.66, 1.36]
+/// 99.8 % of the time (χ² with 39 degrees of freedom); outside a factor 1.5
+/// about 0.1 % of the time per component. (With 20 fits that chance is 2 %.)
+pub const AGREEMENT: f64 = 1.5;
+/// The shortest-push question's target on μ (relative, at [`SIGMAS`] σ).
+pub const MU_TARGET: f64 = 0.01;
+/// The shortest-push question's target on I_cm (relative, at [`SIGMAS`] σ).
+pub const INERTIA_TARGET: f64 = 0.02;
+/// How many Fisher std the targets must hold at (2: about 95 %).
+pub const SIGMAS: f64 = 2.0;
+
+/// One push schedule of the study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// "speed", "duration", "segments" or "shortest".
+    pub sweep: &'static str,
+    /// Pusher speed (m/s), every segment.
+    pub speed: f64,
+    /// Total duration (s).
+    pub duration: f64,
+    /// Number of equal segments.
+    pub segments: usize,
+    /// φ of the first segment (rad).
+    pub phi: f64,
+}
+
+impl Point {
+    /// The pushes: `segments` equal pieces of `duration`, φ from `phis`
+    /// in turn starting with `phi` (its index in `phis`).
+    fn pushes(&self, phis: &[f64]) -> Vec<Push> {
+        let start = phis
+            .iter()
+            .position(|p| (p - self.phi).abs() < 1e-12)
+            .unwrap_or(0);
+        (0..self.segments)
+            .map(|i| Push {
+                duration: self.duration / self.segments as f64,
+                speed: self.speed,
+                phi: if self.segments == 1 {
+                    self.phi
+                } else {
+                    phis[(start + i) % phis.len()]
+                },
+            })
+            .collect()
+    }
+}
+
+/// The parameter sets: μ and I; with the contact offset; with the centre
+/// of friction.
+pub fn sets() -> [Vec<Param>; 3] {
+    [
+        vec![Param::InertiaCm, Param::MuScale],
+        vec![Param::Contact, Param::InertiaCm, Param::MuScale],
+        vec![Param::CenterOfFriction, Param::InertiaCm, Param::MuScale],
+    ]
+}
+
+fn set_name(set: &[Param]) -> String {
+    set.iter().map(|p| p.name()).collect::<Vec<_>>().join("+")
+}
+
+/// The study's scene: the base scenario with `point`'s pushes.
+pub struct Study {
+    /// The scenario every push is put into.
+    pub base: Scenario,
+    /// The file's push angles.
+    pub phis: Vec<f64>,
+    /// The fit's settings with the study's noise levels.
+    pub settings: Settings,
+}
+
+impl Study {
+    /// The study on `scenarios/paper-square-v1.0.toml` in `scenarios`.
+    pub fn new(scenarios: &Path) -> anyhow::Result<Self> {
+        let base = crate::registry::load(scenarios.join("paper-square-v1.0.toml"))?;
+        let phis = base.pushes.iter().map(|p| p.phi).collect();
+        Ok(Self {
+            base,
+            phis,
+            settings: Settings {
+                sigma_position: SIGMA_POSITION,
+                sigma_theta: SIGMA_THETA,
+                ..Settings::default()
+            },
+        })
+    }
+
+    /// The scenario for `point`.
+    pub fn scenario(&self, point: &Point) -> Scenario {
+        let mut sc = self.base.clone();
+        sc.pushes = point.pushes(&self.phis);
+        sc
+    }
+
+    /// The base push: 1 m/s for 2 s at the file's first φ, one segment.
+    pub fn base_point(&self, sweep: &'static str) -> Point {
+        Point {
+            sweep,
+            speed: 1.0,
+            duration: 2.0,
+            segments: 1,
+            phi: self.phis[0],
+        }
+    }
+
+    /// Fisher std of each component of `set` at the truth (the file's values)
+    /// for `point`, with the component scales; NaN where unidentifiable.
+    pub fn fisher_std(&self, point: &Point, set: &[Param]) -> anyhow::Result<(Vec<f64>, Vec<f64>)> {
+        let sc = self.scenario(point);
+        let model = Parametrised::new(&sc, set).map_err(anyhow::Error::msg)?;
+        let f = fisher_at(&model, &model.file_values(), &self.settings)
+            .map_err(anyhow::Error::msg)
+            .with_context(|| format!("Fisher information at {point:?}"))?;
+        Ok((f.std(), model.file_values()))
+    }
+
+    /// `fits` fits of `set` to the exact trajectory plus noise (seeds
+    /// `seed0 + i`), each started off the truth (μ × 0.9, I × 1.15, the
+    /// centre of friction 5 mm off in x and y). Returns the estimates, one
+    /// vector per fit, and how many did not converge.
+    pub fn noisy_fits(
+        &self,
+        point: &Point,
+        set: &[Param],
+        fits: usize,
+        seed0: u64,
+    ) -> anyhow::Result<(Vec<Vec<f64>>, usize)> {
+        let sc = self.scenario(point);
+        let model = Parametrised::new(&sc, set).map_err(anyhow::Error::msg)?;
+        let truth = model.file_values();
+        let exact = pushval_model::DynamicModel::default()
+            .simulate(&sc.problem())
+            .context("the exact trajectory")?
+            .samples;
+        let start: Vec<f64> = model
+            .slots()
+            .iter()
+            .zip(&truth)
+            .map(|((p, _), v)| match p {
+                Param::MuScale => v * 0.9,
+                Param::InertiaCm => v * 1.15,
+                Param::CenterOfFriction | Param::Contact => v + 0.005,
+            })
+            .collect();
+        let mut out = Vec::with_capacity(fits);
+        let mut failed = 0;
+        for i in 0..fits {
+            let data = noise::add_noise(
+                &exact,
+                self.settings.sigma_position,
+                self.settings.sigma_theta,
+                seed0 + i as u64,
+            );
+            let f = fit(&model, &data, &start, &self.settings).map_err(anyhow::Error::msg)?;
+            if !f.converged {
+                failed += 1;
+            }
+            out.push(f.value);
+        }
+        Ok((out, failed))
+    }
+
+    /// The empirical std of [`Self::noisy_fits`]' estimates per component
+    /// (about their mean, n − 1 in the denominator) and the Fisher std.
+    pub fn check(
+        &self,
+        point: &Point,
+        set: &[Param],
+        fits: usize,
+        seed0: u64,
+    ) -> anyhow::Result<Check> {
+        let (est, failed) = self.noisy_fits(point, set, fits, seed0)?;
+        let (fisher, truth) = self.fisher_std(point, set)?;
+        let n = truth.len();
+        let empirical: Vec<f64> = (0..n)
+            .map(|j| {
+                let mean = est.iter().map(|e| e[j]).sum::<f64>() / fits as f64;
+                (est.iter().map(|e| (e[j] - mean).powi(2)).sum::<f64>() / (fits - 1) as f64).sqrt()
+            })
+            .collect();
+        Ok(Check {
+            point: point.clone(),
+            set: set.to_vec(),
+            truth,
+            fisher,
+            empirical,
+            fits,
+            failed,
+        })
+    }
+
+    /// The shortest one-segment push at `speed` and `phi` whose 2σ Fisher
+    /// error is within 1 % on μ and 2 % on I_cm (fitting both), in whole
+    /// sample steps up to `max_duration`; None if not even that is enough.
+    pub fn shortest(&self, speed: f64, phi: f64, max_duration: f64) -> anyhow::Result<Option<f64>> {
+        let set = &sets()[0];
+        let dt = self.base.sample_dt;
+        let ok = |steps: usize| -> anyhow::Result<bool> {
+            let p = Point {
+                sweep: "shortest",
+                speed,
+                duration: steps as f64 * dt,
+                segments: 1,
+                phi,
+            };
+            let (std, truth) = self.fisher_std(&p, set)?;
+            // Components in Param::ALL order: inertia_cm, mu_scale.
+            Ok(SIGMAS * std[0] / truth[0] <= INERTIA_TARGET
+                && SIGMAS * std[1] / truth[1] <= MU_TARGET)
+        };
+        let (mut lo, mut hi) = (1usize, (max_duration / dt).round() as usize);
+        if !ok(hi)? {
+            return Ok(None);
+        }
+        // Invariant: ok(hi), and lo - 1 is not known to be ok.
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if ok(mid)? {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        Ok(Some(hi as f64 * dt))
+    }
+}
+
+/// An empirical check: Fisher std against the spread of repeated fits.
+#[derive(Debug, Clone)]
+pub struct Check {
+    /// Where.
+    pub point: Point,
+    /// The parameters fitted.
+    pub set: Vec<Param>,
+    /// The truth, per component.
+    pub truth: Vec<f64>,
+    /// Fisher std at the truth, per component.
+    pub fisher: Vec<f64>,
+    /// Std of the noisy fits' estimates about their mean, per component.
+    pub empirical: Vec<f64>,
+    /// Number of noisy fits.
+    pub fits: usize,
+    /// Fits that did not converge.
+    pub failed: usize,
+}
+
+impl Check {
+    /// Empirical over Fisher std per component.
+    pub fn ratios(&self) -> Vec<f64> {
+        self.empirical
+            .iter()
+            .zip(&self.fisher)
+            .map(|(e, f)| e / f)
+            .collect()
+    }
+    /// Every ratio within [1/AGREEMENT, AGREEMENT] and every fit converged.
+    pub fn pass(&self) -> bool {
+        self.failed == 0
+            && self
+                .ratios()
+                .iter()
+                .all(|r| *r >= 1.0 / AGREEMENT && *r <= AGREEMENT)
+    }
+}
+
+/// The grids of the three sweeps (`quick`: a few points each).
+pub fn grid(study: &Study, quick: bool) -> Vec<Point> {
+    let speeds: &[f64] = if quick {
+        &[0.2, 1.0]
+    } else {
+        &[0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0]
+    };
+    let durations: &[f64] = if quick {
+        &[0.5, 2.0]
+    } else {
+        &[0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0]
+    };
+    let segments: &[usize] = if quick { &[1, 3] } else { &[1, 2, 3, 4, 5] };
+    let mut out = Vec::new();
+    for &v in speeds {
+        out.push(Point {
+            speed: v,
+            ..study.base_point("speed")
+        });
+    }
+    for &d in durations {
+        out.push(Point {
+            duration: d,
+            ..study.base_point("duration")
+        });
+    }
+    for &k in segments {
+        out.push(Point {
+            segments: k,
+            ..study.base_point("segments")
+        });
+    }
+    out
+}
+
+/// The check points and the sets checked there (indices into [`sets`]):
+/// the base push, a slow push and a short one with μ, I and μ, I, contact;
+/// five segments with every set (the centre of friction needs more than one
+/// push direction).
+pub fn check_points(study: &Study) -> Vec<(Point, Vec<usize>)> {
+    vec![
+        (study.base_point("duration"), vec![0, 1]),
+        (
+            Point {
+                speed: 0.3,
+                ..study.base_point("speed")
+            },
+            vec![0, 1],
+        ),
+        (
+            Point {
+                duration: 0.5,
+                ..study.base_point("duration")
+            },
+            vec![0, 1],
+        ),
+        (
+            Point {
+                segments: 5,
+                ..study.base_point("segments")
+            },
+            vec![0, 1, 2],
+        ),
+    ]
+}
+
+/// The speeds and angles the shortest-push search covers: 0.2–2 m/s and the
+/// file's φ other than π/4.
+pub fn shortest_candidates(study: &Study) -> Vec<(f64, f64)> {
+    let mut phis: Vec<f64> = study
+        .phis
+        .iter()
+        .cloned()
+        .filter(|p| (p - FRAC_PI_4).abs() > 1e-9)
+        .collect();
+    phis.sort_by(f64::total_cmp);
+    phis.dedup();
+    let mut out = Vec::new();
+    for v in [0.2, 0.5, 1.0, 1.5, 2.0] {
+        for &phi in &phis {
+            out.push((v, phi));
+        }
+    }
+    out
+}
+
+/// One row of `identifiability.csv`: one component of one parameter set at
+/// one push.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// The push.
+    pub point: Point,
+    /// Index into [`sets`].
+    pub set: usize,
+    /// The parameter.
+    pub param: Param,
+    /// 0 for a scalar or x, 1 for y.
+    pub component: usize,
+    /// The true value (the file's).
+    pub truth: f64,
+    /// The component's scale ([`Parametrised::scales`]): relative std is
+    /// std / scale.
+    pub scale: f64,
+    /// Fisher std at the stated noise; NaN where unidentifiable.
+    pub fisher_std: f64,
+    /// Every component of the set is identifiable here. Where one is not,
+    /// the others' std is conditional on it being known: kept in the CSV,
+    /// not drawn.
+    pub set_identifiable: bool,
+    /// Empirical std of the noisy fits and their number (check rows only).
+    pub empirical: Option<(f64, usize)>,
+    /// The model's assumption checks that fail on this push (empty: all hold).
+    pub violated: Vec<&'static str>,
+}
+
+impl Row {
+    /// Fisher std over the component's scale.
+    pub fn relative_std(&self) -> f64 {
+        self.fisher_std / self.scale
+    }
+    /// Within the shortest-push target at [`SIGMAS`] σ (μ and I only).
+    pub fn within_target(&self) -> Option<bool> {
+        let target = match self.param {
+            Param::MuScale => MU_TARGET,
+            Param::InertiaCm => INERTIA_TARGET,
+            _ => return None,
+        };
+        Some(SIGMAS * self.relative_std() <= target)
+    }
+    fn csv(&self) -> String {
+        let p = &self.point;
+        let opt = |v: f64| {
+            if v.is_finite() {
+                format!("{v}")
+            } else {
+                String::new()
+            }
+        };
+        let (emp, fits, ratio) = match self.empirical {
+            Some((e, n)) => (format!("{e}"), format!("{n}"), opt(e / self.fisher_std)),
+            None => (String::new(), String::new(), String::new()),
+        };
+        format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            p.sweep,
+            p.speed,
+            p.duration,
+            p.segments,
+            p.phi,
+            set_name(&sets()[self.set]),
+            self.param.name(),
+            if self.param.dim() == 2 {
+                ["x", "y"][self.component]
+            } else {
+                ""
+            },
+            self.truth,
+            self.scale,
+            opt(self.fisher_std),
+            opt(self.relative_std()),
+            self.fisher_std.is_finite(),
+            self.set_identifiable,
+            emp,
+            fits,
+            ratio,
+            self.within_target()
+                .map_or(String::new(), |b| b.to_string()),
+            if self.violated.is_empty() {
+                "hold".to_string()
+            } else {
+                self.violated.join(";")
+            },
+        )
+    }
+}
+
+const HEADER: &str = "sweep,speed_m_s,duration_s,segments,phi_rad,set,parameter,component,truth,scale,fisher_std,relative_std,identifiable,set_identifiable,empirical_std,fits,ratio,within_target,assumptions\n";
+
+impl Study {
+    /// The names of the model's assumption checks that fail on `point`'s
+    /// push (the pusher pulls, the contact slips, a support sticks, …).
+    pub fn violated(&self, point: &Point) -> anyhow::Result<Vec<&'static str>> {
+        let a = pushval_model::DynamicModel::default()
+            .simulate(&self.scenario(point).problem())
+            .context("the assumption checks")?
+            .assumptions;
+        Ok([
+            ("pulling", a.pulling.is_some()),
+            ("contact_slip", a.contact_slip.is_some()),
+            ("force_limit", a.force_limit.is_some()),
+            ("sticking", a.sticking.is_some()),
+            ("pulling_impulse", a.pulling_impulse.is_some()),
+            ("runaway", a.runaway.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(n, v)| v.then_some(n))
+        .collect())
+    }
+
+    /// The rows of set `set` (index into [`sets`]) at `point`, with the
+    /// empirical std where a check gives it.
+    pub fn rows(
+        &self,
+        point: &Point,
+        set: usize,
+        check: Option<&Check>,
+    ) -> anyhow::Result<Vec<Row>> {
+        let params = &sets()[set];
+        let model = Parametrised::new(&self.scenario(point), params).map_err(anyhow::Error::msg)?;
+        let (std, truth) = match check {
+            Some(c) => (c.fisher.clone(), c.truth.clone()),
+            None => self.fisher_std(point, params)?,
+        };
+        let scales = model.scales();
+        let violated = self.violated(point)?;
+        let set_identifiable = std.iter().all(|v| v.is_finite());
+        Ok(model
+            .slots()
+            .into_iter()
+            .enumerate()
+            .map(|(j, (param, component))| Row {
+                point: point.clone(),
+                set,
+                param,
+                component,
+                truth: truth[j],
+                scale: scales[j],
+                fisher_std: std[j],
+                set_identifiable,
+                empirical: check.map(|c| (c.empirical[j], c.fits)),
+                violated: violated.clone(),
+            })
+            .collect())
+    }
+}
+
+/// What the study found.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// Every row of `identifiability.csv`.
+    pub rows: Vec<Row>,
+    /// The empirical checks.
+    pub checks: Vec<Check>,
+    /// The shortest push per candidate speed and φ.
+    pub shortest: Vec<Shortest>,
+    /// The files written.
+    pub files: Vec<PathBuf>,
+}
+
+/// The shortest push at one speed and φ.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shortest {
+    /// m/s
+    pub speed: f64,
+    /// rad
+    pub phi: f64,
+    /// s; None: longer than the longest searched.
+    pub duration: Option<f64>,
+    /// The model's assumption checks that fail on that push.
+    pub violated: Vec<&'static str>,
+}
+
+impl Outcome {
+    /// The shortest push over every candidate on which the model's
+    /// assumptions hold (`valid`), or over all of them: (speed, φ, duration).
+    pub fn best(&self, valid: bool) -> Option<(f64, f64, f64)> {
+        self.shortest
+            .iter()
+            .filter(|c| !valid || c.violated.is_empty())
+            .filter_map(|c| c.duration.map(|d| (c.speed, c.phi, d)))
+            .min_by(|a, b| a.2.total_cmp(&b.2).then(a.0.total_cmp(&b.0)))
+    }
+}
+
+fn component_name(p: Param, k: usize) -> String {
+    if p.dim() == 1 {
+        p.name().into()
+    } else {
+        format!("{}[{}]", p.name(), ["x", "y"][k])
+    }
+}
+
+/// Runs the study and writes its files into `out` (`quick`: reduced grids,
+/// one check point, the shortest push at 1 m/s only).
+pub fn run(scenarios: &Path, out: &Path, quick: bool) -> anyhow::Result<Outcome> {
+    let study = Study::new(scenarios)?;
+    let mut rows = Vec::new();
+    for p in grid(&study, quick) {
+        for set in 0..sets().len() {
+            rows.extend(study.rows(&p, set, None)?);
+        }
+    }
+    let mut checks = Vec::new();
+    let mut cps = check_points(&study);
+    if quick {
+        cps.truncate(1);
+    }
+    for (i, (p, set_ids)) in cps.iter().enumerate() {
+        for &set in set_ids {
+            let seed0 = 10_000 * (i as u64 + 1) + 1000 * set as u64;
+            let c = study.check(p, &sets()[set], FITS, seed0)?;
+            let at = Point {
+                sweep: "check",
+                ..p.clone()
+            };
+            rows.extend(study.rows(&at, set, Some(&c))?);
+            checks.push(c);
+        }
+    }
+    let mut shortest = Vec::new();
+    let candidates: Vec<(f64, f64)> = shortest_candidates(&study)
+        .into_iter()
+        .filter(|c| !quick || c.0 == 1.0)
+        .collect();
+    let max_duration = if quick { 4.0 } else { 10.0 };
+    for (v, phi) in candidates {
+        let d = study.shortest(v, phi, max_duration)?;
+        let mut violated = Vec::new();
+        if let Some(d) = d {
+            let p = Point {
+                sweep: "shortest",
+                speed: v,
+                duration: d,
+                segments: 1,
+                phi,
+            };
+            let r = study.rows(&p, 0, None)?;
+            violated = r[0].violated.clone();
+            rows.extend(r);
+        }
+        shortest.push(Shortest {
+            speed: v,
+            phi,
+            duration: d,
+            violated,
+        });
+    }
+    let mut o = Outcome {
+        rows,
+        checks,
+        shortest,
+        files: Vec::new(),
+    };
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let csv: String = std::iter::once(HEADER.to_string())
+        .chain(o.rows.iter().map(Row::csv))
+        .collect();
+    let svg = plot::render(&figure(&o)).context("drawing identifiability.svg")?;
+    for (name, bytes) in [
+        ("identifiability.csv", csv.into_bytes()),
+        ("identifiability.svg", svg.into_bytes()),
+        ("fit.md", text(&study, &o, quick).into_bytes()),
+    ] {
+        let path = out.join(name);
+        write_atomic(&path, &bytes)?;
+        o.files.push(path);
+    }
+    Ok(o)
+}
+
+fn sweep_x(sweep: &str, p: &Point) -> f64 {
+    match sweep {
+        "speed" => p.speed,
+        "duration" => p.duration,
+        _ => p.segments as f64,
+    }
+}
+
+/// Whether `p` (a check point) lies on `sweep`'s line through the base push.
+fn on_sweep(sweep: &str, p: &Point) -> bool {
+    match sweep {
+        "speed" => p.duration == 2.0 && p.segments == 1,
+        "duration" => p.speed == 1.0 && p.segments == 1,
+        _ => p.speed == 1.0 && p.duration == 2.0,
+    }
+}
+
+fn figure(o: &Outcome) -> Figure {
+    let sweeps = [
+        ("speed", Axis::lin("push speed v_c (m/s); 2 s, one segment")),
+        (
+            "duration",
+            Axis::log("push duration (s); 1 m/s, one segment"),
+        ),
+        ("segments", Axis::lin("segments in 2 s at 1 m/s")),
+    ];
+    let color = |p: Param, k: usize| match (p, k) {
+        (Param::MuScale, _) => plot::BLUE_,
+        (Param::InertiaCm, _) => plot::RED_,
+        (_, 0) => plot::GREEN_,
+        _ => plot::PURPLE,
+    };
+    let mut top = Vec::new();
+    let mut bottom = Vec::new();
+    for (sweep, axis) in &sweeps {
+        let on: Vec<&Row> = o.rows.iter().filter(|r| r.point.sweep == *sweep).collect();
+        let (xlo, xhi) = on
+            .iter()
+            .map(|r| sweep_x(sweep, &r.point))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+        // The segment panels' curves are flat: room above them for the legend.
+        let (rel_axis, pos_axis) = if *sweep == "segments" {
+            (
+                Axis::log("Fisher std / value").range(1e-4, 1.0),
+                Axis::log("Fisher std (mm)").range(0.05, 10.0),
+            )
+        } else {
+            (
+                Axis::log("Fisher std / value"),
+                Axis::log("Fisher std (mm)"),
+            )
+        };
+        let mut rel = Panel::new(
+            format!("μ and I_cm: relative 1σ against {sweep}"),
+            axis.clone(),
+            rel_axis,
+        )
+        .legend(Legend::UpperRight);
+        let mut pos = Panel::new(
+            format!("contact / centre of friction: 1σ against {sweep}"),
+            axis.clone(),
+            pos_axis,
+        )
+        .legend(Legend::UpperRight);
+        // Curves: μ and I of the sets without and with the contact; the
+        // contact's and the centre of friction's components.
+        for (set, stroke, label) in [
+            (0usize, Stroke::Solid, "μ, I"),
+            (1, Stroke::Dashed, "μ, I, contact"),
+            (2, Stroke::Dashed, "μ, I, c.o.f."),
+        ] {
+            for (param, k) in Parametrised::slots_of(&sets()[set]) {
+                let vector = param.dim() == 2;
+                if !vector && set == 2 {
+                    continue;
+                }
+                let pts: Vec<(f64, f64)> = on
+                    .iter()
+                    .filter(|r| r.set == set && r.param == param && r.component == k)
+                    .filter(|r| r.set_identifiable)
+                    .map(|r| {
+                        let y = if vector {
+                            r.fisher_std * 1e3
+                        } else {
+                            r.relative_std()
+                        };
+                        (sweep_x(sweep, &r.point), y)
+                    })
+                    .collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                let stroke = if vector && set == 1 {
+                    Stroke::Solid
+                } else {
+                    stroke
+                };
+                let s = Series::new(
+                    format!("{} ({label})", component_name(param, k)),
+                    color(param, k),
+                    stroke,
+                )
+                .points(pts);
+                if vector {
+                    pos = pos.series(s);
+                } else {
+                    rel = rel.series(s);
+                }
+            }
+        }
+        rel = rel
+            .series(
+                Series::new("μ target: 2σ ≤ 1 %", plot::BLUE_, Stroke::Dashed)
+                    .width(1)
+                    .points(vec![(xlo, MU_TARGET / SIGMAS), (xhi, MU_TARGET / SIGMAS)]),
+            )
+            .series(
+                Series::new("I target: 2σ ≤ 2 %", plot::RED_, Stroke::Dashed)
+                    .width(1)
+                    .points(vec![
+                        (xlo, INERTIA_TARGET / SIGMAS),
+                        (xhi, INERTIA_TARGET / SIGMAS),
+                    ]),
+            );
+        let checks: Vec<&Row> = o
+            .rows
+            .iter()
+            .filter(|r| r.point.sweep == "check" && on_sweep(sweep, &r.point))
+            .collect();
+        let emp = |vector: bool| -> Vec<(f64, f64)> {
+            checks
+                .iter()
+                .filter(|r| (r.param.dim() == 2) == vector)
+                .filter_map(|r| {
+                    let (e, _) = r.empirical?;
+                    let y = if vector { e * 1e3 } else { e / r.scale };
+                    Some((sweep_x(sweep, &r.point), y))
+                })
+                .collect()
+        };
+        for (vector, panel) in [(false, &mut rel), (true, &mut pos)] {
+            let pts = emp(vector);
+            if !pts.is_empty() {
+                *panel = panel.clone().series(
+                    Series::new(
+                        format!("std of {FITS} noisy fits"),
+                        plot::DARK,
+                        Stroke::Dots,
+                    )
+                    .points(pts),
+                );
+            }
+        }
+        top.push(rel);
+        bottom.push(pos);
+    }
+    let mut panels = top;
+    panels.extend(bottom);
+    Figure {
+        size: (1650, 1000),
+        cols: 3,
+        panels,
+        key: None,
+    }
+}
+
+/// `fit.md`: the settings, the answer, where each set is unidentifiable and
+/// the checks, every number from the rows.
+fn text(study: &Study, o: &Outcome, quick: bool) -> String {
+    let sc = &study.base;
+    let mut s = String::from(
+        "# Fitting μ, I_cm, the contact and the centre of friction: identifiability\n\n",
+    );
+    s += "Written by `pushval fit-study`";
+    if quick {
+        s += " (`--quick`: reduced grids)";
+    }
+    s += " from the numbers in `identifiability.csv`; the figure is `identifiability.svg`.\n\n";
+    s += &format!(
+        "Scene: `{}` ({} kg, I_cm = {:.6} kg m², μ = {}, {} supports, contact at ({}, {}) m), started moving with the pusher at ω = 0. \
+         Noise: {} mm on x and y, {} mrad on θ, every {} s sample. \
+         Fisher std: the diagonal of (JᵀJ)⁻¹ of the whitened residuals at the truth (the file's values), \
+         J by central differences (step {:e} of each parameter's scale), the model's DOP853 trajectory at tolerance {:e}. \
+         Relative std: std / value for μ (scale 1) and I_cm.\n\n",
+        sc.name,
+        sc.mass,
+        sc.inertia_cm,
+        sc.supports[0].mu,
+        sc.supports.len(),
+        sc.contact.x,
+        sc.contact.y,
+        SIGMA_POSITION * 1e3,
+        SIGMA_THETA * 1e3,
+        sc.sample_dt,
+        study.settings.fd_step,
+        study.settings.tolerance
+    );
+    s += "## The shortest push\n\n";
+    s += &format!(
+        "Question: the shortest single push (from the paper's start) that gives μ within {} % and I_cm within {} % at {}σ (Fisher std at the stated noise, fitting mu_scale and inertia_cm together).\n\n",
+        MU_TARGET * 100.0,
+        INERTIA_TARGET * 100.0,
+        SIGMAS
+    );
+    let answer = |(v, phi, d): (f64, f64, f64)| {
+        let mut rel = String::new();
+        for r in o
+            .rows
+            .iter()
+            .filter(|r| r.point.sweep == "shortest" && r.point.speed == v && r.point.phi == phi)
+        {
+            rel += &format!(
+                ", {} 2σ = {:.2} %",
+                r.param.name(),
+                100.0 * SIGMAS * r.relative_std()
+            );
+        }
+        format!(
+            "{d:.2} s at {v} m/s and φ = {phi:.4} rad (φ − π/4 = {:+.2} rad){rel}",
+            phi - FRAC_PI_4
+        )
+    };
+    match o.best(true) {
+        Some(b) => {
+            s += &format!(
+                "**Answer: {}**, the shortest of the pushes on which the model's assumptions hold (pushing only, no contact slip at the file's contact μ, every support sliding); searched over the speeds and angles below in steps of one sample ({} s).\n\n",
+                answer(b),
+                sc.sample_dt
+            );
+        }
+        None => s += "**Answer: none of the candidates on which the model's assumptions hold reaches both targets within the longest duration searched.**\n\n",
+    }
+    if let Some(b) = o.best(false).filter(|b| Some(*b) != o.best(true)) {
+        s += &format!(
+            "Ignoring the assumption checks, the shortest would be {} — but there the model itself is not to be trusted.\n\n",
+            answer(b)
+        );
+    }
+    s += "| speed (m/s) | φ (rad) | shortest duration (s) | failing assumption checks on it |\n|---|---|---|---|\n";
+    for c in &o.shortest {
+        let d = c
+            .duration
+            .map_or("> longest searched".to_string(), |d| format!("{d:.2}"));
+        let v = if c.duration.is_none() {
+            "".to_string()
+        } else if c.violated.is_empty() {
+            "none".to_string()
+        } else {
+            c.violated.join(", ")
+        };
+        s += &format!("| {} | {:.4} | {d} | {v} |\n", c.speed, c.phi);
+    }
+    s += "\n## Where a set is unidentifiable\n\n";
+    s += "By the rules of `pushval fit` (information below 1e-10 of the largest, a direction with eigenvalue below 1e-10 of the largest, or a Fisher std above 1e3 × the scale):\n\n";
+    for (set, params) in sets().iter().enumerate() {
+        for sweep in ["speed", "duration", "segments"] {
+            let mut xs: Vec<f64> = Vec::new();
+            let mut names: Vec<&str> = Vec::new();
+            for r in o
+                .rows
+                .iter()
+                .filter(|r| r.point.sweep == sweep && r.set == set)
+            {
+                if !r.fisher_std.is_finite() {
+                    let x = sweep_x(sweep, &r.point);
+                    if !xs.contains(&x) {
+                        xs.push(x);
+                    }
+                    if !names.contains(&r.param.name()) {
+                        names.push(r.param.name());
+                    }
+                }
+            }
+            let what = if xs.is_empty() {
+                "identifiable everywhere".to_string()
+            } else {
+                format!(
+                    "{} unidentifiable at {sweep} = {}",
+                    names.join(", "),
+                    xs.iter()
+                        .map(|x| format!("{x}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            };
+            s += &format!("- {} against {sweep}: {what}\n", set_name(params));
+        }
+    }
+    s += "\n## Fisher std against repeated noisy fits\n\n";
+    s += &format!(
+        "At each check point, {FITS} fits to the exact trajectory plus fresh noise (fixed seeds), started off the truth (μ × 0.9, I × 1.15, vector parameters + 5 mm in x and y). \
+         The empirical std of the estimates (about their mean) must lie within a factor {AGREEMENT} of the Fisher std either way: with {FITS} fits a normal estimate's sample std falls outside that about 0.1 % of the time.\n\n"
+    );
+    s += "| push | parameters | component | Fisher std | empirical std | ratio | within |\n|---|---|---|---|---|---|---|\n";
+    for c in &o.checks {
+        let push = format!(
+            "{} m/s, {} s, {} segment(s), φ₁ = {:.4}",
+            c.point.speed, c.point.duration, c.point.segments, c.point.phi
+        );
+        let mut j = 0;
+        for p in &c.set {
+            for k in 0..p.dim() {
+                let r = c.empirical[j] / c.fisher[j];
+                s += &format!(
+                    "| {push} | {} | {} | {:.3e} | {:.3e} | {:.2} | {} |\n",
+                    set_name(&c.set),
+                    component_name(*p, k),
+                    c.fisher[j],
+                    c.empirical[j],
+                    r,
+                    if (1.0 / AGREEMENT..=AGREEMENT).contains(&r) {
+                        "yes"
+                    } else {
+                        "NO"
+                    }
+                );
+                j += 1;
+            }
+        }
+        if c.failed > 0 {
+            s += &format!(
+                "| {push} | {} | {} of {} fits did not converge | | | | NO |\n",
+                set_name(&c.set),
+                c.failed,
+                c.fits
+            );
+        }
+    }
+    s += &format!(
+        "\n{} of {} checks pass.\n",
+        o.checks.iter().filter(|c| c.pass()).count(),
+        o.checks.len()
+    );
+    s
+}
+
+/// `pushval fit-study`: runs the study on the shipped scenarios, prints the
+/// answer; exit 0 when every empirical check agrees with the Fisher std, 1
+/// when one does not.
+pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {
+    let start = std::time::Instant::now();
+    let o = run(&crate::report::default_scenario_dir(), out, quick)?;
+    match o.best(true) {
+        Some((v, phi, d)) => println!(
+            "shortest push (model assumptions holding) for μ within {} % and I_cm within {} % at {}σ: {d:.2} s at {v} m/s, φ = {phi:.4} rad",
+            MU_TARGET * 100.0,
+            INERTIA_TARGET * 100.0,
+            SIGMAS
+        ),
+        None => println!("no candidate push reaches both targets"),
+    }
+    for c in &o.checks {
+        let r: Vec<String> = c.ratios().iter().map(|r| format!("{r:.2}")).collect();
+        println!(
+            "check {} m/s, {} s, {} segment(s), {}: empirical/Fisher std {} ({})",
+            c.point.speed,
+            c.point.duration,
+            c.point.segments,
+            set_name(&c.set),
+            r.join(", "),
+            if c.pass() { "ok" } else { "FAIL" }
+        );
+    }
+    let files: Vec<String> = o.files.iter().map(|f| f.display().to_string()).collect();
+    println!(
+        "{} rows in {:.1} s; wrote {}",
+        o.rows.len(),
+        start.elapsed().as_secs_f64(),
+        files.join(", ")
+    );
+    Ok(if o.checks.iter().all(Check::pass) {
+        std::process::ExitCode::SUCCESS
+    } else {
+        for c in o.checks.iter().filter(|c| !c.pass()) {
+            eprintln!(
+                "FAIL check {} m/s, {} s, {}: empirical/Fisher std outside a factor {AGREEMENT}",
+                c.point.speed,
+                c.point.duration,
+                set_name(&c.set)
+            );
+        }
+        std::process::ExitCode::from(1)
+    })
+}
