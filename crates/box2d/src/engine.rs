@@ -1,0 +1,146 @@
+//! The Box2D models as pushval engine plug-ins: `box2d` (per-support
+//! Coulomb forces, gateable) and `box2d_motor_joint` (Box2D's top-down
+//! friction idiom, informational).
+
+use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_model::{ModelError, Problem};
+
+use crate::{Box2dSettings, Box2dSimulator, Friction};
+
+/// The engine crate and version this adapter is built against (the `boxdd`
+/// entry of the workspace's Cargo.toml; a test checks it against
+/// Cargo.lock).
+pub const ENGINE_CRATE: EngineCrate = EngineCrate {
+    name: "boxdd",
+    version: "0.6.0",
+};
+
+/// The Box2D source boxdd 0.6.0 builds (its README: a pinned Box2D 3.2.0
+/// development snapshot).
+const BOX2D_SOURCE: &str = "Box2D 3.2.0 snapshot 56edae7";
+
+/// The `[engine]` keys the Box2D models read, besides `dt`.
+const OPTION_KEYS: &[&str] = &["substeps"];
+
+/// One Box2D model: a friction law and the scenario's engine settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Box2dModel {
+    /// The settings of a run (its `dt` is replaced by the run's).
+    pub settings: Box2dSettings,
+}
+
+/// The settings the `[engine]` table asks for, over the adapter's defaults.
+pub fn settings_from(opts: &EngineOptions) -> Result<Box2dSettings, OptionError> {
+    let mut s = Box2dSettings::default();
+    if let Some(dt) = opts.dt {
+        s.dt = dt;
+    }
+    if let Some(n) = opts.integer("substeps", 1)? {
+        if n > 64 {
+            return Err(OptionError {
+                key: "substeps".into(),
+                problem: format!("must be an integer in 1..=64, got {n}"),
+            });
+        }
+        s.substeps = n;
+    }
+    Ok(s)
+}
+
+fn build(friction: Friction, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
+    let settings = Box2dSettings {
+        friction,
+        ..settings_from(opts)?
+    };
+    Ok(Box::new(Box2dModel { settings }))
+}
+
+/// The Box2D models, one row each: the crate's entries in pushval's engine
+/// registry.
+pub fn models() -> Vec<ModelEntry> {
+    vec![
+        ModelEntry {
+            name: "box2d",
+            build: |o| build(Friction::Coulomb, o),
+        },
+        ModelEntry {
+            name: "box2d_motor_joint",
+            build: |o| build(Friction::MotorJoint, o),
+        },
+    ]
+}
+
+impl Engine for Box2dModel {
+    fn name(&self) -> &'static str {
+        match self.settings.friction {
+            Friction::Coulomb => "box2d",
+            Friction::MotorJoint => "box2d_motor_joint",
+        }
+    }
+    fn description(&self) -> &'static str {
+        match self.settings.friction {
+            Friction::Coulomb => {
+                "Box2D v3: top-down rigid body, kinematic pusher through a revolute joint, Coulomb force at every support"
+            }
+            Friction::MotorJoint => {
+                "Box2D v3 top-down friction idiom: motor joint to the ground capped at mu m g and mu m g r_mean, no per-support forces"
+            }
+        }
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-box2d"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        ENGINE_CRATE
+    }
+    fn version(&self) -> String {
+        format!(
+            "{} {} ({BOX2D_SOURCE}, f64 positions)",
+            ENGINE_CRATE.name, ENGINE_CRATE.version
+        )
+    }
+    /// First order: the friction forces are explicit in the step-start
+    /// state and the pusher is steered at the step-start heading (measured:
+    /// see the crate's README).
+    fn order(&self) -> f64 {
+        1.0
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.dt
+    }
+    fn option_keys(&self) -> &'static [&'static str] {
+        OPTION_KEYS
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = Box2dSettings {
+            dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": s.dt,
+            "substeps": s.substeps,
+            "friction_model": s.friction.as_str(),
+            "joint_hertz": s.joint_hertz,
+            "joint_damping_ratio": crate::JOINT_DAMPING_RATIO,
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = Box2dSimulator::new(Box2dSettings {
+            dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        Ok(EngineRun {
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "max_joint_drift": r.max_joint_drift,
+                "steps": r.steps,
+            }),
+            trajectory: r.trajectory,
+        })
+    }
+}
