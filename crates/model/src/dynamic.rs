@@ -27,7 +27,12 @@ pub enum RootKind {
     Unstable,
     /// ω̇ jumps through zero where a support stops sliding: the object pivots
     /// on that support (friction there is set-valued). Stable if the jump is downward.
-    Pivot { support: usize, stable: bool },
+    Pivot {
+        /// Index of the support that stops sliding.
+        support: usize,
+        /// Whether ω̇ jumps downward through zero there (nearby ω tend to it).
+        stable: bool,
+    },
 }
 
 /// A steady angular velocity of one segment.
@@ -35,6 +40,7 @@ pub enum RootKind {
 pub struct SteadyState {
     /// ω* (rad/s).
     pub omega: f64,
+    /// Stable, unstable, or a pivot on a support.
     pub kind: RootKind,
     /// Relaxation time `τ = −I_P / G'(ω*)` (s) for a stable smooth root, else None.
     pub tau: Option<f64>,

@@ -7,8 +7,11 @@ pub enum ModelError {
     /// A physical parameter is outside its domain (named, with its value).
     #[error("{name} must be {requirement}, got {value}")]
     Parameter {
+        /// The parameter.
         name: &'static str,
+        /// What it must be, e.g. "finite and > 0".
         requirement: &'static str,
+        /// The value given.
         value: f64,
     },
     /// The object has no support points.
@@ -19,17 +22,31 @@ pub enum ModelError {
     EmptySchedule,
     /// The integrator could not keep its error below the tolerance.
     #[error("integration failed at t = {t} s: {reason}")]
-    Integration { t: f64, reason: String },
+    Integration {
+        /// Time of the failure (s).
+        t: f64,
+        /// Why, e.g. a step size underflow.
+        reason: String,
+    },
     /// The state left the finite numbers (a blow-up).
     #[error("the state became non-finite at t = {t} s (step {step})")]
-    NonFinite { t: f64, step: usize },
+    NonFinite {
+        /// Time (s).
+        t: f64,
+        /// Accepted steps so far.
+        step: usize,
+    },
     /// |ω| passed a thousand times the largest value a trajectory of the
     /// segment can reach (its start and its steady states): ω runs away.
     #[error("omega ran away at t = {t} s (step {step}): |{omega:.3e}| rad/s > {limit:.3e} rad/s")]
     Runaway {
+        /// Time (s).
         t: f64,
+        /// Accepted steps so far.
         step: usize,
+        /// ω there (rad/s).
         omega: f64,
+        /// The limit |ω| passed (rad/s).
         limit: f64,
     },
 }

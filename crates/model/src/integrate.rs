@@ -64,7 +64,9 @@ const D7: f64 = 69997945.0 / 29380423.0;
 /// Dense output over one accepted step: `y(t0 + s h)` for `s ∈ [0, 1]`, 4th order.
 #[derive(Debug, Clone, Copy)]
 pub struct Dense {
+    /// Start of the step (s).
     pub t0: f64,
+    /// Step size (s).
     pub h: f64,
     r: [State; 5],
 }
@@ -86,6 +88,7 @@ impl Dense {
 
 /// Result of one attempted Dormand–Prince step.
 pub struct Attempt {
+    /// The state at the step's end (5th order).
     pub y1: State,
     /// Derivative at the new point (first stage of the next step: FSAL).
     pub k7: State,
@@ -341,6 +344,7 @@ pub mod dop853 {
 
     /// One attempted step.
     pub struct Attempt {
+        /// The state at the step's end (8th order).
         pub y1: State,
         /// f(y1): the next step's first stage.
         pub k13: State,
@@ -414,7 +418,9 @@ pub mod dop853 {
     /// The 7th-order dense output over an accepted step.
     #[derive(Debug, Clone, Copy)]
     pub struct Dense {
+        /// Start of the step (s).
         pub t0: f64,
+        /// Step size (s).
         pub h: f64,
         y0: State,
         r: [State; 7],

@@ -20,6 +20,7 @@
 //! mass, `D = [[0,−1],[1,0]]`, `a × b = a_x b_y − a_y b_x`.
 //!
 //! This crate does no I/O and depends on no physics engine.
+#![warn(missing_docs)]
 
 mod arc;
 mod body;

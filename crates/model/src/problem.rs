@@ -76,11 +76,15 @@ impl ContactLimits {
 /// A complete pushing problem: the body, the input schedule, the start.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Problem {
+    /// The pushed object, in its own frame (origin at the centre of mass).
     pub body: Body,
     /// Contact geometry and limits for the assumption checks.
     pub limits: ContactLimits,
+    /// The piecewise-constant input, in order (at least one).
     pub pushes: Vec<Push>,
+    /// The state when the first push starts.
     pub initial: Initial,
+    /// What ω does at a switch.
     pub switching: Switching,
     /// Spacing of the output samples (s), > 0.
     pub sample_dt: f64,

@@ -35,6 +35,7 @@
 //! ([`AVAILABLE`] is false) and [`MujocoSimulator`] returns an error.
 //!
 //! Units are SI throughout (m, s, rad, kg, N).
+#![warn(missing_docs)]
 
 use std::time::Duration;
 
@@ -218,8 +219,9 @@ pub struct MjStep {
     pub segment: usize,
     /// End time of the step (s).
     pub t: f64,
-    /// World position of the centre of mass (m).
+    /// World x of the centre of mass (m).
     pub x: f64,
+    /// World y of the centre of mass (m).
     pub y: f64,
     /// Yaw, unwrapped (rad).
     pub theta: f64,

@@ -7,6 +7,8 @@ use pushval_model::{cross, Body, Push, SegmentDynamics, Vec2};
 /// sliding with velocity `u` (m/s, object frame), given its Coulomb
 /// magnitude `f = μ_i N_i` (N).
 pub trait FrictionLaw {
+    /// The force (N, object frame) on support `i` sliding at `u` (m/s),
+    /// Coulomb magnitude `f` (N).
     fn force(&self, i: usize, u: Vec2, f: f64) -> Vec2;
 }
 
@@ -27,6 +29,7 @@ impl FrictionLaw for Coulomb {
 /// Coulomb friction made viscous below the slip speed `v_s` (m/s):
 /// `−f u / max(|u|, v_s)`. The force of a soft (regularised) contact.
 pub struct Regularised {
+    /// The slip speed `v_s` (m/s).
     pub slip_speed: f64,
 }
 

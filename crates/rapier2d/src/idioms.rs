@@ -52,9 +52,15 @@ pub enum FrictionModel {
     /// The stopping impulse per world axis, each component capped at `F Δt`.
     ImpulseBox,
     /// `−F u/v_s` below the slip speed `slip_speed` (m/s), Coulomb above.
-    RegularisedLinear { slip_speed: f64 },
+    RegularisedLinear {
+        /// The slip speed `v_s` (m/s).
+        slip_speed: f64,
+    },
     /// `−F tanh(|u|/v_s) u/|u|`, `v_s = slip_speed` (m/s).
-    RegularisedTanh { slip_speed: f64 },
+    RegularisedTanh {
+        /// The slip speed `v_s` (m/s).
+        slip_speed: f64,
+    },
 }
 
 impl FrictionModel {

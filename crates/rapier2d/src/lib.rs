@@ -24,6 +24,7 @@
 //! (`world.rs`) is compiled once for each precision.
 //!
 //! Units are SI throughout (m, s, rad, kg, N).
+#![warn(missing_docs)]
 
 use std::time::{Duration, Instant};
 

@@ -56,6 +56,7 @@
 //! refused.
 //!
 //! Units are SI throughout (m, s, rad, kg, N).
+#![warn(missing_docs)]
 
 use std::time::{Duration, Instant};
 
@@ -239,12 +240,15 @@ impl Rapier3dSettings {
 pub struct Step3d {
     /// Push segment of the step.
     pub segment: usize,
-    /// Start and end time (s); equal for the initial record.
+    /// Start time (s); equal to `t1` for the initial record.
     pub t0: f64,
+    /// End time (s).
     pub t1: f64,
-    /// World position of the centre of mass at `t1` (m).
+    /// World x of the centre of mass at `t1` (m).
     pub x: f64,
+    /// World y of the centre of mass at `t1` (m).
     pub y: f64,
+    /// World z (up) of the centre of mass at `t1` (m).
     pub z: f64,
     /// Yaw at `t1`, unwrapped (rad).
     pub theta: f64,
@@ -291,9 +295,10 @@ pub struct Rapier3dRun {
     /// Largest horizontal distance (m) between the pusher and the object's
     /// contact point after a step (before re-pinning).
     pub max_joint_drift: f64,
-    /// Contact manifolds (and their points) the solver saw between the object
-    /// and the ground at the end of the settle phase.
+    /// Contact manifolds the solver saw between the object and the ground at
+    /// the end of the settle phase.
     pub manifolds: usize,
+    /// Contact points in those manifolds.
     pub manifold_points: usize,
     /// Every step of the push, after an initial record at t = 0.
     pub history: Vec<Step3d>,

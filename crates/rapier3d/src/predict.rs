@@ -118,8 +118,9 @@ pub struct Scene {
     pub mass: f64,
     /// Vertical-axis inertia about the centre of mass (kg m²).
     pub inertia_z: f64,
-    /// Tilt inertias about the centre of mass (kg m²).
+    /// Tilt inertia about the x axis through the centre of mass (kg m²).
     pub ixx: f64,
+    /// Tilt inertia about the y axis through the centre of mass (kg m²).
     pub iyy: f64,
     /// Gravity (m/s²).
     pub gravity: f64,

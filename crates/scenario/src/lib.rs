@@ -7,6 +7,7 @@
 //! or into a [`ScenarioError`] that names the file, the key and the value.
 //!
 //! The file format is documented in the repository README ("Scenario format").
+#![warn(missing_docs)]
 
 mod error;
 mod geometry;

@@ -35,22 +35,34 @@ fn opt_xys<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::
     Option::<Vec<Xy>>::deserialize(d).map(|v| v.map(|v| v.into_iter().map(|p| p.0).collect()))
 }
 
+/// The whole file.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawScenario {
+    /// `name`: names the scenario in every output.
     pub name: String,
+    /// `description`: free text.
     pub description: Option<String>,
+    /// `[object]`.
     pub object: RawObject,
+    /// `[supports]`.
     pub supports: RawSupports,
+    /// `[contact]`.
     pub contact: RawContact,
+    /// `[initial]`; absent: all zero.
     pub initial: Option<RawInitial>,
+    /// `[[push]]`, in order.
     #[serde(default)]
     pub push: Vec<RawPush>,
+    /// `[run]`; absent: the defaults.
     pub run: Option<RawRun>,
+    /// `[tolerance]`; absent: every figure `"auto"`.
     pub tolerance: Option<RawTolerance>,
+    /// `[engine]`; absent: each engine's defaults.
     pub engine: Option<RawEngine>,
 }
 
+/// `[object]`: the pushed object.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawObject {
@@ -73,7 +85,9 @@ pub struct RawObject {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum PerPoint {
+    /// The same value at every support.
     One(f64),
+    /// One value per support, in the supports' order.
     Each(Vec<f64>),
 }
 
@@ -81,64 +95,92 @@ pub enum PerPoint {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum RawLoad {
+    /// A rule: `"equal"`, `"statics"` or `"uniform"`.
     Named(String),
+    /// One normal load per support (N).
     Explicit(Vec<f64>),
 }
 
+/// `[supports]`: where the object rests on the floor.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSupports {
+    /// m, object frame
     #[serde(default, deserialize_with = "opt_xys")]
     pub points: Option<Vec<[f64; 2]>>,
     /// m spacing of a uniform-pressure grid, instead of `points`
     pub uniform_grid: Option<f64>,
+    /// Friction coefficient of the supports against the floor
     pub mu: PerPoint,
+    /// Normal loads; default `"equal"` (`"uniform"` with `uniform_grid`)
     pub load: Option<RawLoad>,
     /// m/s², default 9.81
     pub gravity: Option<f64>,
 }
 
+/// `[contact]`: where the pusher touches the object.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawContact {
+    /// m, object frame, on the polygon's boundary
     #[serde(deserialize_with = "xy")]
     pub point: [f64; 2],
+    /// Pusher–object friction coefficient: flags contact slip
     pub mu: Option<f64>,
+    /// N: flags where the pusher would need more
     pub max_force: Option<f64>,
 }
 
+/// `[initial]`: the state when the first push starts.
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawInitial {
+    /// rad, default 0
     pub theta: Option<f64>,
+    /// rad/s, default 0
     pub omega: Option<f64>,
+    /// m, world position of the centre of mass; default [0, 0]
     #[serde(default, deserialize_with = "opt_xy")]
     pub position: Option<[f64; 2]>,
+    /// At rest when the pusher starts (an impulsive start); default false
     pub from_rest: Option<bool>,
 }
 
+/// One `[[push]]`: a constant pusher velocity for a while.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawPush {
+    /// s, > 0
     pub duration: f64,
+    /// m/s, >= 0
     pub speed: f64,
+    /// rad, direction of the push in the object frame
     pub phi: f64,
 }
 
+/// `[run]`: what runs and how it is sampled.
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawRun {
+    /// Model names, in output order
     pub models: Option<Vec<String>>,
+    /// The engines asserted against the dynamic model
     pub gate: Option<Vec<String>>,
+    /// s, default 0.01
     pub sample_dt: Option<f64>,
+    /// `"impulsive"` (default) or `"continuous"`
     pub switching: Option<String>,
 }
 
+/// `[tolerance]`: what is asserted between a gated engine and the dynamic model.
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawTolerance {
+    /// Relative error of the steady ω
     pub omega_steady_rel: Option<RawLimit>,
+    /// m, largest centre-of-mass position difference
     pub position_max: Option<RawLimit>,
+    /// rad, largest angle difference
     pub theta_max: Option<RawLimit>,
 }
 
@@ -146,7 +188,9 @@ pub struct RawTolerance {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum RawLimit {
+    /// The figure itself (in its unit).
     Number(f64),
+    /// A word; only `"auto"` is valid.
     Word(String),
 }
 

@@ -8,7 +8,8 @@ use pushval_model::{
 };
 use rstest::rstest;
 
-use crate::common::*;
+mod common;
+use common::*;
 
 /// Pushing through the centre of friction of a symmetric plate: the friction
 /// moment about the contact vanishes at ω = 0 and so does the inertial term,

@@ -3,7 +3,8 @@
 use pushval_model::{DynamicModel, Initial, Integrator, Push, Simulator, Switching};
 use rstest::rstest;
 
-use crate::common::*;
+mod common;
+use common::*;
 
 /// The paper-style schedule at 1 m/s: five 2 s segments, impulsive switches.
 fn paper_problem() -> pushval_model::Problem {
