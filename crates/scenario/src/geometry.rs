@@ -113,6 +113,10 @@ pub(crate) fn contains(poly: &[Vec2], p: Vec2) -> bool {
 
 /// Convex hull of a point set (counter-clockwise, parry2d).
 pub(crate) fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
+    // parry needs two points at least; one point is its own hull.
+    if points.len() < 2 {
+        return points.to_vec();
+    }
     let pts: Vec<_> = points
         .iter()
         .map(|v| parry2d_f64::math::Vector::new(v.x, v.y))
