@@ -127,7 +127,7 @@ fn main() {
     );
     for r in &rows {
         csv.push_str(&format!(
-            "{},{},{:.6e},{:.4e},{:.4e},{:.4e},{}\n",
+            "{},\"{}\",{:.6e},{:.4e},{:.4e},{:.4e},{}\n",
             r.engine, r.version, r.dt, r.cpu_per_sim_s, r.omega_rel, r.position, r.steps
         ));
     }
@@ -161,6 +161,16 @@ fn main() {
         ));
     }
     let out = root.join("results");
+    if let Some(best) = rows
+        .iter()
+        .filter(|r| r.omega_rel <= TARGET)
+        .min_by(|a, b| a.cpu_per_sim_s.total_cmp(&b.cpu_per_sim_s))
+    {
+        summary.push_str(&format!(
+            "# cheapest at {TARGET:e} relative steady-omega error: {} at dt = {:.4e} s, {:.4e} s CPU per simulated second\n",
+            best.engine, best.dt, best.cpu_per_sim_s
+        ));
+    }
     pushval::output::write_atomic(&out.join("engine_work_precision.csv"), csv.as_bytes())
         .expect("write csv");
     pushval::output::write_atomic(
