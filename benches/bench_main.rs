@@ -5,6 +5,7 @@
 mod benchmarks;
 
 criterion::criterion_main!(
+    benchmarks::engine_step::benches,
     benchmarks::model_rhs::benches,
     benchmarks::model_steady::benches,
     benchmarks::model_trajectory::benches,

@@ -1,3 +1,4 @@
+pub mod engine_step;
 pub mod model_rhs;
 pub mod model_steady;
 pub mod model_trajectory;

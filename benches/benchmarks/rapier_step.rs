@@ -3,7 +3,10 @@
 //! (no colliders: friction is applied as forces, rapier's broad and narrow
 //! phases have nothing to do), the same run with massless, non-interacting
 //! colliders on the object and the pusher (`EngineSettings::colliders`), to
-//! measure what skipping the collision stages saves.
+//! measure what skipping the collision stages saves. Adapter-specific on
+//! purpose (precision, friction-velocity modes, colliders and the split of
+//! the time between rapier's step and the adapter are not in the `Engine`
+//! trait); `engine_step` times every engine through the trait.
 
 use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use pushval_model::{Initial, Problem, Push, Switching};
