@@ -15,6 +15,7 @@ pub const ENGINE_CRATES: &[fn() -> Vec<ModelEntry>] = &[
     pushval_rapier3d::models,
     pushval_mujoco::models,
     pushval_box2d::models,
+    pushval_avian::models,
 ];
 
 /// Every engine model, in registry order.

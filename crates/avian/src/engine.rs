@@ -1,0 +1,212 @@
+//! The Avian models as pushval engine plug-ins: `avian2d` (per-support
+//! Coulomb forces in Avian's substep loop) and `avian3d` (the plate on ball
+//! feet with Avian's own contact friction). Without the `avian` feature they
+//! are listed but not available.
+
+use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_model::{ModelError, Problem};
+
+use crate::{Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator, AVAILABLE};
+
+/// The 2-D engine crate and the version this adapter is built against (the
+/// `avian2d` entry of the workspace's Cargo.toml; a test checks it against
+/// Cargo.lock).
+pub const ENGINE_CRATE_2D: EngineCrate = EngineCrate {
+    name: "avian2d",
+    version: "0.7.0",
+};
+
+/// The 3-D engine crate and version (the `avian3d` entry).
+pub const ENGINE_CRATE_3D: EngineCrate = EngineCrate {
+    name: "avian3d",
+    version: "0.7.0",
+};
+
+/// The `[engine]` keys the Avian models read, besides `dt`.
+const OPTION_KEYS: &[&str] = &["substeps"];
+
+/// Avian's substep count from `[engine] substeps`, if set (1 to 1024).
+fn substeps(opts: &EngineOptions) -> Result<Option<u32>, OptionError> {
+    match opts.integer("substeps", 1)? {
+        Some(n) if n > 1024 => Err(OptionError {
+            key: "substeps".into(),
+            problem: format!("must be at most 1024, got {n}"),
+        }),
+        n => Ok(n.map(|n| n as u32)),
+    }
+}
+
+fn availability() -> Result<(), String> {
+    if AVAILABLE {
+        Ok(())
+    } else {
+        Err("build with --features avian".into())
+    }
+}
+
+/// The `avian2d` model.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Avian2dModel {
+    /// The settings of a run (its `dt` is replaced by the run's).
+    pub settings: Avian2dSettings,
+}
+
+/// The `avian3d` model.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Avian3dModel {
+    /// The settings of a run (its `dt` is replaced by the run's).
+    pub settings: Avian3dSettings,
+}
+
+/// The Avian models: the crate's entries in pushval's engine registry.
+pub fn models() -> Vec<ModelEntry> {
+    vec![
+        ModelEntry {
+            name: "avian2d",
+            build: |o| {
+                let mut settings = Avian2dSettings::default();
+                if let Some(dt) = o.dt {
+                    settings.dt = dt;
+                }
+                if let Some(n) = substeps(o)? {
+                    settings.substeps = n;
+                }
+                Ok(Box::new(Avian2dModel { settings }))
+            },
+        },
+        ModelEntry {
+            name: "avian3d",
+            build: |o| {
+                let mut settings = Avian3dSettings::default();
+                if let Some(dt) = o.dt {
+                    settings.dt = dt;
+                }
+                if let Some(n) = substeps(o)? {
+                    settings.substeps = n;
+                }
+                Ok(Box::new(Avian3dModel { settings }))
+            },
+        },
+    ]
+}
+
+impl Engine for Avian2dModel {
+    fn name(&self) -> &'static str {
+        "avian2d"
+    }
+    fn description(&self) -> &'static str {
+        "top-down rigid body, kinematic pusher through a revolute joint, Coulomb force at every support in Avian's substep loop"
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-avian"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        ENGINE_CRATE_2D
+    }
+    /// First order: the trajectory's error is proportional to the substep
+    /// (measured: see the crate's README; the steady ω converges faster).
+    fn order(&self) -> f64 {
+        1.0
+    }
+    fn availability(&self) -> Result<(), String> {
+        availability()
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.dt
+    }
+    fn option_keys(&self) -> &'static [&'static str] {
+        OPTION_KEYS
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = Avian2dSettings {
+            dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": dt,
+            "substeps": s.substeps,
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = Avian2dSimulator::new(Avian2dSettings {
+            dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        Ok(EngineRun {
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_joint_drift": r.max_joint_drift,
+            }),
+            trajectory: r.trajectory,
+        })
+    }
+}
+
+impl Engine for Avian3dModel {
+    fn name(&self) -> &'static str {
+        "avian3d"
+    }
+    fn description(&self) -> &'static str {
+        "plate on ball feet on a floor, Avian's own contact friction (Coulomb along -u per contact point)"
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-avian"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        ENGINE_CRATE_3D
+    }
+    /// First order in the step (measured: see the crate's README).
+    fn order(&self) -> f64 {
+        1.0
+    }
+    fn availability(&self) -> Result<(), String> {
+        availability()
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.dt
+    }
+    fn option_keys(&self) -> &'static [&'static str] {
+        OPTION_KEYS
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = Avian3dSettings {
+            dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": dt,
+            "substeps": s.substeps,
+            "foot_radius": s.foot_radius,
+            "cm_height": s.cm_height,
+            "settle_time": s.settle_time,
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = Avian3dSimulator::new(Avian3dSettings {
+            dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        Ok(EngineRun {
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_joint_drift": r.max_joint_drift,
+                "max_tilt": r.max_tilt,
+                "rest_loads": r.rest_loads,
+                "mu": r.mu,
+            }),
+            trajectory: r.trajectory,
+        })
+    }
+}
