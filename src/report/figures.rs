@@ -16,12 +16,20 @@ use super::plot::{
     PURPLE,
 };
 use super::{num, Csv, Entry, Writer};
+use pushval_model::{kappa, kappa_series, KappaSeries};
 
-fn stroke_for(k: usize) -> Stroke {
-    match k % 3 {
-        0 => Stroke::Solid,
-        1 => Stroke::Dashed,
-        _ => Stroke::Dots,
+/// `(min, max)` of the finite values (`(NaN, NaN)` when there are none).
+fn min_max(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if lo > hi {
+        (f64::NAN, f64::NAN)
+    } else {
+        (lo, hi)
     }
 }
 
@@ -68,6 +76,40 @@ pub fn figures(
     ])
 }
 
+/// The relative error a closed form of κ may have below its Froude limit.
+pub const KAPPA_LIMIT_TOLERANCE: f64 = 0.01;
+
+/// One κ curve: a geometry and push direction, its closed-form series and
+/// the Froude numbers below which each closed form stays within
+/// [`KAPPA_LIMIT_TOLERANCE`] of the exact κ.
+struct KappaCurve {
+    geom: usize,
+    phi: usize,
+    series: Option<KappaSeries>,
+    /// `[first order, second order]` (`first_order_froude_limit`,
+    /// `second_order_froude_limit`); NaN where no series exists.
+    limits: [f64; 2],
+    /// `(Fr, κ exact)` on the grid.
+    exact: Vec<(f64, f64)>,
+}
+
+impl KappaCurve {
+    /// `[1 + κ₁ Fr, 1 + κ₁ Fr + κ₂ Fr²]` (NaN without a series).
+    fn closed(&self, fr: f64) -> [f64; 2] {
+        self.series
+            .map_or([f64::NAN; 2], |s| [s.first_order(fr), s.second_order(fr)])
+    }
+}
+
+/// `(x, y)` points up to the first one outside `[lo, hi]` in y (a closed
+/// form leaves the panel and is not drawn beyond).
+fn within(points: impl IntoIterator<Item = (f64, f64)>, lo: f64, hi: f64) -> Vec<(f64, f64)> {
+    points
+        .into_iter()
+        .take_while(|p| p.1 >= lo && p.1 <= hi)
+        .collect()
+}
+
 fn kappa_figure(
     geoms: &[Geometry],
     grids: &Grids,
@@ -75,6 +117,25 @@ fn kappa_figure(
     rows: &[Vec<f64>],
     w: &mut Writer,
 ) -> anyhow::Result<Entry> {
+    let mut curves: Vec<KappaCurve> = Vec::new();
+    for (gi, g) in geoms.iter().enumerate() {
+        for (pi, &phi) in g.phis.iter().enumerate() {
+            let series = kappa_series(&g.body, phi);
+            let limit = |f: fn(&pushval_model::Body, f64, f64) -> Option<f64>| {
+                f(&g.body, phi, KAPPA_LIMIT_TOLERANCE).unwrap_or(f64::NAN)
+            };
+            curves.push(KappaCurve {
+                geom: gi,
+                phi: pi,
+                series,
+                limits: [
+                    limit(kappa::first_order_froude_limit),
+                    limit(kappa::second_order_froude_limit),
+                ],
+                exact: Vec::new(),
+            });
+        }
+    }
     let mut csv = Csv::new(&[
         "geometry",
         "phi",
@@ -84,71 +145,139 @@ fn kappa_figure(
         "omega_steady",
         "kappa",
         "tau",
+        "kappa1",
+        "kappa2",
+        "kappa_first_order",
+        "kappa_second_order",
+        "froude_limit_first_order",
+        "froude_limit_second_order",
     ]);
-    // curves[geom][phi] = [(Fr, κ)]
-    let mut curves: Vec<Vec<Vec<(f64, f64)>>> = geoms
-        .iter()
-        .map(|g| vec![Vec::new(); g.phis.len()])
-        .collect();
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Kappa { geom, phi, i } = *t {
             let g = &geoms[geom];
+            let fr = grids.fr[i];
+            let c = curves
+                .iter_mut()
+                .find(|c| c.geom == geom && c.phi == phi)
+                .expect("a curve per geometry and direction");
+            let [k1, k2] = c.series.map_or([f64::NAN; 2], |s| [s.kappa1, s.kappa2]);
+            let [first, second] = c.closed(fr);
             csv.row(&[
                 g.name.to_string(),
                 num(g.phis[phi]),
-                num(grids.fr[i]),
+                num(fr),
                 num(r[0]),
                 num(r[1]),
                 num(r[2]),
                 num(r[3]),
                 num(r[4]),
+                num(k1),
+                num(k2),
+                num(first),
+                num(second),
+                num(c.limits[0]),
+                num(c.limits[1]),
             ]);
-            curves[geom][phi].push((grids.fr[i], r[3]));
+            c.exact.push((fr, r[3]));
         }
     }
-    let mut left = Panel::new(
-        "κ = ω* / (v_c ψ) against the Froude number",
-        Axis::log("Froude number Fr = v_c² / (μ̄ g L)"),
-        Axis::lin("κ = ω* / (v_c ψ(φ))"),
-    )
-    .legend(Legend::LowerLeft);
-    let mut right = Panel::new(
-        "|1 − κ| (log–log): the departure from the kinematic model",
-        Axis::log("Froude number Fr = v_c² / (μ̄ g L)"),
-        Axis::log("|1 − κ|"),
-    )
-    .legend(Legend::None);
-    for (gi, g) in geoms.iter().enumerate() {
-        for (pi, phi) in g.phis.iter().enumerate() {
-            let pts = &curves[gi][pi];
-            let s = Series::new(
-                format!("{}, φ = {phi:.3}", g.name),
-                PALETTE[gi],
-                stroke_for(pi),
-            )
-            .width(if stroke_for(pi) == Stroke::Dots { 3 } else { 2 });
-            left = left.series(s.clone().points(pts.clone()));
-            right = right.series(
-                s.points(
-                    pts.iter()
-                        .map(|&(x, k)| (x, (1.0 - k).abs()))
-                        .filter(|p| p.1 > 0.0)
-                        .collect(),
-                ),
+    // One panel per geometry: exact (solid), first order (dashed), second
+    // order (dotted), one colour per push direction; then the closed forms'
+    // relative errors, one colour per geometry, with the 1 % line.
+    let (k_lo, k_hi) = min_max(curves.iter().flat_map(|c| c.exact.iter().map(|p| p.1)));
+    let (y_lo, y_hi) = (k_lo.min(1.0) - 0.05, k_hi.max(1.0) + 0.05);
+    let fr_axis = || Axis::log("Froude number Fr = v_c² / (μ̄ g L)");
+    let mut panels = Vec::new();
+    for (gi, g) in geoms.iter().enumerate().filter(|(_, g)| !g.phis.is_empty()) {
+        let mut p = Panel::new(
+            format!("κ = ω*/(v_c ψ): {}", g.name),
+            fr_axis(),
+            Axis::lin("κ").range(y_lo, y_hi),
+        )
+        .legend(Legend::LowerLeft);
+        let mine: Vec<&KappaCurve> = curves.iter().filter(|c| c.geom == gi).collect();
+        for c in &mine {
+            p = p.series(
+                Series::new(
+                    format!("φ = {:.3}", g.phis[c.phi]),
+                    PALETTE[c.phi % PALETTE.len()],
+                    Stroke::Solid,
+                )
+                .points(c.exact.clone()),
             );
         }
+        for (k, stroke, label) in [
+            (0, Stroke::Dashed, "1 + κ₁ Fr (dashed)"),
+            (1, Stroke::Dotted, "1 + κ₁ Fr + κ₂ Fr² (dotted)"),
+        ] {
+            for c in &mine {
+                let pts = within(
+                    c.exact.iter().map(|&(fr, _)| (fr, c.closed(fr)[k])),
+                    y_lo,
+                    y_hi,
+                );
+                let label = if c.phi == 0 { label } else { "" };
+                p = p
+                    .series(Series::new(label, PALETTE[c.phi % PALETTE.len()], stroke).points(pts));
+            }
+        }
+        panels.push(p);
+    }
+    for (k, order) in [
+        (0, "first order 1 + κ₁ Fr"),
+        (1, "second order 1 + κ₁ Fr + κ₂ Fr²"),
+    ] {
+        let mut p = Panel::new(
+            format!("relative error of the {order}"),
+            fr_axis(),
+            Axis::log("|κ_closed − κ| / κ"),
+        )
+        .legend(if k == 0 {
+            Legend::UpperLeft
+        } else {
+            Legend::None
+        });
+        for c in &curves {
+            let label = if c.phi == 0 { geoms[c.geom].name } else { "" };
+            let pts: Vec<(f64, f64)> = c
+                .exact
+                .iter()
+                .map(|&(fr, kappa)| (fr, ((c.closed(fr)[k] - kappa) / kappa).abs()))
+                .filter(|q| q.1 > 0.0 && q.1.is_finite())
+                .collect();
+            p = p.series(
+                Series::new(label, PALETTE[c.geom % PALETTE.len()], Stroke::Solid).points(pts),
+            );
+        }
+        p = p.series(
+            Series::new(
+                if k == 0 {
+                    "1 % (the Froude limits)"
+                } else {
+                    ""
+                },
+                DARK,
+                Stroke::Dashed,
+            )
+            .width(1)
+            .points(vec![
+                (grids.fr[0], KAPPA_LIMIT_TOLERANCE),
+                (*grids.fr.last().unwrap_or(&10.0), KAPPA_LIMIT_TOLERANCE),
+            ]),
+        );
+        panels.push(p);
     }
     w.file("kappa.csv", csv.as_bytes())?;
     w.figure(
         "kappa.svg",
         &Figure {
-            size: (1600, 700),
-            cols: 2,
-            panels: vec![left, right],
+            size: (1800, 1040),
+            cols: 3,
+            panels,
             key: None,
         },
     )?;
-    let all: Vec<&Vec<(f64, f64)>> = curves.iter().flatten().collect();
+    let all: Vec<&Vec<(f64, f64)>> = curves.iter().map(|c| &c.exact).collect();
     let spread_at = |fr: f64| {
         let ks: Vec<f64> = all.iter().map(|c| interp_log(c, fr)).collect();
         let lo = ks.iter().copied().fold(f64::INFINITY, f64::min);
@@ -164,49 +293,86 @@ fn kappa_figure(
             format!("| {fr} | {lo:.4} | {hi:.4} | {:.4} |", hi - lo)
         })
         .collect();
-    // Small-Fr slope of |1 − κ| on log–log axes, per curve (first two grid points).
-    let mut slopes: Vec<f64> = all
+    // Observed orders of the closed forms' errors at the two smallest Fr.
+    let order_of = |k: usize| {
+        min_max(curves.iter().filter(|c| c.exact.len() >= 2).map(|c| {
+            let e = |p: (f64, f64)| ((c.closed(p.0)[k] - p.1) / p.1).abs();
+            let (a, b) = (c.exact[0], c.exact[1]);
+            (e(b).ln() - e(a).ln()) / (b.0.ln() - a.0.ln())
+        }))
+    };
+    let (o1, o2) = (order_of(0), order_of(1));
+    let (c_lo, c_hi) = min_max(curves.iter().filter_map(|c| c.series.map(|s| s.kappa1)));
+    let limits: Vec<String> = curves
         .iter()
-        .filter(|c| c.len() >= 2)
         .map(|c| {
-            let (a, b) = (c[0], c[1]);
-            ((1.0 - b.1).abs().ln() - (1.0 - a.1).abs().ln()) / (b.0.ln() - a.0.ln())
+            let g = &geoms[c.geom];
+            let (k1, k2) = c
+                .series
+                .map_or((f64::NAN, f64::NAN), |s| (s.kappa1, s.kappa2));
+            let speed = |fr: f64| g.speed(fr);
+            format!(
+                "| {} | {:.3} | {k1:.4} | {k2:.4} | {} | {} |",
+                g.name,
+                g.phis[c.phi],
+                limit_text(c.limits[0], speed(c.limits[0])),
+                limit_text(c.limits[1], speed(c.limits[1])),
+            )
         })
         .collect();
-    slopes.sort_by(f64::total_cmp);
-    let (smin, smax) = (
-        slopes.first().copied().unwrap_or(f64::NAN),
-        slopes.last().copied().unwrap_or(f64::NAN),
-    );
-    // The prefactor c of κ ≈ 1 − c Fr at the smallest Fr.
-    let mut cs: Vec<f64> = all
-        .iter()
-        .filter_map(|c| c.first().map(|p| (1.0 - p.1) / p.0))
-        .collect();
-    cs.sort_by(f64::total_cmp);
-    let (cmin, cmax) = (
-        cs.first().copied().unwrap_or(f64::NAN),
-        cs.last().copied().unwrap_or(f64::NAN),
-    );
+    let (l1_lo, l1_hi) = min_max(curves.iter().map(|c| c.limits[0]));
+    let (l2_lo, l2_hi) = min_max(curves.iter().map(|c| c.limits[1]));
     Ok(Entry {
         figure: "kappa.svg".into(),
         data: vec!["kappa.csv".into()],
         text: format!(
             "κ = ω*/(v_c ψ), the paper's missing scaling factor between the dynamic and the \
-             quasi-static model, against Fr (log x) for {} curves: four geometries (colours; the \
-             paper plate pushed at a corner on four supports, a triangle pushed on an edge, the \
-             same square on a uniform pressure, a 3:1 rectangle pushed at a corner) and three \
-             push directions each (line styles). Every curve starts at κ = 1 as Fr → 0, and \
-             |1 − κ| grows like Fr^p with p between {smin:.2} and {smax:.2} at the smallest Fr, \
-             i.e. κ ≈ 1 − c Fr with a prefactor c between {cmin:.3} and {cmax:.3} that depends on \
-             the geometry and φ. So the curves do not collapse on Fr alone: c varies by a factor \
-             {:.1} over the curves, and the spread (max − min κ) peaks near Fr ≈ 1; a geometry factor c would rescale the small-Fr part onto one line.\n\n\
-             | Fr | min κ | max κ | spread |\n|---|---|---|---|\n{}",
-            all.len(),
-            cmax / cmin,
-            table.join("\n")
+             quasi-static model, against Fr (log x) for {n} curves: four geometries (one panel \
+             each: the paper plate pushed at a corner on four supports, a triangle pushed on an \
+             edge, the same square on a uniform pressure, a 3:1 rectangle pushed at a corner) and \
+             three push directions each (colours). Solid: the exact κ (the steady root of the \
+             dynamic model reached from ω = 0); dashed: the first-order closed form 1 + κ₁ Fr; \
+             dotted: the second-order one 1 + κ₁ Fr + κ₂ Fr² (`pushval_model::kappa`: \
+             κ₁ = −L (p_c · n_φ)/h'(ψ), κ₂ = κ₁² (1 − ψ h''(ψ)/(2 h'(ψ))), h the friction moment \
+             about the contact per unit total friction; a closed form is drawn until it leaves \
+             the panel). The bottom panels give their relative errors: at the two smallest Fr \
+             they grow with Fr with the observed order {o1a:.2}–{o1b:.2} (first order) and \
+             {o2a:.2}–{o2b:.2} (second order): the first-order formula is off by O(Fr²), the \
+             second-order one by O(Fr³). Every curve starts at κ = 1; the slope κ₁ ranges over {c_lo:.3} to \
+             {c_hi:.3}, so the curves do not collapse on Fr alone (a factor {ratio:.1} between \
+             the slopes), and the spread (max − min κ) peaks near Fr ≈ 1.\n\n\
+             The Froude number below which each closed form stays within \
+             {tol} % of the exact κ (`first_order_froude_limit` / `second_order_froude_limit` \
+             with tolerance {tolf}: the first Fr, on a scan of 8 points a decade bisected to \
+             1e-10, where the relative error exceeds it; in brackets the pusher speed there): \
+             the first order holds up to Fr = {l1_lo:.3}–{l1_hi:.3}, the second order up to \
+             Fr = {l2_lo:.3}–{l2_hi:.3}.\n\n\
+             | geometry | φ (rad) | κ₁ | κ₂ | Fr limit, first order (v_c) | Fr limit, second order (v_c) |\n\
+             |---|---|---|---|---|---|\n{limits}\n\n\
+             | Fr | min κ | max κ | spread |\n|---|---|---|---|\n{table}",
+            n = curves.len(),
+            o1a = o1.0,
+            o1b = o1.1,
+            o2a = o2.0,
+            o2b = o2.1,
+            ratio = c_lo.abs().max(c_hi.abs()) / c_lo.abs().min(c_hi.abs()),
+            tol = 100.0 * KAPPA_LIMIT_TOLERANCE,
+            tolf = KAPPA_LIMIT_TOLERANCE,
+            limits = limits.join("\n"),
+            table = table.join("\n"),
         ),
     })
+}
+
+/// A Froude limit and the pusher speed there, for the README.
+fn limit_text(fr: f64, speed: f64) -> String {
+    if fr.is_nan() {
+        "no series".into()
+    } else if fr.is_infinite() {
+        "none up to 1e6".into()
+    } else {
+        format!("{fr:.4} ({speed:.3} m/s)")
+    }
 }
 
 fn tau_figure(

@@ -16,6 +16,8 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 pub enum Stroke {
     Solid,
     Dashed,
+    /// A line of short dashes (finer than [`Stroke::Dashed`]).
+    Dotted,
     /// Small filled circles at the points (for the engine drawn over a model).
     Dots,
 }
@@ -522,6 +524,9 @@ where
             Stroke::Dashed => chart
                 .draw_series(DashedLineSeries::new(pts, 9, 6, style))
                 .map_err(err)?,
+            Stroke::Dotted => chart
+                .draw_series(DashedLineSeries::new(pts, 2, 4, style))
+                .map_err(err)?,
             Stroke::Dots => {
                 let c = s.color;
                 let r = s.width;
@@ -543,6 +548,15 @@ where
                         EmptyElement::at((x, y))
                             + PathElement::new(vec![(0, 0), (8, 0)], style)
                             + PathElement::new(vec![(13, 0), (21, 0)], style)
+                    });
+                }
+                Stroke::Dotted => {
+                    anno.label(s.label.as_str()).legend(move |(x, y)| {
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (2, 0)], style)
+                            + PathElement::new(vec![(6, 0), (8, 0)], style)
+                            + PathElement::new(vec![(12, 0), (14, 0)], style)
+                            + PathElement::new(vec![(18, 0), (20, 0)], style)
                     });
                 }
                 Stroke::Solid => {

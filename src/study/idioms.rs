@@ -461,6 +461,7 @@ impl super::Study for Idioms {
         readme.push_str(&locks(&data, w)?);
         readme.push_str(&stop);
         readme.push_str(&angle);
+        readme.push_str(&super::fits::readme_section(out));
         readme.push_str(&other_engines(out));
         w.file("README.md", readme.as_bytes())?;
         Ok(())
@@ -1069,7 +1070,7 @@ fn findings(d: &Data) -> String {
         format!("At Δt = 1/60 it chatters in none of the {n_cells} cells of this grid.")
     } else {
         format!(
-            "At Δt = 1/60 it chatters in {} of {n_cells} cells, all at Fr ≤ {:.2} (stop gain γ > 2, below).",
+            "At Δt = 1/60 it chatters in {} of {n_cells} cells, all at Fr ≤ {:.3} (stop gain γ > 2, below).",
             disk_chat.len(),
             disk_chat.iter().map(|c| c.fr).fold(0.0, f64::max)
         )
@@ -1181,7 +1182,7 @@ supports would damp this; not done).\n\n",
 }
 
 /// Rows of a CSV file as header → value maps (None when the file is missing).
-fn read_csv(path: &Path) -> Option<Vec<std::collections::HashMap<String, String>>> {
+pub(super) fn read_csv(path: &Path) -> Option<Vec<std::collections::HashMap<String, String>>> {
     let text = std::fs::read_to_string(path).ok()?;
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next()?.split(',').collect();

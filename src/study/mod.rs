@@ -8,9 +8,16 @@
 //!   rapier2d, against Coulomb; its README also gathers the other studies'
 //!   paper-plate numbers and findings, so `all` runs it last;
 //! * [`rapier3d`] (`OUT/rapier3d/`): rapier3d's own contact friction;
+//! * [`box2d`] (`OUT/box2d/`): Box2D's per-support Coulomb model and its
+//!   motor-joint idiom (through the registry's `Engine` trait, with the
+//!   idiom's closed form from `pushval_box2d::predict`);
 //! * `mujoco` (`OUT/mujoco/`): MuJoCo's friction cones; compiled only with
 //!   the root feature `mujoco` (without it `study mujoco` exits 2 naming the
-//!   feature and `study all` skips it, keeping `OUT/mujoco/` as it is).
+//!   feature and `study all` skips it, keeping `OUT/mujoco/` as it is);
+//! * `avian` (`OUT/avian/`): Avian's per-support Coulomb model (avian2d) and
+//!   its own contact friction in closed form (avian3d, through the crate's
+//!   simulators and `pushval_avian::predict`); compiled only with the root
+//!   feature `avian`, gated like `mujoco`.
 //!
 //! A study is a fixed list of tasks (engine runs and the closed forms that
 //! need their output), each reduced to a row of numbers ([`Study::eval`]);
@@ -31,6 +38,10 @@
 //! contact manifolds, tail statistics). The registry still names and
 //! versions each engine in the READMEs.
 
+#[cfg(feature = "avian")]
+pub mod avian;
+pub mod box2d;
+pub mod fits;
 pub mod idioms;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
@@ -46,11 +57,22 @@ use crate::report::shard::{grid_name, shard_range, Parts, Shard};
 use crate::report::{par_rows, Writer};
 
 /// The studies on the command line, in the order `all` runs them.
-pub const STUDIES: [&str; 3] = ["rapier3d", "mujoco", "idioms"];
+pub const STUDIES: [&str; 6] = [
+    "rapier3d",
+    "mujoco",
+    "box2d",
+    "avian",
+    "coulomb_fits",
+    "idioms",
+];
 
 /// The cargo feature that brings in the MuJoCo study.
 pub const MUJOCO_FEATURE: &str =
     "the MuJoCo study needs the cargo feature `mujoco` (build with --features mujoco; scripts/setup-mujoco.sh provides libmujoco.so)";
+
+/// The cargo feature that brings in the Avian study.
+pub const AVIAN_FEATURE: &str =
+    "the Avian study needs the cargo feature `avian` (build with --features avian)";
 
 /// What `pushval study` does.
 #[derive(Debug, Clone)]
@@ -167,6 +189,13 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
                 ));
                 continue;
             }
+            if s == "avian" && !cfg!(feature = "avian") {
+                all.notes.push(format!(
+                    "skipped the Avian study, keeping {} as it is: {AVIAN_FEATURE}",
+                    opts.out.join("avian").display()
+                ));
+                continue;
+            }
             let one = run(s, opts)?;
             all.files.extend(one.files);
             all.tasks += one.tasks;
@@ -177,10 +206,16 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
     match name {
         "idioms" => run_study(&idioms::Idioms { quick: opts.quick }, opts),
         "rapier3d" => run_study(&rapier3d::Rapier3d { quick: opts.quick }, opts),
+        "box2d" => run_study(&box2d::Box2d { quick: opts.quick }, opts),
+        "coulomb_fits" => run_study(&fits::Fits { quick: opts.quick }, opts),
         #[cfg(feature = "mujoco")]
         "mujoco" => run_study(&mujoco::Mujoco { quick: opts.quick }, opts),
         #[cfg(not(feature = "mujoco"))]
         "mujoco" => bail!("{MUJOCO_FEATURE}"),
+        #[cfg(feature = "avian")]
+        "avian" => run_study(&avian::Avian { quick: opts.quick }, opts),
+        #[cfg(not(feature = "avian"))]
+        "avian" => bail!("{AVIAN_FEATURE}"),
         _ => bail!("unknown study '{name}'; known: {}, all", STUDIES.join(", ")),
     }
 }
@@ -268,8 +303,22 @@ pub fn error_figure(panels: Vec<Panel>, cols: usize, letters: &[(&str, &str)]) -
     let notes: Vec<String> = std::iter::once("cell: log10 of the error".to_string())
         .chain(letters.iter().map(|(l, m)| format!("{l}: {m}")))
         .collect();
+    // Room for every cell's mark: about 38 px a column, 24 px a row.
+    let distinct = |v: Vec<f64>| {
+        let mut v = v;
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v.len() as u32
+    };
+    let (nx, ny) = panels.iter().fold((0, 0), |(nx, ny), p| {
+        (
+            distinct(p.cells.iter().map(|c| c.x.0).collect()).max(nx),
+            distinct(p.cells.iter().map(|c| c.y.0).collect()).max(ny),
+        )
+    });
+    let (w, h) = ((140 + 38 * nx).max(430), (130 + 24 * ny).max(420));
     Figure {
-        size: (430 * cols as u32 + 230, (420 * rows).max(560)),
+        size: (w * cols as u32 + 230, (h * rows).max(560)),
         cols,
         panels,
         key: Some(ERROR_SCALE.key("|ω − ω*|/|ω*|", &[], &notes)),

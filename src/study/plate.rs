@@ -17,8 +17,12 @@ pub const HALF: f64 = 0.125;
 pub const PHI_TABLE: f64 = FRAC_PI_4 + 0.3;
 /// The pusher speeds of the studies' tables (m/s).
 pub const TABLE_SPEEDS: [f64; 3] = [0.2, 0.5, 1.0];
-/// The Froude numbers of the (Fr, φ) maps.
-pub const FRS: [f64; 7] = [0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0];
+/// The Froude numbers of the (Fr, φ) maps: 20 log-spaced from 0.02 to 2
+/// (3 significant digits), so each map has 20 × 20 = 400 cells.
+pub const FRS: [f64; 20] = [
+    0.02, 0.0255, 0.0325, 0.0414, 0.0527, 0.0672, 0.0856, 0.109, 0.139, 0.177, 0.226, 0.288, 0.367,
+    0.467, 0.595, 0.759, 0.967, 1.23, 1.57, 2.0,
+];
 /// The quick grid's Froude numbers (tests).
 pub const FRS_QUICK: [f64; 2] = [0.1, 1.0];
 /// Range of the maps' push directions (rad).
@@ -75,10 +79,10 @@ pub fn froude(speed: f64) -> f64 {
     speed * speed / (MU * G * length())
 }
 
-/// The maps' push directions (rad): 9 evenly spaced in [`PHI_RANGE`] (3 on
-/// the quick grid).
+/// The maps' push directions (rad): 20 evenly spaced in [`PHI_RANGE`] (3
+/// on the quick grid).
 pub fn phis(quick: bool) -> Vec<f64> {
-    let n = if quick { 3 } else { 9 };
+    let n = if quick { 3 } else { 20 };
     let (lo, hi) = PHI_RANGE;
     (0..n)
         .map(|k| lo + k as f64 * (hi - lo) / (n - 1) as f64)

@@ -407,3 +407,179 @@ fn assumptions_map_flags_slip_where_the_model_run_does() {
     }
     assert!(slipping > 0);
 }
+
+// ---------------------------------------------------------------------------
+// The closed forms of κ in kappa.csv and the README (issue "The seed paper's
+// future work", item 1). Known answers: κ = 1 + κ₁ Fr + κ₂ Fr² + O(Fr³), so
+// the first-order formula is off by κ₂ Fr² + O(Fr³) and the second-order one
+// by O(Fr³); halving Fr quarters the first's error and divides the second's
+// by eight. The exact κ here is the report's (the steady root reached from
+// ω = 0, per cell), not the one the Froude limits use.
+// ---------------------------------------------------------------------------
+
+/// The κ curves of kappa.csv: (geometry, φ) → rows sorted by Fr.
+fn kappa_curves() -> BTreeMap<(String, String), Vec<BTreeMap<String, String>>> {
+    let mut out: BTreeMap<(String, String), Vec<BTreeMap<String, String>>> = BTreeMap::new();
+    for r in read_csv(&quick_dir().join("kappa.csv")) {
+        out.entry((r["geometry"].clone(), r["phi"].clone()))
+            .or_default()
+            .push(r);
+    }
+    for rows in out.values_mut() {
+        rows.sort_by(|a, b| val(a, "froude").total_cmp(&val(b, "froude")));
+    }
+    out
+}
+
+#[test]
+fn kappa_closed_forms_agree_with_the_exact_kappa_to_second_order() {
+    let curves = kappa_curves();
+    assert_eq!(curves.len(), 12);
+    for ((geom, phi), rows) in &curves {
+        let (k1, k2) = (val(&rows[0], "kappa1"), val(&rows[0], "kappa2"));
+        assert!(
+            k1 < 0.0,
+            "{geom} φ {phi}: κ₁ = {k1} (pushing towards the CM)"
+        );
+        let err = |r: &BTreeMap<String, String>, col: &str| val(r, "kappa") - val(r, col);
+        for r in rows {
+            // The columns are the formulas with this curve's coefficients.
+            let fr = val(r, "froude");
+            assert_eq!(val(r, "kappa1"), k1);
+            assert_eq!(val(r, "kappa2"), k2);
+            assert!((val(r, "kappa_first_order") - (1.0 + k1 * fr)).abs() <= 1e-14 * (1.0 + fr));
+            assert!(
+                (val(r, "kappa_second_order") - (1.0 + k1 * fr + k2 * fr * fr)).abs()
+                    <= 1e-14 * (1.0 + fr * fr)
+            );
+        }
+        // At the smallest Fr: (κ − κ_first)/Fr² is κ₂ (+ O(Fr)), and
+        // (κ − 1)/Fr is κ₁ (+ κ₂ Fr) — the coefficients are right, not only
+        // the orders.
+        let (a, b) = (&rows[0], &rows[1]);
+        let fr = val(a, "froude");
+        assert!((fr - 1e-3).abs() < 1e-15);
+        let c2 = err(a, "kappa_first_order") / (fr * fr);
+        assert!(
+            (c2 - k2).abs() <= 0.01 * k2.abs(),
+            "{geom} φ {phi}: (κ − κ_first)/Fr² = {c2}, κ₂ = {k2}"
+        );
+        let c1 = (val(a, "kappa") - 1.0) / fr;
+        assert!(
+            (c1 - k1 - k2 * fr).abs() <= 0.01 * k2.abs() * fr,
+            "{geom} φ {phi}: (κ − 1)/Fr = {c1}, κ₁ + κ₂ Fr = {}",
+            k1 + k2 * fr
+        );
+        // Observed orders between the two smallest Fr (a factor √10 apart).
+        let order = |col: &str| {
+            (err(b, col).abs().ln() - err(a, col).abs().ln())
+                / (val(b, "froude").ln() - val(a, "froude").ln())
+        };
+        let (p1, p2) = (order("kappa_first_order"), order("kappa_second_order"));
+        assert!(
+            (p1 - 2.0).abs() < 0.01,
+            "{geom} φ {phi}: first-order error order {p1}"
+        );
+        assert!(
+            (p2 - 3.0).abs() < 0.01,
+            "{geom} φ {phi}: second-order error order {p2}"
+        );
+    }
+}
+
+#[test]
+fn halving_fr_quarters_the_first_order_error() {
+    // From the library's exact κ (its own root finder from v_c ψ), on every
+    // κ geometry of the report, at Fr = 0.004 and 0.002.
+    let geoms = report::cells::geometries(&root().join("scenarios")).unwrap();
+    let mut checked = 0;
+    for g in geoms.iter().filter(|g| !g.phis.is_empty()) {
+        for &phi in &g.phis {
+            let s = pushval_model::kappa_series(&g.body, phi).unwrap();
+            let e = |fr: f64, second: bool| {
+                let exact = pushval_model::kappa_exact(&g.body, phi, fr).unwrap();
+                let closed = if second {
+                    s.second_order(fr)
+                } else {
+                    s.first_order(fr)
+                };
+                (exact - closed).abs()
+            };
+            let (fr, half) = (0.004, 0.002);
+            let r1 = e(fr, false) / e(half, false);
+            let r2 = e(fr, true) / e(half, true);
+            assert!(
+                (r1 - 4.0).abs() < 0.05 * 4.0,
+                "{} φ {phi}: ratio {r1}",
+                g.name
+            );
+            assert!(
+                (r2 - 8.0).abs() < 0.1 * 8.0,
+                "{} φ {phi}: ratio {r2}",
+                g.name
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 12);
+}
+
+#[test]
+fn froude_limits_are_the_library_s_and_hold_against_an_integrated_kappa() {
+    let curves = kappa_curves();
+    let geoms = report::cells::geometries(&root().join("scenarios")).unwrap();
+    let readme = std::fs::read_to_string(quick_dir().join("README.md")).unwrap();
+    let mut checked = 0;
+    for ((name, phi_text), rows) in &curves {
+        let g = geoms.iter().find(|g| g.name == name).unwrap();
+        let phi: f64 = phi_text.parse().unwrap();
+        let lim = [
+            val(&rows[0], "froude_limit_first_order"),
+            val(&rows[0], "froude_limit_second_order"),
+        ];
+        for r in rows {
+            assert_eq!(val(r, "froude_limit_first_order"), lim[0]);
+            assert_eq!(val(r, "froude_limit_second_order"), lim[1]);
+        }
+        assert_eq!(
+            Some(lim[0]),
+            pushval_model::kappa::first_order_froude_limit(&g.body, phi, 0.01)
+        );
+        assert_eq!(
+            Some(lim[1]),
+            pushval_model::kappa::second_order_froude_limit(&g.body, phi, 0.01)
+        );
+        assert!(lim[0].is_finite() && lim[0] > 0.0 && lim[1] > lim[0]);
+        for l in lim {
+            let text = format!("{l:.4} (");
+            assert!(readme.contains(&text), "README lacks the limit {text}");
+        }
+        // The paper plate's limits, checked against κ from an RK4 of the
+        // moment balance written out in this file: within 1 % just below the
+        // limit, beyond it just above.
+        if name == "square corner" {
+            let s = pushval_model::kappa_series(&g.body, phi).unwrap();
+            let psi = kinematic_psi_by_bisection(&g.body, phi);
+            let kappa = |fr: f64| {
+                let v = g.speed(fr);
+                let seg = report::cells::segment(&g.body, v, phi);
+                let tau = report::cells::steady(&seg).1;
+                integrated_steady_omega(&g.body, v, phi, tau / 20.0) / (v * psi)
+            };
+            for (k, l) in lim.iter().enumerate() {
+                let closed = |fr: f64| {
+                    if k == 0 {
+                        s.first_order(fr)
+                    } else {
+                        s.second_order(fr)
+                    }
+                };
+                let rel = |fr: f64| ((closed(fr) - kappa(fr)) / kappa(fr)).abs();
+                assert!(rel(0.99 * l) <= 0.01, "order {} at 0.99 × {l}", k + 1);
+                assert!(rel(1.01 * l) > 0.01, "order {} at 1.01 × {l}", k + 1);
+            }
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 3);
+}

@@ -241,3 +241,525 @@ fn unknown_and_missing_studies_exit_2() {
         assert!(String::from_utf8_lossy(&out.stderr).contains("--features mujoco"));
     }
 }
+
+// Issue "More engines": the Box2D study (`pushval study box2d`).
+
+/// One quick Box2D study (its folder `OUT/box2d/`), shared by the tests
+/// that read it.
+fn box2d_dir() -> &'static Path {
+    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    let (_, path) = DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        ok(study(&["box2d", "--quick"], dir.path()));
+        let path = dir.path().join("box2d");
+        (dir, path)
+    });
+    path
+}
+
+/// The plate of a `geometry` column: the paper plate, or the same plate on
+/// supports moved in to (±0.05, ±0.05) m.
+fn box2d_body(geometry: &str) -> pushval_model::Body {
+    let b = paper_plate();
+    match geometry {
+        "paper" => b,
+        "inner" => {
+            let supports: Vec<pushval_model::Support> = b
+                .supports()
+                .map(|s| pushval_model::Support {
+                    position: s.position * (0.05 / 0.125),
+                    friction: s.friction,
+                })
+                .collect();
+            pushval_model::Body::new(b.mass(), b.inertia_cm(), b.contact(), &supports).unwrap()
+        }
+        g => panic!("unknown geometry {g}"),
+    }
+}
+
+/// `box2d_motor_joint` against its closed form (`pushval_box2d::predict`,
+/// recomputed here from each row's push): on the paper plate the torque cap
+/// locks the plate (ω = 0 exactly; the engine's |ω| checked absolutely, to
+/// 1e-2 of 1e-3 v_c/L), on the inner supports it turns (relative, 1e-2),
+/// and either way it is not Coulomb.
+#[test]
+fn box2d_motor_joint_follows_its_closed_form() {
+    use pushval_box2d::predict::motor_joint_steady;
+    let length = 0.125 * 2f64.sqrt();
+    let rows = read_csv(&box2d_dir().join("steady.csv"));
+    let mut checked = [0, 0];
+    for r in rows
+        .iter()
+        .filter(|r| r["model"] == "box2d_motor_joint" && val(r, "dt") == 1e-3)
+    {
+        let body = box2d_body(&r["geometry"]);
+        let push = Push {
+            duration: 6.0,
+            speed: val(r, "speed"),
+            phi: val(r, "phi"),
+        };
+        let closed = motor_joint_steady(&body, &push, 0.0).unwrap();
+        let (w, star) = (val(r, "omega_engine"), val(r, "omega_star"));
+        assert!((val(r, "omega_closed_form") - closed.omega).abs() <= 1e-12);
+        if r["geometry"] == "paper" {
+            assert!(closed.locked && closed.omega == 0.0);
+            assert!(
+                w.abs() <= 1e-2 * 1e-3 * push.speed / length,
+                "v_c {}: locked plate turns at {w}",
+                push.speed
+            );
+            checked[0] += 1;
+        } else {
+            assert!(!closed.locked);
+            assert!(
+                rel(w, closed.omega) <= 1e-2,
+                "v_c {}: engine {w} vs closed form {}",
+                push.speed,
+                closed.omega
+            );
+            checked[1] += 1;
+        }
+        assert!(
+            rel(w, star) > 0.2,
+            "the motor joint is not Coulomb: {w} vs {star}"
+        );
+    }
+    assert_eq!(checked, [3, 3]);
+    // Every map cell, in the map's own measure (relative, absolute at ω = 0).
+    let mut turning = 0;
+    for geometry in ["paper", "inner"] {
+        let map = read_csv(&box2d_dir().join(format!("map_box2d_motor_joint_{geometry}_1e-3.csv")));
+        assert!(!map.is_empty());
+        for c in &map {
+            assert!(
+                val(c, "err_vs_closed_form") <= 1e-2,
+                "{geometry} Fr {} φ {}: {}",
+                c["froude"],
+                c["phi"],
+                c["err_vs_closed_form"]
+            );
+            turning += usize::from(val(c, "locked") == 0.0);
+        }
+    }
+    assert!(turning >= 1, "no map cell turns");
+}
+
+/// `box2d` is Coulomb support friction to first order in Δt: on the quick
+/// ladder (4, 2, 1 ms) the steady-ω error against the dynamic model halves
+/// with the step (observed order 1 ± 0.1), and the README's order range is
+/// the data's.
+#[test]
+fn box2d_coulomb_is_first_order_and_the_readme_says_so() {
+    let dir = box2d_dir();
+    let ladder = read_csv(&dir.join("dt_ladder.csv"));
+    let orders: Vec<f64> = ladder
+        .iter()
+        .filter(|r| !r["observed_order"].is_empty())
+        .map(|r| val(r, "observed_order"))
+        .collect();
+    assert_eq!(orders.len(), 6, "two steps × three speeds");
+    for p in &orders {
+        assert!((p - 1.0).abs() <= 0.1, "order {p}");
+    }
+    for r in ladder.iter().filter(|r| val(r, "dt") == 1e-3) {
+        assert!(val(r, "err_vs_model") <= 5e-3, "{}", r["err_vs_model"]);
+    }
+    let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+    let lo = orders.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = orders.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (a, b) = (format!("{lo:.2}"), format!("{hi:.2}"));
+    let text = if a == b {
+        format!("observed order {a} ")
+    } else {
+        format!("observed order {a}–{b} ")
+    };
+    assert!(readme.contains(&text), "README lacks '{text}'");
+    // The paper-plate table: ω* and box2d's ω from paper_plate.csv.
+    for r in read_csv(&dir.join("paper_plate.csv")) {
+        let text = format!(
+            "| {:.4} | {:.4} (",
+            val(&r, "omega_star"),
+            val(&r, "omega_box2d")
+        );
+        assert!(readme.contains(&text), "README lacks '{text}'");
+    }
+    for bad in ["NaN", " inf"] {
+        assert!(!readme.contains(bad), "README holds '{bad}'");
+    }
+}
+
+#[test]
+fn box2d_shards_merged_equal_a_single_run_byte_for_byte() {
+    let single = box2d_dir();
+    let sharded = tempfile::tempdir().unwrap();
+    for k in ["1/3", "2/3", "3/3"] {
+        ok(study(&["box2d", "--quick", "--shard", k], sharded.path()));
+    }
+    assert!(
+        !sharded.path().join("box2d").exists(),
+        "a shard wrote outputs"
+    );
+    ok(study(&["box2d", "--quick", "--merge"], sharded.path()));
+    let (a, b) = (files(single), files(&sharded.path().join("box2d")));
+    assert_eq!(a.len(), b.len());
+    assert!(a.len() >= 9, "{} files", a.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x.file_name(), y.file_name());
+        assert!(
+            std::fs::read(x).unwrap() == std::fs::read(y).unwrap(),
+            "{} differs between the single and the merged run",
+            x.display()
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------
+// `pushval study coulomb_fits` (issue "The seed paper's future work", item 4):
+// the Coulomb model fitted to each engine's trajectory. Known answers: the
+// Coulomb engine (rapier2d, a Coulomb force at every support) must be
+// explained by the file's own parameters (μ scale 1, the file's centre of
+// friction (0, 0) and I_cm); impulse_box, which locks the plate's
+// orientation, must not be explained once the schedule switches direction.
+// ---------------------------------------------------------------------------
+
+/// One quick Coulomb-fit study (rapier2d and rapier2d_impulse_box, both
+/// schedules), shared by the tests that read it.
+fn fits_dir() -> &'static Path {
+    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        ok(study(&["coulomb_fits", "--quick"], dir.path()));
+        dir
+    })
+    .path()
+}
+
+fn fit_row(engine: &str, schedule: &str) -> BTreeMap<String, String> {
+    read_csv(&fits_dir().join("coulomb_fits.csv"))
+        .into_iter()
+        .find(|r| r["engine"] == engine && r["schedule"] == schedule)
+        .unwrap_or_else(|| panic!("no fit of {engine} on {schedule}"))
+}
+
+/// The threshold of the verdict, recomputed from the engine's own error.
+fn threshold(r: &BTreeMap<String, String>, what: &str) -> f64 {
+    (10.0 * val(r, &format!("engine_error_{what}"))).max(1e-6)
+}
+
+#[test]
+fn coulomb_fit_recovers_the_coulomb_engine_s_own_parameters() {
+    let r = fit_row("rapier2d", "paper-square-v1.0");
+    // The five segments identify every parameter, so all are fitted.
+    assert_eq!(r["fitted"], "mu_scale+center_of_friction+inertia_cm");
+    assert_eq!(r["unidentifiable"], "");
+    assert_eq!(r["converged"], "true");
+    // Truth: the file (μ scale 1, equal loads on a centred square: centre
+    // of friction at the centre of mass, I_cm = m a²/6 for a 0.25 m plate).
+    let sc = crate::common::load(&root().join("scenarios/paper-square-v1.0.toml"));
+    assert!((val(&r, "inertia_cm_file") - sc.inertia_cm).abs() < 1e-15);
+    assert!((sc.inertia_cm - 0.25f64.powi(2) / 6.0).abs() < 1e-12);
+    let within = |v: f64, truth: f64, std: f64, what: &str| {
+        assert!(std > 0.0 && std.is_finite(), "{what}: std {std}");
+        assert!(
+            (v - truth).abs() <= 2.0 * std,
+            "{what}: {v} vs the file's {truth}, std {std}"
+        );
+    };
+    within(
+        val(&r, "mu_scale"),
+        1.0,
+        val(&r, "mu_scale_std"),
+        "mu_scale",
+    );
+    within(val(&r, "cof_x"), 0.0, val(&r, "cof_x_std"), "cof_x");
+    within(val(&r, "cof_y"), 0.0, val(&r, "cof_y_std"), "cof_y");
+    within(
+        val(&r, "inertia_cm"),
+        sc.inertia_cm,
+        val(&r, "inertia_cm_std"),
+        "inertia_cm",
+    );
+    // And to an absolute standard: 1e-5 in μ, 10 µm, 1e-5 relative in I.
+    assert!((val(&r, "mu_scale") - 1.0).abs() < 1e-5);
+    assert!(val(&r, "cof_x").hypot(val(&r, "cof_y")) < 1e-5);
+    assert!((val(&r, "inertia_cm") / sc.inertia_cm - 1.0).abs() < 1e-5);
+    // The residual is below the threshold, and the threshold is tight.
+    for what in ["position", "theta"] {
+        let t = threshold(&r, what);
+        assert!((t - val(&r, &format!("threshold_{what}"))).abs() <= 1e-12 * t);
+        assert!(t < 1e-4, "threshold {what} {t}");
+        let rms = val(&r, &format!("{what}_rms"));
+        assert!(rms <= t, "rapier2d residual {what} {rms} above {t}");
+    }
+    assert_eq!(r["verdict"], "explained");
+    // Before the fit (at the file's values) the residual is the engine's own
+    // error: the Coulomb engine needs no fitting.
+    assert!(val(&r, "start_position_rms") <= threshold(&r, "position"));
+}
+
+#[test]
+fn coulomb_fit_does_not_explain_the_orientation_lock() {
+    let r = fit_row("rapier2d_impulse_box", "paper-square-v1.0");
+    let (p, t) = (val(&r, "position_rms"), val(&r, "theta_rms"));
+    assert!(
+        p > threshold(&r, "position") || t > threshold(&r, "theta"),
+        "impulse_box explained: residual {p} m, {t} rad"
+    );
+    // Not a marginal miss: centimetres and tens of mrad off.
+    assert!(p > 0.01 && t > 0.01, "residual {p} m, {t} rad");
+    assert_eq!(r["verdict"], "not_explained");
+    // On one push from ω = 0 a frictionless plate (μ → 0) keeps its
+    // orientation exactly as the lock does: explained, by a degenerate μ.
+    let one = fit_row("rapier2d_impulse_box", "friction-engines");
+    assert_eq!(one["verdict"], "explained");
+    assert!(val(&one, "mu_scale") < 1e-3);
+}
+
+#[test]
+fn one_push_does_not_identify_the_centre_of_friction() {
+    // The Fisher information of a single constant push at the file's values
+    // leaves the centre of friction unidentifiable (only ω* and one
+    // relaxation show), so the fit there holds it at the file's value.
+    let r = fit_row("rapier2d", "friction-engines");
+    assert_eq!(r["fitted"], "mu_scale+inertia_cm");
+    assert_eq!(val(&r, "cof_x"), 0.0);
+    assert_eq!(r["cof_x_std"], "");
+    assert_eq!(r["verdict"], "explained");
+    assert!((val(&r, "mu_scale") - 1.0).abs() <= 2.0 * val(&r, "mu_scale_std"));
+}
+
+#[test]
+fn coulomb_fit_verdicts_and_readme_follow_the_data() {
+    let rows = read_csv(&fits_dir().join("coulomb_fits.csv"));
+    assert!(rows.len() >= 4);
+    for r in &rows {
+        let (p, t) = (val(r, "position_rms"), val(r, "theta_rms"));
+        let (tp, tt) = (threshold(r, "position"), threshold(r, "theta"));
+        let verdict = if p > tp || t > tt {
+            "not_explained"
+        } else if p <= 1e-3 && t <= 1e-3 {
+            "explained"
+        } else {
+            "undecided"
+        };
+        assert_eq!(
+            r["verdict"], verdict,
+            "{} on {}",
+            r["engine"], r["schedule"]
+        );
+        let mu = val(r, "mu_file") * val(r, "mu_scale");
+        assert!((val(r, "mu_effective") - mu).abs() <= 1e-12 * mu.abs().max(1e-300));
+    }
+    let md = pushval::study::fits::readme_section(fits_dir());
+    let r = fit_row("rapier2d", "paper-square-v1.0");
+    let mu = format!("{:.8}", val(&r, "mu_scale"));
+    assert!(
+        md.contains(&format!("μ scale {mu}")),
+        "README lacks μ scale {mu}"
+    );
+    let box_row = fit_row("rapier2d_impulse_box", "paper-square-v1.0");
+    let text = format!(
+        "rapier2d_impulse_box ({:.3} m, {:.3} rad)",
+        val(&box_row, "position_rms"),
+        val(&box_row, "theta_rms")
+    );
+    assert!(md.contains(&text), "README lacks '{text}'");
+    assert!(!md.contains("NaN"), "README section holds NaN");
+    assert!(
+        !md.split(|c: char| !c.is_alphanumeric()).any(|w| w == "inf"),
+        "README section holds inf"
+    );
+}
+
+#[test]
+fn coulomb_fit_shards_merge_into_the_single_run() {
+    let sharded = tempfile::tempdir().unwrap();
+    for k in ["1/3", "2/3", "3/3"] {
+        ok(study(
+            &["coulomb_fits", "--quick", "--shard", k],
+            sharded.path(),
+        ));
+    }
+    ok(study(
+        &["coulomb_fits", "--quick", "--merge"],
+        sharded.path(),
+    ));
+    let name = "coulomb_fits.csv";
+    assert!(
+        std::fs::read(fits_dir().join(name)).unwrap()
+            == std::fs::read(sharded.path().join(name)).unwrap(),
+        "{name} differs between the single and the merged run"
+    );
+}
+
+// ---------------------------------------------------------------------------
+// `pushval study avian` (needs the root feature `avian`). Known answers, each
+// recomputed here from a closed form, not read from the study's summary:
+// avian2d applies Coulomb's law, so its steady ω is the Coulomb root ω* up to
+// a first-order step error; avian3d's friction is Coulomb along −u per
+// contact point with the loads of a rigid plate on soft contacts
+// (`pushval_avian::predict::PlateScene::steady`), which is ω* itself when the
+// centre of mass is on the floor's plane and moves off it when raised.
+// ---------------------------------------------------------------------------
+
+/// One quick Avian study (its folder `OUT/avian/`), shared by the tests
+/// that read it.
+#[cfg(feature = "avian")]
+fn avian_dir() -> &'static Path {
+    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    let (_, path) = DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        ok(study(&["avian", "--quick"], dir.path()));
+        let path = dir.path().join("avian");
+        (dir, path)
+    });
+    path
+}
+
+/// avian3d against `PlateScene::steady`, recomputed from each row's push and
+/// centre-of-mass height: within 1e-2 (relative) in the load-transfer table
+/// and in every cell of both avian3d maps; at h_cm = 0 the closed form is ω*,
+/// raised it is more than 1 % off ω* (load transfer matters).
+#[cfg(feature = "avian")]
+#[test]
+fn avian3d_follows_its_closed_form() {
+    use pushval_avian::predict::PlateScene;
+    use pushval_avian::Avian3dSettings;
+    let predicted = |speed: f64, phi: f64, cm_height: f64| {
+        let p = crate::common::one_push(paper_plate(), 1.0, speed, phi);
+        let s = Avian3dSettings {
+            cm_height,
+            ..Default::default()
+        };
+        PlateScene::new(&p, &s)
+            .unwrap()
+            .steady(&p.pushes[0], 0.0)
+            .unwrap()
+            .0
+    };
+    let star = |speed: f64, phi: f64| {
+        let push = Push {
+            duration: 1.0,
+            speed,
+            phi,
+        };
+        SegmentDynamics::new(&paper_plate(), &push)
+            .attractor_from(0.0)
+            .unwrap()
+            .omega
+    };
+    let dir = avian_dir();
+    let loads = read_csv(&dir.join("load_transfer.csv"));
+    assert_eq!(loads.len(), 3);
+    for r in &loads {
+        let (v, phi, h) = (val(r, "speed"), val(r, "phi"), val(r, "cm_height"));
+        let pred = predicted(v, phi, h);
+        assert!((val(r, "omega_predicted") - pred).abs() <= 1e-12);
+        assert!((val(r, "omega_star") - star(v, phi)).abs() <= 1e-12);
+        let w = val(r, "omega_engine");
+        assert!(rel(w, pred) <= 1e-2, "h {h} v {v}: engine {w} vs {pred}");
+        assert!(
+            rel(pred, star(v, phi)) > 1e-2,
+            "h {h} v {v}: no load transfer"
+        );
+    }
+    for (name, h) in [("map_avian3d_h0.csv", 0.0), ("map_avian3d_h0.02.csv", 0.02)] {
+        let map = read_csv(&dir.join(name));
+        assert_eq!(map.len(), 6, "{name}");
+        for c in &map {
+            let (v, phi) = (val(c, "speed"), val(c, "phi"));
+            let pred = predicted(v, phi, h);
+            if h == 0.0 {
+                assert!(rel(pred, star(v, phi)) <= 1e-12);
+            }
+            let w = val(c, "omega_engine");
+            assert!(rel(w, pred) <= 1e-2, "{name} v {v} φ {phi}: {w} vs {pred}");
+        }
+    }
+}
+
+/// avian2d is Coulomb to first order in Δt: on the quick ladder (2, 1 ms)
+/// the steady-ω error against ω* halves with the step (order 1 ± 0.25), is
+/// within 5e-4 of ω* at 1 ms on the paper plate, and the README's table and
+/// order range are the data's.
+#[cfg(feature = "avian")]
+#[test]
+fn avian2d_is_first_order_coulomb_and_the_readme_says_so() {
+    let dir = avian_dir();
+    let ladder = read_csv(&dir.join("dt_ladder.csv"));
+    let orders = |model: &str| -> Vec<f64> {
+        ladder
+            .iter()
+            .filter(|r| r["model"] == model && !r["observed_order"].is_empty())
+            .map(|r| val(r, "observed_order"))
+            .collect()
+    };
+    let o2 = orders("avian2d");
+    assert_eq!(o2.len(), 3, "one order per speed");
+    for p in &o2 {
+        assert!((p - 1.0).abs() <= 0.25, "order {p}");
+    }
+    let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+    let lo = o2.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = o2.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (a, b) = (format!("{lo:.2}"), format!("{hi:.2}"));
+    let text = if a == b {
+        format!("avian2d {a}, avian3d")
+    } else {
+        format!("avian2d {a}–{b}, avian3d")
+    };
+    assert!(readme.contains(&text), "README lacks '{text}'");
+    for r in read_csv(&dir.join("paper_plate.csv")) {
+        let push = Push {
+            duration: 1.0,
+            speed: val(&r, "speed"),
+            phi: val(&r, "phi"),
+        };
+        let star = SegmentDynamics::new(&paper_plate(), &push)
+            .attractor_from(0.0)
+            .unwrap()
+            .omega;
+        assert!((val(&r, "omega_star") - star).abs() <= 1e-12);
+        assert!(rel(val(&r, "omega_avian2d"), star) <= 5e-4);
+        let text = format!("| {:.8} | {:.8} (", star, val(&r, "omega_avian2d"));
+        assert!(readme.contains(&text), "README lacks '{text}'");
+    }
+    for bad in ["NaN", " inf"] {
+        assert!(!readme.contains(bad), "README holds '{bad}'");
+    }
+}
+
+#[cfg(feature = "avian")]
+#[test]
+fn avian_shards_merged_equal_a_single_run_byte_for_byte() {
+    let single = avian_dir();
+    let sharded = tempfile::tempdir().unwrap();
+    for k in ["1/2", "2/2"] {
+        ok(study(&["avian", "--quick", "--shard", k], sharded.path()));
+    }
+    assert!(
+        !sharded.path().join("avian").exists(),
+        "a shard wrote outputs"
+    );
+    ok(study(&["avian", "--quick", "--merge"], sharded.path()));
+    let (a, b) = (files(single), files(&sharded.path().join("avian")));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x.file_name(), y.file_name());
+        assert!(
+            std::fs::read(x).unwrap() == std::fs::read(y).unwrap(),
+            "{} differs between the single and the merged run",
+            x.display()
+        );
+    }
+}
+
+/// Without the feature, `study avian` exits 2 naming it.
+#[cfg(not(feature = "avian"))]
+#[test]
+fn avian_study_without_the_feature_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = study(&["avian", "--quick"], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--features avian"));
+}
