@@ -75,7 +75,7 @@ enum Command {
     /// disagrees with Coulomb support friction, and the closed forms that
     /// explain it.
     Study {
-        /// idioms, rapier3d, mujoco (needs --features mujoco) or all.
+        /// coulomb_fits, idioms, rapier3d, box2d, mujoco (--features mujoco), avian (--features avian), or all.
         name: String,
         /// Output folder (created if missing).
         #[arg(long, default_value = "results/friction_models")]
