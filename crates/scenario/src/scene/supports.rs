@@ -170,27 +170,18 @@ fn check_tipping(positions: &[Vec2], object: &Object, file: &Path) -> Result<(),
                 ),
             ));
         }
-    } else {
-        // One support, or all on one line: the object balances only with
-        // its centre of mass on that point or segment.
-        let d = match hull.as_slice() {
-            [] => f64::INFINITY,
-            [p] => (cm - p).norm(),
-            [a, b, ..] => {
-                let e = b - a;
-                let t = ((cm - a).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
-                (a + t * e - cm).norm()
-            }
-        };
+    } else if let [p] = hull.as_slice() {
+        // One support point (or all at one place): the object balances only
+        // with its centre of mass above it. (Supports on a line are checked
+        // with the loads: statics names the problem there.)
+        let d = (cm - p).norm();
         if !(d <= 1e-9 * size) {
             return Err(ScenarioError::new(
                 file,
                 "supports",
                 format!(
-                    "{} support point(s) on a line cannot carry the object: the centre of mass [{}, {}] is {d:.3e} m off them, the object would tip",
-                    positions.len(),
-                    cm.x,
-                    cm.y
+                    "a single support point cannot carry the object: the centre of mass [{}, {}] is {d:.3e} m off it, the object would tip",
+                    cm.x, cm.y
                 ),
             ));
         }
