@@ -2,7 +2,7 @@
 //! paper plate pushed at a corner with φ = π/4 + 0.3 for 6 s, and a plate
 //! whose supports sit close to the centre (so the joint does not lock).
 //!
-//! `cargo run --release -p pushval-box2d --example motor_joint [DT]`
+//! `cargo run --release -p pushval-box2d --example box2d_motor_joint [DT]`
 
 use std::f64::consts::FRAC_PI_4;
 

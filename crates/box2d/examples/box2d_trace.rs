@@ -1,4 +1,4 @@
-//! ω over time of one box2d run: `--example trace FILE DT [EVERY]`.
+//! ω over time of one box2d run: `--example box2d_trace FILE DT [EVERY]`.
 use pushval_box2d::{Box2dSettings, Box2dSimulator};
 use pushval_scenario::Scenario;
 

@@ -3,7 +3,7 @@
 //! 1 kg, μ = 0.5, corner push, 1 s at φ = π/4 then 3 s at φ = π/4 + 0.3, at
 //! 1 m/s), and the wall time per simulated second.
 //!
-//! `cargo run --release -p pushval-box2d --example sweep [FROM_REST]`
+//! `cargo run --release -p pushval-box2d --example box2d_sweep [FROM_REST]`
 
 use std::f64::consts::FRAC_PI_4;
 

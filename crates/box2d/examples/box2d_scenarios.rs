@@ -4,7 +4,7 @@
 //! over the segments (tail means over the last 20 %, with the harness's
 //! floor `1e-3 v_c / L` on the denominator) and the joint drift (m).
 //!
-//! `cargo run --release -p pushval-box2d --example scenarios [FILES...]`
+//! `cargo run --release -p pushval-box2d --example box2d_scenarios [FILES...]`
 //! (default: every file in scenarios/).
 
 use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator};

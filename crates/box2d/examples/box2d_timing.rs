@@ -5,7 +5,7 @@
 //! for a core on a busy machine does not count), and the share of the wall
 //! time inside `b2World_Step`.
 //!
-//! `cargo run --release -p pushval-box2d --example timing [FILE] [DT]`
+//! `cargo run --release -p pushval-box2d --example box2d_timing [FILE] [DT]`
 
 use pushval_box2d::{Box2dSettings, Box2dSimulator, Friction};
 use pushval_scenario::Scenario;
