@@ -14,6 +14,7 @@ pub const ENGINE_CRATES: &[fn() -> Vec<ModelEntry>] = &[
     pushval_rapier2d::models,
     pushval_rapier3d::models,
     pushval_mujoco::models,
+    pushval_physx::models,
     pushval_box2d::models,
     pushval_avian::models,
 ];

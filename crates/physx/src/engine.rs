@@ -1,0 +1,138 @@
+//! The PhysX models as pushval engine plug-ins: `physx_patch`,
+//! `physx_two_directional` and `physx_one_directional`, the plate on sphere
+//! feet on a ground plane with each of PhysX's friction types. Without the
+//! `physx` feature they are listed but not available.
+
+use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_model::{ModelError, Problem};
+
+use crate::{FrictionType, PhysxSettings, PhysxSimulator, AVAILABLE};
+
+/// The engine crate and version this adapter is built against (the `physx`
+/// entry of the workspace's Cargo.toml; a test checks it against Cargo.lock).
+pub const ENGINE_CRATE: EngineCrate = EngineCrate {
+    name: "physx",
+    version: "0.19.0",
+};
+
+/// The PhysX SDK the `physx` crate builds (physx-sys 0.11.5 vendors it;
+/// `PX_PHYSICS_VERSION` 5.1.3).
+pub const PHYSX_SDK_VERSION: &str = "5.1.3";
+
+/// One PhysX model (a friction type).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhysxModel {
+    /// The settings of a run (its `dt` is replaced by the run's).
+    pub settings: PhysxSettings,
+}
+
+fn build(friction: FrictionType, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
+    let mut settings = PhysxSettings {
+        friction,
+        ..Default::default()
+    };
+    if let Some(dt) = opts.dt {
+        settings.dt = dt;
+    }
+    Ok(Box::new(PhysxModel { settings }))
+}
+
+/// The PhysX models: the crate's entries in pushval's engine registry.
+pub fn models() -> Vec<ModelEntry> {
+    vec![
+        ModelEntry {
+            name: "physx_patch",
+            build: |o| build(FrictionType::Patch, o),
+        },
+        ModelEntry {
+            name: "physx_two_directional",
+            build: |o| build(FrictionType::TwoDirectional, o),
+        },
+        ModelEntry {
+            name: "physx_one_directional",
+            build: |o| build(FrictionType::OneDirectional, o),
+        },
+    ]
+}
+
+impl Engine for PhysxModel {
+    fn name(&self) -> &'static str {
+        self.settings.friction.model_name()
+    }
+    fn description(&self) -> &'static str {
+        match self.settings.friction {
+            FrictionType::Patch => {
+                "plate on sphere feet on a ground plane, PhysX 5 PGS, patch friction (ePATCH)"
+            }
+            FrictionType::TwoDirectional => {
+                "plate on sphere feet on a ground plane, PhysX 5 PGS, per-point two-axis friction (eTWO_DIRECTIONAL)"
+            }
+            FrictionType::OneDirectional => {
+                "plate on sphere feet on a ground plane, PhysX 5 PGS, per-point one-axis friction (eONE_DIRECTIONAL)"
+            }
+        }
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-physx"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        ENGINE_CRATE
+    }
+    fn version(&self) -> String {
+        format!(
+            "{} {} (PhysX {})",
+            ENGINE_CRATE.name, ENGINE_CRATE.version, PHYSX_SDK_VERSION
+        )
+    }
+    /// Symplectic Euler with the pusher at the mid-step heading: first order.
+    fn order(&self) -> f64 {
+        1.0
+    }
+    fn availability(&self) -> Result<(), String> {
+        if AVAILABLE {
+            Ok(())
+        } else {
+            Err("build with --features physx (needs clang++: apt-get install clang)".into())
+        }
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.dt
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = PhysxSettings {
+            dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": dt,
+            "friction_type": s.friction.physx_name(),
+            "contacts": s.contacts.as_str(),
+            "position_iterations": s.position_iterations,
+            "velocity_iterations": s.velocity_iterations,
+            "precision": "f32",
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = PhysxSimulator::new(PhysxSettings {
+            dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        Ok(EngineRun {
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_joint_drift": r.max_joint_drift,
+                "max_tilt": r.max_tilt,
+                "max_lift": r.max_lift,
+                "rest_loads": r.rest_loads,
+                "mu": r.mu,
+            }),
+            trajectory: r.trajectory,
+        })
+    }
+}

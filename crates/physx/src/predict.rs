@@ -1,0 +1,352 @@
+//! Closed forms of what PhysX's friction types do to the steady ω (no PhysX
+//! needed: they use only `pushval-model`).
+//!
+//! From the PhysX 5.1.3 source (physx-sys 0.11.5 vendors it, under
+//! `physx/physx/source/lowleveldynamics/src/`):
+//!
+//! * **Welding** (`DyDynamics.cpp`, `PxsSolverConstraintPostProcessTask::
+//!   mergeContacts`). All contact pairs between the same two bodies — here
+//!   every foot against the static world — are merged into **one** solver
+//!   constraint, unless a pair's contacts are modifiable; its points are then
+//!   grouped into patches by normal and friction coefficient. Feet with one
+//!   coefficient on a flat floor are one patch of n points
+//!   ([`FootContacts::Welded`](crate::FootContacts)); unwelded, each foot is
+//!   a patch of one point ([`FootContacts::Separate`](crate::FootContacts)).
+//! * **Axes** (`DyContactPrep.cpp` for `ePATCH`, `DyContactPrepPF.cpp` for
+//!   the others). Every patch takes `t0` from the relative *linear* velocity
+//!   of the two bodies projected on the contact plane — for a body on static
+//!   ground the direction of its **centre-of-mass** velocity, the same for
+//!   every foot — and `t1 = n × t0` (`t0 × n` for the per-point types; the
+//!   clamp is symmetric, the sign does not matter). Only below 1e-2 m/s
+//!   (patch) or 3e-3 m/s (per point) does PhysX fall back on fixed axes.
+//! * **Rows and caps** (`DySolverConstraints.cpp` `solveContact_BStatic`,
+//!   `DySolverPFConstraints.cpp` `solveFriction_BStatic`). Each row is its own
+//!   1-D constraint clamped to `±cap`: a box, not a disk.
+//!   - `eTWO_DIRECTIONAL`: a `t0` and a `t1` row at every point, cap `μ λ_i`.
+//!   - `eONE_DIRECTIONAL`: one row per point, `t0`, `t1`, `t0`, … in the
+//!     order of the patch's points, cap `μ λ_i`; a one-point patch: `t0`.
+//!   - `ePATCH`: a `t0` and a `t1` row at each of at most two anchors (the
+//!     patch's first point, then greedily the farthest pair, `growPatches` in
+//!     `DyFrictionCorrelation.cpp`), cap `μ Σλ` over the patch, halved with
+//!     two anchors (`eIMPROVED_PATCH_FRICTION`, on by default).
+//!
+//! So in steady sliding a row at point `p` on axis `t` with cap `c` gives
+//! `−c sgn(u_p·t) t`, with `u_p = v_c n_φ + ω D (p − p_c)` the point's
+//! velocity, `t0 = v_cm/|v_cm|`, `v_cm = v_c n_φ − ω D p_c` (object frame,
+//! origin at the centre of mass) and `t1 = D t0`; a row whose velocity is zero
+//! sticks (any force in `[−c, c]`). The steady ω is a root of
+//! `G(ω) = I_P ω̇ = Σ (p − p_c) × f + m v_c ω (p_c · n_φ)` ([`moment`],
+//! [`steady_omega`]).
+//!
+//! At ω = 0 every point slides along `v_cm = v_c n_φ`, so every `t1` row
+//! changes sign there and `G` jumps: the `t1` rows hold the orientation when
+//! the jump straddles 0 ([`locks`]). On the paper plate every law with `t1`
+//! rows locks — patch and two-directional in either scene, and welded
+//! one-directional — and only the one-directional law on separate feet
+//! ([`Law::Line`]), which has no `t1` row, turns. On feet close to the centre
+//! of mass the lock fails and every law has an ordinary root.
+
+use pushval_model::{cross, perp, Body, Push, Vec2};
+
+/// A support-friction law (see the module docs). The caps come from the
+/// body's support friction magnitudes `F_i`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Law {
+    /// Coulomb at every support, `−F_i u_i/|u_i|` (the analytic model).
+    Coulomb,
+    /// A `t0` and a `t1` row at every point, cap `F_i`
+    /// (`eTWO_DIRECTIONAL`; `ePATCH` on one-point patches).
+    Box,
+    /// A `t0` row at every point, cap `F_i` (`eONE_DIRECTIONAL` on one-point
+    /// patches).
+    Line,
+    /// One row per point, `t0` where bit i of the mask is set, `t1` where it
+    /// is not, cap `F_i` (`eONE_DIRECTIONAL` on a welded patch;
+    /// [`alternating_mask`]).
+    Alternating(u64),
+    /// A `t0` and a `t1` row at the two anchor points, each capped by half the
+    /// patch's total `Σ F_i` (`ePATCH` on a welded patch; [`patch_anchors`]);
+    /// one anchor (`a == b`): the whole total.
+    Anchors(usize, usize),
+}
+
+/// The friction axes `(t0, t1)` (object frame) at ω: `t0` along the
+/// centre-of-mass velocity `v_c n_φ − ω D p_c`, `t1 = D t0`. `None` when that
+/// velocity is zero.
+pub fn axes(body: &Body, push: &Push, omega: f64) -> Option<(Vec2, Vec2)> {
+    let v = push.velocity() - perp(&body.contact()) * omega;
+    let n = v.norm();
+    (n > 0.0).then(|| {
+        let t0 = v / n;
+        (t0, perp(&t0))
+    })
+}
+
+/// Which axis a friction row is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// Along the centre-of-mass velocity.
+    T0,
+    /// Across it.
+    T1,
+}
+
+/// One friction row: a point (m, object frame), its axis, its cap (N).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Row {
+    /// Where it acts (m, object frame).
+    pub point: Vec2,
+    /// Its axis.
+    pub axis: Axis,
+    /// Its clamp (N).
+    pub cap: f64,
+}
+
+/// The friction rows of `law` on `body` (empty for [`Law::Coulomb`]).
+pub fn rows(body: &Body, law: Law) -> Vec<Row> {
+    let row = |i: usize, axis: Axis, cap: f64| Row {
+        point: body.support(i).position,
+        axis,
+        cap,
+    };
+    let n = body.len();
+    match law {
+        Law::Coulomb => Vec::new(),
+        Law::Box => (0..n)
+            .flat_map(|i| {
+                let c = body.support(i).friction;
+                [row(i, Axis::T0, c), row(i, Axis::T1, c)]
+            })
+            .collect(),
+        Law::Line => (0..n)
+            .map(|i| row(i, Axis::T0, body.support(i).friction))
+            .collect(),
+        Law::Alternating(mask) => (0..n)
+            .map(|i| {
+                let axis = if mask >> i & 1 == 1 {
+                    Axis::T0
+                } else {
+                    Axis::T1
+                };
+                row(i, axis, body.support(i).friction)
+            })
+            .collect(),
+        Law::Anchors(a, b) if a == b => {
+            let c = body.total_friction();
+            vec![row(a, Axis::T0, c), row(a, Axis::T1, c)]
+        }
+        Law::Anchors(a, b) => {
+            let half = 0.5 * body.total_friction();
+            [a, b]
+                .into_iter()
+                .flat_map(|i| [row(i, Axis::T0, half), row(i, Axis::T1, half)])
+                .collect()
+        }
+    }
+}
+
+/// The mask of [`Law::Alternating`] for points in the patch order `order`
+/// (support indices): the 1st, 3rd, 5th, … get `t0`.
+pub fn alternating_mask(order: &[usize]) -> u64 {
+    order.iter().step_by(2).fold(0u64, |m, &i| m | 1u64 << i)
+}
+
+/// The two anchors `ePATCH` picks from points in the order `order` (support
+/// indices into `points`): the first point, the next one more than 1e-4 m
+/// away, then each further point replaces the anchor it is farther from when
+/// that lengthens the pair (`growPatches`). For a rectangle of four corners:
+/// a diagonal.
+pub fn patch_anchors(points: &[[f64; 2]], order: &[usize]) -> (usize, usize) {
+    let d2 = |a: usize, b: usize| {
+        let (p, q) = (points[a], points[b]);
+        (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)
+    };
+    let mut anchors: Vec<usize> = Vec::with_capacity(2);
+    let mut best = 0.0;
+    for &j in order {
+        match anchors.len() {
+            0 => anchors.push(j),
+            1 => {
+                let d = d2(j, anchors[0]);
+                if d > 1e-8 {
+                    anchors.push(j);
+                    best = d;
+                }
+            }
+            _ => {
+                let (d0, d1) = (d2(j, anchors[0]), d2(j, anchors[1]));
+                if d0 > d1 {
+                    if d0 > best {
+                        anchors[1] = j;
+                        best = d0;
+                    }
+                } else if d1 > best {
+                    anchors[0] = j;
+                    best = d1;
+                }
+            }
+        }
+    }
+    match anchors[..] {
+        [a, b] => (a, b),
+        [a] => (a, a),
+        _ => (0, 0),
+    }
+}
+
+fn sgn(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// `G(ω) = I_P ω̇` (N m) under `law`: the friction moment about the contact
+/// point plus the inertial term `m v_c ω (p_c · n_φ)`. A sticking row (zero
+/// velocity along its axis) contributes nothing here; [`steady_omega`] finds
+/// the set-valued roots.
+pub fn moment(body: &Body, push: &Push, omega: f64, law: Law) -> f64 {
+    let pc = body.contact();
+    let v = push.velocity();
+    let mut m = body.mass() * push.speed * omega * pc.dot(&push.direction());
+    let vel = |p: Vec2| v + perp(&(p - pc)) * omega;
+    if law == Law::Coulomb {
+        for s in body.supports() {
+            let u = vel(s.position);
+            let n = u.norm();
+            if n > 0.0 {
+                m += cross(&(s.position - pc), &(-u * (s.friction / n)));
+            }
+        }
+        return m;
+    }
+    let Some((t0, t1)) = axes(body, push, omega) else {
+        return m;
+    };
+    for r in rows(body, law) {
+        let t = match r.axis {
+            Axis::T0 => t0,
+            Axis::T1 => t1,
+        };
+        let f = -t * (r.cap * sgn(vel(r.point).dot(&t)));
+        m += cross(&(r.point - pc), &f);
+    }
+    m
+}
+
+/// Whether `law` holds ω = 0 (see the module docs). Near ω = 0 every point
+/// slides along `t0 ≈ n_φ`, so a `t0` row at `p` gives the moment
+/// `−c (p − p_c) × n_φ` about the contact point, and a `t1` row slides with
+/// `u·t1 = ω p·t0` (its speed across the centre-of-mass velocity, measured
+/// from the centre of mass) and gives `−c sgn(ω p·n_φ) (p − p_c)·n_φ`. So
+/// `G(0±) = M₀ ∓ H` with `M₀ = −Σ_{t0} c (p − p_c) × n_φ` and
+/// `H = Σ_{t1} c sgn(p·n_φ) (p − p_c)·n_φ`, and ω = 0 attracts (the rows hold
+/// it, Filippov's sliding mode) iff `|M₀| ≤ H`. False for [`Law::Coulomb`].
+///
+/// (That the `t1` rows could balance `M₀` at ω = 0, `|M₀| ≤ Σ_{t1} c
+/// |(p − p_c)·n_φ|`, is not enough: a row whose point lies behind the centre
+/// of mass, `p·n_φ < 0`, pushes ω away from 0 on both sides, and PhysX,
+/// which re-aims `t0` at the centre-of-mass velocity every step, leaves 0.)
+pub fn locks(body: &Body, push: &Push, law: Law) -> bool {
+    if law == Law::Coulomb {
+        return false;
+    }
+    let (m0, h) = lock_moments(body, push, law);
+    m0.abs() <= h
+}
+
+/// `(M₀, H)` of [`locks`] (N m).
+pub fn lock_moments(body: &Body, push: &Push, law: Law) -> (f64, f64) {
+    let pc = body.contact();
+    let n = push.direction();
+    let (mut m0, mut h) = (0.0, 0.0);
+    for r in rows(body, law) {
+        let d = r.point - pc;
+        match r.axis {
+            Axis::T0 => m0 -= r.cap * cross(&d, &n),
+            Axis::T1 => h += r.cap * sgn(r.point.dot(&n)) * d.dot(&n),
+        }
+    }
+    (m0, h)
+}
+
+/// A steady state of a friction law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Steady {
+    /// The steady ω (rad/s).
+    pub omega: f64,
+    /// True when `G` jumps across zero there (a friction row sticks and holds
+    /// ω: a set-valued root, e.g. the lock at 0), false at an ordinary root.
+    pub sticks: bool,
+}
+
+/// The steady ω that `I_P ω̇ = G(ω)` reaches from `omega0` (rad/s) under
+/// `law`: marching from `omega0` in the direction `G` drives ω to the first
+/// sign change of `G`, then bisecting; a sign change by a jump is a sticking
+/// root. From `omega0 = 0` the side is read off `G(0±)`: 0 itself when the
+/// jump straddles 0 ([`locks`]), otherwise the side both point to (or, when
+/// they point away from each other, the side of `G(0+) + G(0−)`).
+pub fn steady_omega(body: &Body, push: &Push, law: Law, omega0: f64) -> Steady {
+    let g = |w: f64| moment(body, push, w, law);
+    let (start, g0) = if omega0 == 0.0 {
+        let eps = 1e-12;
+        let (gp, gm) = (g(eps), g(-eps));
+        if gp <= 0.0 && gm >= 0.0 {
+            return Steady {
+                omega: 0.0,
+                sticks: gp < 0.0 || gm > 0.0,
+            };
+        }
+        let side = if gp > 0.0 && gm > 0.0 {
+            1.0
+        } else if gp < 0.0 && gm < 0.0 {
+            -1.0
+        } else {
+            (gp + gm).signum()
+        };
+        (side * eps, g(side * eps))
+    } else {
+        (omega0, g(omega0))
+    };
+    if g0 == 0.0 {
+        return Steady {
+            omega: start,
+            sticks: false,
+        };
+    }
+    let dir = g0.signum();
+    let mut lo = start;
+    let mut step = 1e-3 * (push.speed + 1e-3);
+    let mut hi = start + dir * step;
+    let mut n = 0;
+    while g(hi) * dir > 0.0 && n < 200 {
+        lo = hi;
+        step *= 1.5;
+        hi += dir * step;
+        n += 1;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid == lo || mid == hi {
+            break;
+        }
+        if g(mid) * dir > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let scale = body.total_friction()
+        * body
+            .supports()
+            .map(|s| (s.position - body.contact()).norm())
+            .fold(0.0, f64::max);
+    let jump = g(lo).abs().min(g(hi).abs());
+    Steady {
+        omega: 0.5 * (lo + hi),
+        sticks: jump > 1e-9 * scale,
+    }
+}

@@ -1,0 +1,579 @@
+//! The PhysX scene and its stepping loop (see the crate docs).
+
+use std::f64::consts::{PI, TAU};
+use std::sync::{Arc, Mutex};
+
+use physx::material::Material;
+use physx::prelude::*;
+use physx::traits::Class;
+use pushval_engine::StepRecord;
+use pushval_model::{ModelError, Problem, SolverStats, Trajectory};
+
+use crate::sys;
+use crate::{FootContacts, FrictionType, PhysxRun, PhysxSettings, PxStep};
+
+type PxMaterial = physx::material::PxMaterial<()>;
+/// Shape user data: the foot's index + 1 (0 for the ground).
+type PxShape = physx::shape::PxShape<usize, PxMaterial>;
+type PxArticulationLink = physx::articulation_link::PxArticulationLink<(), PxShape>;
+type PxRigidStatic = physx::rigid_static::PxRigidStatic<(), PxShape>;
+/// Actor user data: [`OBJECT`] or [`PUSHER`].
+type PxRigidDynamic = physx::rigid_dynamic::PxRigidDynamic<usize, PxShape>;
+type PxArticulation =
+    physx::articulation_reduced_coordinate::PxArticulationReducedCoordinate<(), PxArticulationLink>;
+type PxScene = physx::scene::PxScene<
+    (),
+    PxArticulationLink,
+    PxRigidStatic,
+    PxRigidDynamic,
+    PxArticulation,
+    OnCollision,
+    NoTrigger,
+    NoConstraintBreak,
+    NoWakeSleep,
+    NoAdvance,
+>;
+
+const OBJECT: usize = 1;
+const PUSHER: usize = 2;
+
+/// Fraction of a phase's steps, at its end, over which tail means are taken.
+const TAIL: f64 = 0.2;
+
+/// PhysX keeps one foundation per process: runs take turns.
+static FOUNDATION: Mutex<()> = Mutex::new(());
+
+/// Normal impulses (N s) of the feet over the last step, from the contact
+/// reports (indexed by foot).
+#[derive(Default)]
+struct ContactLog {
+    /// Shape pointer of each foot, to match the reported pairs.
+    feet: Vec<usize>,
+    impulse: Vec<f64>,
+}
+
+struct OnCollision(Arc<Mutex<ContactLog>>);
+
+impl CollisionCallback for OnCollision {
+    fn on_collision(
+        &mut self,
+        _header: &physx_sys::PxContactPairHeader,
+        pairs: &[physx_sys::PxContactPair],
+    ) {
+        let mut log = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        for pair in pairs {
+            let foot = pair
+                .shapes
+                .iter()
+                .find_map(|&s| log.feet.iter().position(|&f| f == s as usize));
+            if let Some(i) = foot {
+                log.impulse[i] += sys::normal_impulse(pair);
+            }
+        }
+    }
+}
+
+struct NoTrigger;
+impl TriggerCallback for NoTrigger {
+    fn on_trigger(&mut self, _pairs: &[physx_sys::PxTriggerPair]) {}
+}
+struct NoConstraintBreak;
+impl ConstraintBreakCallback for NoConstraintBreak {
+    fn on_constraint_break(&mut self, _constraints: &[physx_sys::PxConstraintInfo]) {}
+}
+struct NoWakeSleep;
+impl WakeSleepCallback<PxArticulationLink, PxRigidStatic, PxRigidDynamic> for NoWakeSleep {
+    fn on_wake_sleep(
+        &mut self,
+        _actors: &[&physx::actor::ActorMap<PxArticulationLink, PxRigidStatic, PxRigidDynamic>],
+        _is_waking: bool,
+    ) {
+    }
+}
+struct NoAdvance;
+impl AdvanceCallback<PxArticulationLink, PxRigidDynamic> for NoAdvance {
+    fn on_advance(
+        &self,
+        _actors: &[&physx::rigid_body::RigidBodyMap<PxArticulationLink, PxRigidDynamic>],
+        _transforms: &[PxTransform],
+    ) {
+    }
+}
+
+fn v3(x: f64, y: f64, z: f64) -> PxVec3 {
+    PxVec3::new(x as f32, y as f32, z as f32)
+}
+
+fn yaw(theta: f64) -> PxQuat {
+    let (s, c) = (0.5 * theta).sin_cos();
+    PxQuat::new(0.0, 0.0, s as f32, c as f32)
+}
+
+fn raw(t: PxTransform) -> physx_sys::PxTransform {
+    t.into()
+}
+
+/// The object's state as read from the engine.
+#[derive(Clone, Copy)]
+struct State {
+    pose: PxTransform,
+    vel: [f64; 3],
+    theta: f64,
+    omega: f64,
+    tilt: f64,
+}
+
+impl State {
+    fn position(&self) -> [f64; 3] {
+        let p = self.pose.translation();
+        [p.x() as f64, p.y() as f64, p.z() as f64]
+    }
+
+    /// A point given in the object's frame, in the world (m).
+    fn world(&self, local: PxVec3) -> [f64; 3] {
+        let p = self.pose.transform_vector(&local);
+        [p.x() as f64, p.y() as f64, p.z() as f64]
+    }
+}
+
+fn actor(scene: &mut PxScene, tag: usize) -> &mut PxRigidDynamic {
+    scene
+        .get_dynamic_actors()
+        .into_iter()
+        .find(|a| *a.get_user_data() == tag)
+        .expect("the scene holds the object and the pusher")
+}
+
+fn read(scene: &mut PxScene, prev_theta: f64) -> State {
+    let a = actor(scene, OBJECT);
+    let pose = a.get_global_pose();
+    let q = pose.rotation();
+    let ex = q.get_basis_vector_x();
+    let angle = (ex.y() as f64).atan2(ex.x() as f64);
+    let mut d = angle - prev_theta.rem_euclid(TAU);
+    d = (d + PI).rem_euclid(TAU) - PI;
+    let v = a.get_linear_velocity();
+    State {
+        pose,
+        vel: [v.x() as f64, v.y() as f64, v.z() as f64],
+        theta: prev_theta + d,
+        omega: a.get_angular_velocity().z() as f64,
+        // cos(tilt) = 1 − 2 (q_x² + q_y²), in f64 from the components.
+        tilt: 2.0 * ((q.x() as f64).hypot(q.y() as f64)).min(1.0).asin(),
+    }
+}
+
+fn physx_error(what: &str) -> ModelError {
+    ModelError::Integration {
+        t: 0.0,
+        reason: format!("PhysX: {what}"),
+    }
+}
+
+/// Runs the problem.
+pub(crate) fn simulate(problem: &Problem, s: &PhysxSettings) -> Result<PhysxRun, ModelError> {
+    let _turn = FOUNDATION.lock().unwrap_or_else(|e| e.into_inner());
+    let body = &problem.body;
+    let mu = body.total_friction() / (body.mass() * s.gravity);
+    let mut physics = PhysicsFoundation::<physx::foundation::DefaultAllocator, PxShape>::default();
+    let run = World::new(&mut physics, problem, s, mu).and_then(|mut w| {
+        let settled = w.settle(problem, s)?;
+        w.push(problem, s, settled, mu)
+    });
+    drop(physics);
+    run
+}
+
+/// A built scene. Dropped in PhysX's order: the joint, the scene with its
+/// actors, the CPU dispatcher it ran on, then the materials.
+struct World {
+    joint: Option<sys::D6Joint>,
+    scene: Option<Owner<PxScene>>,
+    dispatcher: Option<sys::Dispatcher>,
+    materials: Vec<Owner<PxMaterial>>,
+    log: Arc<Mutex<ContactLog>>,
+    /// The pusher joint's anchor in the object's frame.
+    anchor_local: PxVec3,
+}
+
+impl Drop for World {
+    fn drop(&mut self) {
+        drop(self.joint.take());
+        drop(self.scene.take());
+        if let Some(d) = self.dispatcher.take() {
+            d.release();
+        }
+    }
+}
+
+/// The end of the settle phase.
+struct Settled {
+    state: State,
+    /// Mean normal force of each foot over the last 20 % of the phase (N).
+    loads: Vec<f64>,
+}
+
+impl World {
+    /// The scene of `problem` with friction coefficient `mu` on every foot.
+    fn new(
+        physics: &mut PhysicsFoundation<physx::foundation::DefaultAllocator, PxShape>,
+        problem: &Problem,
+        s: &PhysxSettings,
+        mu: f64,
+    ) -> Result<Self, ModelError> {
+        let body = &problem.body;
+        let init = problem.initial;
+        let pc = body.contact();
+        let h_cm = s.cm_height;
+        let mass = body.mass();
+        let iz = body.inertia_cm();
+        let tilt_inertia = 0.5 * iz + mass * s.plate_thickness * s.plate_thickness / 12.0;
+
+        let log = Arc::new(Mutex::new(ContactLog {
+            feet: Vec::new(),
+            impulse: vec![0.0; body.len()],
+        }));
+        let scene: Owner<PxScene> = physics
+            .create(SceneDescriptor {
+                gravity: v3(0.0, 0.0, -s.gravity),
+                friction_type: match s.friction {
+                    FrictionType::Patch => physx_sys::PxFrictionType::Patch,
+                    FrictionType::TwoDirectional => physx_sys::PxFrictionType::TwoDirectional,
+                    FrictionType::OneDirectional => physx_sys::PxFrictionType::OneDirectional,
+                },
+                solver_type: SolverType::Pgs,
+                // Tasks run on the calling thread: deterministic, no workers.
+                thread_count: 0,
+                on_collide: Some(OnCollision(log.clone())),
+                simulation_filter_shader: FilterShaderDescriptor::Custom(sys::report_contacts),
+                ..SceneDescriptor::new(())
+            })
+            .ok_or_else(|| physx_error("scene creation failed"))?;
+        // Owned by `world` from here on, so that an early return still
+        // releases everything in order.
+        let mut world = World {
+            joint: None,
+            dispatcher: Some(sys::Dispatcher::of(scene.as_ref())),
+            scene: Some(scene),
+            materials: Vec::new(),
+            log,
+            anchor_local: v3(pc.x, pc.y, s.push_height - h_cm),
+        };
+        let mut material = |mu: f64| -> Result<Owner<PxMaterial>, ModelError> {
+            let mut m = physics
+                .create_material(mu as f32, mu as f32, 0.0, ())
+                .ok_or_else(|| physx_error("material creation failed"))?;
+            m.set_friction_combined_mode(physx_sys::PxCombineMode::Multiply);
+            Ok(m)
+        };
+        // The ground's, and the one every foot shares.
+        world.materials = vec![material(1.0)?, material(mu)?];
+
+        let ground = physics
+            .create_plane(v3(0.0, 0.0, 1.0), 0.0, world.materials[0].as_mut(), ())
+            .ok_or_else(|| physx_error("ground creation failed"))?;
+        world.scene().add_static_actor(ground);
+
+        // Object: origin at the centre of mass, feet just touching the ground.
+        let pose0 = PxTransform::from_translation_rotation(
+            &v3(init.position.x, init.position.y, h_cm),
+            &yaw(init.theta),
+        );
+        let mut object = physics
+            .create_dynamic(&pose0, OBJECT)
+            .ok_or_else(|| physx_error("object creation failed"))?;
+        let r = s.foot_radius;
+        let mut feet = Vec::with_capacity(body.len());
+        for (i, sup) in body.supports().enumerate() {
+            let p = sup.position;
+            let mut shape = physics
+                .create_shape(
+                    &PxSphereGeometry::new(r as f32),
+                    &mut [world.materials[1].as_mut()],
+                    true,
+                    ShapeFlags::SimulationShape,
+                    i + 1,
+                )
+                .ok_or_else(|| physx_error("shape creation failed"))?;
+            if s.contacts == FootContacts::Separate {
+                shape.set_simulation_filter_data(
+                    CollisionLayers::empty(),
+                    CollisionLayers::empty(),
+                    0,
+                    sys::UNWELDED,
+                );
+            }
+            sys::set_local_pose(
+                shape.as_mut(),
+                raw(PxTransform::from_translation(&v3(p.x, p.y, -h_cm + r))),
+            );
+            object.attach_shape(shape.as_mut());
+            feet.push(Class::<physx_sys::PxShape>::as_ptr(shape.as_ref()) as usize);
+        }
+        world.log.lock().unwrap_or_else(|e| e.into_inner()).feet = feet;
+        object.set_mass(mass as f32);
+        object.set_mass_space_inertia_tensor(&v3(tilt_inertia, tilt_inertia, iz));
+        object.set_linear_damping(0.0);
+        object.set_angular_damping(0.0);
+        object.set_max_angular_velocity(1.0e4);
+        object.set_sleep_threshold(0.0);
+        object.set_solver_iteration_counts(s.position_iterations, s.velocity_iterations);
+
+        // Pusher: kinematic, no shapes, on the contact point at push height.
+        let mut pusher = physics
+            .create_dynamic(
+                &PxTransform::from_translation(&pose0.transform_vector(&world.anchor_local)),
+                PUSHER,
+            )
+            .ok_or_else(|| physx_error("pusher creation failed"))?;
+        pusher.set_rigid_body_flag(RigidBodyFlag::Kinematic, true);
+        pusher.set_sleep_threshold(0.0);
+        world.joint = Some(
+            sys::D6Joint::new(
+                physics,
+                pusher.as_mut(),
+                raw(PxTransform::default()),
+                object.as_mut(),
+                raw(PxTransform::from_translation(&world.anchor_local)),
+            )
+            .ok_or_else(|| physx_error("joint creation failed"))?,
+        );
+        world.scene().add_dynamic_actor(object);
+        world.scene().add_dynamic_actor(pusher);
+        Ok(world)
+    }
+
+    fn scene(&mut self) -> &mut PxScene {
+        self.scene.as_mut().expect("built in World::new")
+    }
+
+    /// Puts the pusher back on the object's contact point and gives it the
+    /// kinematic target that moves it at `vel` (m/s, world) over `h` (s).
+    /// Returns how far it was from the contact point (m, horizontal).
+    fn drive(&mut self, st: &State, vel: [f64; 2], h: f64) -> f64 {
+        let a = st.world(self.anchor_local);
+        let p = actor(self.scene(), PUSHER);
+        let before = p.get_global_position();
+        let drift =
+            ((before.x() as f64 - a[0]).powi(2) + (before.y() as f64 - a[1]).powi(2)).sqrt();
+        p.set_global_pose(&PxTransform::from_translation(&v3(a[0], a[1], a[2])), true);
+        p.set_kinematic_target(&PxTransform::from_translation(&v3(
+            a[0] + vel[0] * h,
+            a[1] + vel[1] * h,
+            a[2],
+        )));
+        drift
+    }
+
+    /// One engine step of length `h` ending at `t`; returns the feet's normal
+    /// forces (N).
+    fn step(&mut self, h: f64, t: f64) -> Result<Vec<f64>, ModelError> {
+        let log = self.log.clone();
+        log.lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .impulse
+            .iter_mut()
+            .for_each(|x| *x = 0.0);
+        self.scene()
+            .step(h as f32, None::<&mut physx_sys::PxBaseTask>, None, true)
+            .map_err(|code| ModelError::Integration {
+                t,
+                reason: format!("PhysX fetchResults failed (error {code})"),
+            })?;
+        let log = log.lock().unwrap_or_else(|e| e.into_inner());
+        Ok(log.impulse.iter().map(|j| j / h).collect())
+    }
+
+    /// Settles with the pusher at rest for `settle_time`.
+    fn settle(&mut self, problem: &Problem, s: &PhysxSettings) -> Result<Settled, ModelError> {
+        let n_feet = problem.body.len();
+        let mut state = read(self.scene(), problem.initial.theta);
+        let steps = (s.settle_time / s.dt).ceil() as usize;
+        let tail = ((1.0 - TAIL) * steps as f64).floor() as usize;
+        let mut loads = vec![0.0; n_feet];
+        let mut count = 0usize;
+        for k in 0..steps {
+            self.drive(&state, [0.0, 0.0], s.dt);
+            let step = self.step(s.dt, 0.0)?;
+            state = read(self.scene(), state.theta);
+            if k >= tail {
+                for (a, l) in loads.iter_mut().zip(&step) {
+                    *a += l;
+                }
+                count += 1;
+            }
+        }
+        if count > 0 {
+            loads.iter_mut().for_each(|a| *a /= count as f64);
+        }
+        Ok(Settled { state, loads })
+    }
+
+    /// The push schedule, from the settled state.
+    fn push(
+        &mut self,
+        problem: &Problem,
+        s: &PhysxSettings,
+        settled: Settled,
+        mu: f64,
+    ) -> Result<PhysxRun, ModelError> {
+        let init = problem.initial;
+        let n_feet = problem.body.len();
+        let pc = problem.body.contact();
+        let mut state = settled.state;
+        let z_rest = state.position()[2];
+
+        // Start: moving with the first push at ω = initial.omega, unless from rest.
+        if !init.from_rest {
+            let vc = problem.pushes[0].velocity();
+            let local = [vc.x + init.omega * pc.y, vc.y - init.omega * pc.x];
+            let (sn, cs) = state.theta.sin_cos();
+            let o = actor(self.scene(), OBJECT);
+            o.set_linear_velocity(
+                &v3(
+                    cs * local[0] - sn * local[1],
+                    sn * local[0] + cs * local[1],
+                    state.vel[2],
+                ),
+                true,
+            );
+            o.set_angular_velocity(&v3(0.0, 0.0, init.omega), true);
+            state.omega = init.omega;
+        }
+
+        let p0 = state.position();
+        let mut history = vec![PxStep {
+            segment: 0,
+            t0: 0.0,
+            t1: 0.0,
+            x: p0[0],
+            y: p0[1],
+            z: p0[2],
+            theta: state.theta,
+            omega: state.omega,
+            tilt: state.tilt,
+        }];
+        let mut steps = 0usize;
+        let mut max_tilt = 0.0f64;
+        let mut max_lift = 0.0f64;
+        let mut max_drift = 0.0f64;
+        let mut min_loads = vec![f64::INFINITY; n_feet];
+        let mut tail_omega = Vec::new();
+        let mut tail_omega_std = Vec::new();
+        let mut tail_loads = Vec::new();
+        let mut tail_force = Vec::new();
+        let mut t_seg = 0.0;
+        for (j, push) in problem.pushes.iter().enumerate() {
+            let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+            let h = push.duration / n as f64;
+            let tail_from = ((1.0 - TAIL) * n as f64).floor() as usize;
+            let (mut acc_w, mut acc_w2, mut acc_t) = (0.0, 0.0, 0.0);
+            let mut acc_n = vec![0.0; n_feet];
+            let mut acc_f = [0.0; 2];
+            let vc = push.velocity();
+            for k in 0..n {
+                let t0 = t_seg + k as f64 * h;
+                let t1 = if k + 1 == n {
+                    t_seg + push.duration
+                } else {
+                    t0 + h
+                };
+                let (sn, cs) = (state.theta + 0.5 * h * state.omega).sin_cos();
+                let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y];
+                let drift = self.drive(&state, vel, h);
+                if k > 0 || j > 0 {
+                    max_drift = max_drift.max(drift);
+                }
+                let loads = self.step(h, t1)?;
+                steps += 1;
+                state = read(self.scene(), state.theta);
+                let p = state.position();
+                if !(p.iter().all(|x| x.is_finite()) && state.omega.is_finite()) {
+                    return Err(ModelError::NonFinite { t: t1, step: steps });
+                }
+                for (m, &f) in min_loads.iter_mut().zip(&loads) {
+                    *m = m.min(f);
+                }
+                max_tilt = max_tilt.max(state.tilt);
+                max_lift = max_lift.max((p[2] - z_rest).abs());
+                if k >= tail_from {
+                    acc_w += state.omega * h;
+                    acc_w2 += state.omega * state.omega * h;
+                    acc_t += h;
+                    for (a, l) in acc_n.iter_mut().zip(&loads) {
+                        *a += l * h;
+                    }
+                    // The object feels the opposite of the force on the
+                    // pusher; turned into the object frame.
+                    let f = self
+                        .joint
+                        .as_ref()
+                        .map_or([0.0; 3], |j| j.force_on_pusher());
+                    let (sn, cs) = state.theta.sin_cos();
+                    acc_f[0] -= (cs * f[0] + sn * f[1]) * h;
+                    acc_f[1] -= (-sn * f[0] + cs * f[1]) * h;
+                }
+                history.push(PxStep {
+                    segment: j,
+                    t0,
+                    t1,
+                    x: p[0],
+                    y: p[1],
+                    z: p[2],
+                    theta: state.theta,
+                    omega: state.omega,
+                    tilt: state.tilt,
+                });
+            }
+            let mean = acc_w / acc_t;
+            tail_omega.push(mean);
+            tail_omega_std.push((acc_w2 / acc_t - mean * mean).max(0.0).sqrt());
+            tail_loads.push(acc_n.iter().map(|a| a / acc_t).collect());
+            tail_force.push([acc_f[0] / acc_t, acc_f[1] / acc_t]);
+            t_seg += push.duration;
+        }
+        let records: Vec<StepRecord> = history.iter().map(record).collect();
+        let (samples, segments) = pushval_engine::resample(problem, &records);
+        Ok(PhysxRun {
+            trajectory: Trajectory {
+                model: String::new(),
+                samples,
+                segments,
+                stats: SolverStats {
+                    rhs_evals: steps,
+                    steps,
+                    rejected: 0,
+                },
+                ..Default::default()
+            },
+            settings: *s,
+            steps,
+            wall_time: Default::default(),
+            mu,
+            engine_friction: settled.loads.iter().map(|n| mu * n).collect(),
+            rest_loads: settled.loads,
+            segment_tail_omega: tail_omega,
+            segment_tail_omega_std: tail_omega_std,
+            segment_tail_loads: tail_loads,
+            segment_tail_pusher_force: tail_force,
+            min_loads,
+            max_tilt,
+            max_lift,
+            max_joint_drift: max_drift,
+            history,
+        })
+    }
+}
+
+/// The shared resampler's view of a step.
+fn record(r: &PxStep) -> StepRecord {
+    StepRecord {
+        segment: r.segment,
+        t0: r.t0,
+        t1: r.t1,
+        x: r.x,
+        y: r.y,
+        theta: r.theta,
+        omega: r.omega,
+    }
+}

@@ -1,0 +1,111 @@
+//! The closed forms of `pushval_physx::predict`, checked against the model
+//! and against themselves (no PhysX needed).
+
+mod common;
+
+use common::*;
+use pushval_model::SegmentDynamics;
+use pushval_physx::predict::{
+    alternating_mask, lock_moments, locks, moment, patch_anchors, steady_omega, Law,
+};
+
+#[test]
+fn coulomb_law_is_the_model() {
+    let b = plate();
+    for v in [0.2, 0.5, 1.0] {
+        let p = push(v, PHI, 1.0);
+        let seg = SegmentDynamics::new(&b, &p);
+        for w in [-0.9, -0.3, 0.0, 0.4] {
+            let m = moment(&b, &p, w, Law::Coulomb);
+            assert!(
+                (m - seg.moment(w)).abs() < 1e-12,
+                "{m} vs {}",
+                seg.moment(w)
+            );
+        }
+        let s = steady_omega(&b, &p, Law::Coulomb, 0.0);
+        let roots = seg.steady_states();
+        let star = seg.attractor(&roots, 0.0).unwrap().omega;
+        assert!((s.omega - star).abs() < 1e-9, "{} vs {star}", s.omega);
+        assert!(!s.sticks);
+    }
+}
+
+#[test]
+fn lock_is_where_g_jumps_across_zero() {
+    // The closed form M₀ ∓ H is G just either side of 0.
+    for (half, phi, v) in [(HALF, PHI, 0.5), (0.05, 0.15, 0.3), (0.08, 0.6, 1.0)] {
+        let b = plate_with(half, [1.4, 1.05, 1.4, 1.05]);
+        let p = push(v, phi, 1.0);
+        for law in [Law::Box, Law::Alternating(0b0101), Law::Anchors(0, 2)] {
+            let (m0, h) = lock_moments(&b, &p, law);
+            let (gp, gm) = (moment(&b, &p, 1e-9, law), moment(&b, &p, -1e-9, law));
+            assert!((gp - (m0 - h)).abs() < 1e-6, "{law:?}: {gp} vs {}", m0 - h);
+            assert!((gm - (m0 + h)).abs() < 1e-6, "{law:?}: {gm} vs {}", m0 + h);
+            assert_eq!(locks(&b, &p, law), gp <= 0.0 && gm >= 0.0, "{law:?}");
+        }
+    }
+}
+
+#[test]
+fn box_and_anchors_lock_the_paper_plate_line_turns() {
+    // PhysX's PGS loads on the paper plate (2.80 / 2.10 N on the diagonals).
+    let b = with_friction(&plate(), &[1.401, 1.051, 1.401, 1.051]);
+    for v in [0.2, 0.5, 1.0] {
+        let p = push(v, PHI, 1.0);
+        for law in [Law::Box, Law::Anchors(0, 2), Law::Anchors(1, 3)] {
+            assert!(locks(&b, &p, law), "{law:?} at {v}");
+            let s = steady_omega(&b, &p, law, 0.0);
+            assert_eq!(s.omega, 0.0);
+            assert!(s.sticks);
+        }
+        assert!(!locks(&b, &p, Law::Line));
+        let line = steady_omega(&b, &p, Law::Line, 0.0);
+        assert!(line.omega < 0.0 && !line.sticks);
+        // Welded one-directional with t0 on feet 0 and 2 (what PhysX does):
+        // G(0±) < 0, the continuous law drifts away from 0.
+        let (m0, h) = lock_moments(&b, &p, Law::Alternating(0b0101));
+        assert!(m0 < 0.0 && m0 + h < 0.0 && h > 0.0, "{m0} {h}");
+        let alt = steady_omega(&b, &p, Law::Alternating(0b0101), 0.0);
+        assert!(alt.omega < -0.1 && !alt.sticks, "{alt:?}");
+    }
+}
+
+#[test]
+fn small_feet_do_not_lock() {
+    let b = plate_with(0.05, [1.85, 0.6, 1.85, 0.6]);
+    let p = push(0.3, 0.15, 1.0);
+    for law in [
+        Law::Box,
+        Law::Anchors(0, 2),
+        Law::Alternating(0b0101),
+        Law::Line,
+    ] {
+        assert!(!locks(&b, &p, law), "{law:?}");
+        let s = steady_omega(&b, &p, law, 0.0);
+        assert!(s.omega > 0.3 && !s.sticks, "{law:?}: {s:?}");
+        assert!(moment(&b, &p, s.omega, law).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn patch_anchors_are_a_diagonal_of_a_rectangle() {
+    let c = corners(HALF);
+    for (order, want) in [
+        ([0, 1, 2, 3], (0, 2)),
+        ([2, 1, 0, 3], (2, 0)),
+        ([0, 2, 1, 3], (0, 2)),
+        ([1, 0, 2, 3], (2, 0)),
+        ([3, 2, 1, 0], (3, 1)),
+    ] {
+        assert_eq!(patch_anchors(&c, &order), want, "{order:?}");
+    }
+}
+
+#[test]
+fn alternating_mask_takes_every_other_point() {
+    assert_eq!(alternating_mask(&[0, 1, 2, 3]), 0b0101);
+    assert_eq!(alternating_mask(&[2, 1, 0, 3]), 0b0101);
+    assert_eq!(alternating_mask(&[1, 0, 2, 3]), 0b0110);
+    assert_eq!(alternating_mask(&[0, 1, 2]), 0b101);
+}
