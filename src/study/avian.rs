@@ -529,14 +529,13 @@ fn write_paper(rungs: &[Rung], w: &mut Writer) -> anyhow::Result<String> {
         "| v_c (m/s) | ω* (Coulomb) | avian2d (error vs ω*) | avian3d (error vs ω*) | avian3d predicted |\n\
          |---:|---:|---:|---:|---:|\n",
     );
-    for v in 0..TABLE_SPEEDS.len() {
+    for (v, &speed) in TABLE_SPEEDS.iter().enumerate() {
         let (Some(a), Some(b)) = (
             rung(rungs, Model::Avian2d, FINE_DT, v),
             rung(rungs, Model::Avian3d, FINE_DT, v),
         ) else {
             continue;
         };
-        let speed = TABLE_SPEEDS[v];
         let pred = b.r[6];
         writeln!(
             csv,
