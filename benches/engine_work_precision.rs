@@ -17,7 +17,8 @@
 //! cost ∝ dt^(−b) fitted over the ladder.
 //!
 //! `cargo bench --bench engine_work_precision` (add `-- --quick` for one
-//! repeat and a shorter ladder). With `--features mujoco` the MuJoCo rows are
+//! repeat and a shorter ladder; `-- --replot` redraws the SVG from the CSV
+//! without running anything). With `--features mujoco` the MuJoCo rows are
 //! measured too.
 
 use std::time::Duration;
@@ -46,9 +47,43 @@ struct Row {
     steps: usize,
 }
 
+/// The rows of a written `engine_work_precision.csv` (for `--replot`).
+fn read_rows(text: &str) -> Vec<Row> {
+    text.lines()
+        .skip(1)
+        .filter_map(|line| {
+            // The version is quoted and may hold commas: split around it.
+            let (engine, rest) = line.split_once(",\"")?;
+            let (version, rest) = rest.split_once("\",")?;
+            let f: Vec<&str> = rest.split(',').collect();
+            Some(Row {
+                engine: engine.to_string(),
+                version: version.to_string(),
+                dt: f.first()?.parse().ok()?,
+                cpu_per_sim_s: f.get(1)?.parse().ok()?,
+                omega_rel: f.get(2)?.parse().ok()?,
+                position: f.get(3)?.parse().ok()?,
+                steps: f.get(4)?.parse().ok()?,
+            })
+        })
+        .collect()
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    if std::env::args().any(|a| a == "--replot") {
+        let csv = root.join("results/engine_work_precision.csv");
+        let rows = read_rows(&std::fs::read_to_string(&csv).expect("read the CSV"));
+        let mut names: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();
+        names.dedup();
+        pushval::output::write_atomic(
+            &root.join("results/engine_work_precision.svg"),
+            figure(&rows, &names).as_bytes(),
+        )
+        .expect("write svg");
+        return;
+    }
     let sc = registry::load(root.join("scenarios/friction-engines.toml")).expect("scenario loads");
     let problem = sc.problem();
     let duration = problem.duration();
@@ -196,7 +231,7 @@ fn figure(rows: &[Row], names: &[&str]) -> String {
             Axis::log("CPU time per simulated second (s/s)"),
             Axis::log(ylabel),
         )
-        .legend(Legend::UpperRight);
+        .legend(Legend::LowerRight);
         for (k, name) in names.iter().enumerate() {
             let mut pts: Vec<(f64, f64)> = rows
                 .iter()

@@ -75,7 +75,7 @@ enum Command {
     /// disagrees with Coulomb support friction, and the closed forms that
     /// explain it.
     Study {
-        /// coulomb_fits, idioms, rapier3d, box2d, mujoco (--features mujoco), avian (--features avian), or all.
+        /// coulomb_fits, idioms, rapier3d, box2d, mujoco (--features mujoco), avian (--features avian), physx (--features physx), or all.
         name: String,
         /// Output folder (created if missing).
         #[arg(long, default_value = "results/friction_models")]

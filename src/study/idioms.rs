@@ -1254,8 +1254,48 @@ fn other_engines(out: &Path) -> String {
         "omega_mujoco",
         "omega_star",
     );
+    // Box2D and Avian write one column per model.
+    for (label, column) in [
+        ("Box2D, Coulomb per support", "omega_box2d"),
+        ("Box2D, motor joint", "omega_motor_joint"),
+    ] {
+        push_rows(
+            "box2d/paper_plate.csv",
+            &|_| Some(label.to_string()),
+            "speed",
+            column,
+            "omega_star",
+        );
+    }
+    for (label, column) in [
+        ("avian2d, Coulomb per support", "omega_avian2d"),
+        ("avian3d, own contact friction", "omega_avian3d"),
+    ] {
+        push_rows(
+            "avian/paper_plate.csv",
+            &|r| at_1e3(r).then(|| label.to_string()),
+            "speed",
+            column,
+            "omega_star",
+        );
+    }
+    push_rows(
+        "physx/paper_plate.csv",
+        &|r| {
+            at_1e3(r).then(|| {
+                format!(
+                    "PhysX, {} ({} feet)",
+                    field(r, "friction"),
+                    field(r, "contacts")
+                )
+            })
+        },
+        "speed",
+        "omega_engine",
+        "omega_star",
+    );
     md.push_str("## Every engine on the paper plate at φ = π/4 + 0.3\n\n");
-    md.push_str("Steady ω in rad/s (relative error against the Coulomb model's ω*); rapier at Δt = 1e-3, MuJoCo at its defaults (Δt = 1e-3). Sources: `table_phi_pi4+0.3.csv`, `rapier3d/paper_table.csv`, `mujoco/paper_plate.csv` (regenerate all with `pushval study all`).\n\n");
+    md.push_str("Steady ω in rad/s (relative error against the Coulomb model's ω*); Δt = 1e-3 s for rapier, Box2D, Avian and PhysX, MuJoCo at its defaults (Δt = 1e-3). Sources: `table_phi_pi4+0.3.csv`, `rapier3d/paper_table.csv`, `mujoco/paper_plate.csv`, `box2d/paper_plate.csv`, `avian/paper_plate.csv`, `physx/paper_plate.csv` (regenerate all with `pushval study all`; a study whose feature is missing keeps its folder). What explains each row is in the sections below.\n\n");
     let head: Vec<String> = TABLE_SPEEDS
         .iter()
         .enumerate()
@@ -1292,7 +1332,13 @@ fn other_engines(out: &Path) -> String {
         md.push_str(&format!("| {name} | {} |\n", cells.join(" | ")));
     }
     md.push('\n');
-    for (dir, title) in [("rapier3d", "rapier3d"), ("mujoco", "MuJoCo")] {
+    for (dir, title) in [
+        ("rapier3d", "rapier3d"),
+        ("mujoco", "MuJoCo"),
+        ("box2d", "Box2D"),
+        ("avian", "Avian"),
+        ("physx", "PhysX"),
+    ] {
         match std::fs::read_to_string(out.join(dir).join("README.md")) {
             Ok(text) => {
                 md.push_str(&format!("---\n\n(From `{dir}/README.md`: {title}.)\n\n"));

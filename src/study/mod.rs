@@ -17,7 +17,11 @@
 //! * `avian` (`OUT/avian/`): Avian's per-support Coulomb model (avian2d) and
 //!   its own contact friction in closed form (avian3d, through the crate's
 //!   simulators and `pushval_avian::predict`); compiled only with the root
-//!   feature `avian`, gated like `mujoco`.
+//!   feature `avian`, gated like `mujoco`;
+//! * `physx` (`OUT/physx/`): PhysX's friction types on the feet-on-floor
+//!   scene against their closed forms (`pushval_physx::predict`), and which
+//!   lock criterion PhysX follows; compiled only with the root feature
+//!   `physx`, gated like `mujoco`.
 //!
 //! A study is a fixed list of tasks (engine runs and the closed forms that
 //! need their output), each reduced to a row of numbers ([`Study::eval`]);
@@ -45,6 +49,8 @@ pub mod fits;
 pub mod idioms;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
+#[cfg(feature = "physx")]
+pub mod physx;
 pub mod plate;
 pub mod rapier3d;
 
@@ -57,11 +63,12 @@ use crate::report::shard::{grid_name, shard_range, Parts, Shard};
 use crate::report::{par_rows, Writer};
 
 /// The studies on the command line, in the order `all` runs them.
-pub const STUDIES: [&str; 6] = [
+pub const STUDIES: [&str; 7] = [
     "rapier3d",
     "mujoco",
     "box2d",
     "avian",
+    "physx",
     "coulomb_fits",
     "idioms",
 ];
@@ -73,6 +80,10 @@ pub const MUJOCO_FEATURE: &str =
 /// The cargo feature that brings in the Avian study.
 pub const AVIAN_FEATURE: &str =
     "the Avian study needs the cargo feature `avian` (build with --features avian)";
+
+/// The cargo feature that brings in the PhysX study.
+pub const PHYSX_FEATURE: &str =
+    "the PhysX study needs the cargo feature `physx` (build with --features physx; needs clang++: apt-get install clang)";
 
 /// What `pushval study` does.
 #[derive(Debug, Clone)]
@@ -177,7 +188,7 @@ pub fn run_study<S: Study>(study: &S, opts: &Options) -> anyhow::Result<Summary>
     })
 }
 
-/// Runs the study `name` (`idioms`, `rapier3d`, `mujoco`) or `all` of them.
+/// Runs the study `name` (one of [`STUDIES`]) or `all` of them.
 pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
     if name == "all" {
         let mut all = Summary::default();
@@ -193,6 +204,13 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
                 all.notes.push(format!(
                     "skipped the Avian study, keeping {} as it is: {AVIAN_FEATURE}",
                     opts.out.join("avian").display()
+                ));
+                continue;
+            }
+            if s == "physx" && !cfg!(feature = "physx") {
+                all.notes.push(format!(
+                    "skipped the PhysX study, keeping {} as it is: {PHYSX_FEATURE}",
+                    opts.out.join("physx").display()
                 ));
                 continue;
             }
@@ -216,6 +234,10 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
         "avian" => run_study(&avian::Avian { quick: opts.quick }, opts),
         #[cfg(not(feature = "avian"))]
         "avian" => bail!("{AVIAN_FEATURE}"),
+        #[cfg(feature = "physx")]
+        "physx" => run_study(&physx::Physx { quick: opts.quick }, opts),
+        #[cfg(not(feature = "physx"))]
+        "physx" => bail!("{PHYSX_FEATURE}"),
         _ => bail!("unknown study '{name}'; known: {}, all", STUDIES.join(", ")),
     }
 }

@@ -732,26 +732,7 @@ fn avian2d_is_first_order_coulomb_and_the_readme_says_so() {
 #[cfg(feature = "avian")]
 #[test]
 fn avian_shards_merged_equal_a_single_run_byte_for_byte() {
-    let single = avian_dir();
-    let sharded = tempfile::tempdir().unwrap();
-    for k in ["1/2", "2/2"] {
-        ok(study(&["avian", "--quick", "--shard", k], sharded.path()));
-    }
-    assert!(
-        !sharded.path().join("avian").exists(),
-        "a shard wrote outputs"
-    );
-    ok(study(&["avian", "--quick", "--merge"], sharded.path()));
-    let (a, b) = (files(single), files(&sharded.path().join("avian")));
-    assert_eq!(a.len(), b.len());
-    for (x, y) in a.iter().zip(&b) {
-        assert_eq!(x.file_name(), y.file_name());
-        assert!(
-            std::fs::read(x).unwrap() == std::fs::read(y).unwrap(),
-            "{} differs between the single and the merged run",
-            x.display()
-        );
-    }
+    shards_merge_into_the_single_run("avian", avian_dir());
 }
 
 /// Without the feature, `study avian` exits 2 naming it.
@@ -762,4 +743,156 @@ fn avian_study_without_the_feature_exits_2() {
     let out = study(&["avian", "--quick"], dir.path());
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--features avian"));
+}
+
+// ---------------------------------------------------------------------------
+// `pushval study physx` (needs the root feature `physx`). Expected values come
+// from the closed forms of `pushval_physx::predict`, recomputed here from each
+// row's push and PhysX's rest loads (the feet's friction μ̄ N_i), never from
+// the study's own columns alone.
+// ---------------------------------------------------------------------------
+
+/// One quick PhysX study (its folder `OUT/physx/`), shared by the tests
+/// that read it.
+#[cfg(feature = "physx")]
+fn physx_dir() -> &'static Path {
+    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    let (_, path) = DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        ok(study(&["physx", "--quick"], dir.path()));
+        let path = dir.path().join("physx");
+        (dir, path)
+    });
+    path
+}
+
+/// The paper-plate table against the closed forms: the class of ω = 0 and
+/// M₀, H, S from `predict` with the row's loads; locked runs hold the plate
+/// (|ω| ≤ 1e-2 |ω*|), runs that turn are within 1e-2 of the law's root,
+/// semi-stable runs are at 0 or escaped to the side of M₀; and the welded
+/// one-directional model, which Filippov's criterion says turns, is
+/// semi-stable on the paper plate and held there.
+#[cfg(feature = "physx")]
+#[test]
+fn physx_paper_plate_follows_its_closed_forms() {
+    use pushval_model::{Body, Support};
+    use pushval_physx::predict::{at_rest, lock_moments, rest_moments, steady_omega, AtRest};
+    use pushval_physx::{FootContacts, FrictionType};
+    let rows = read_csv(&physx_dir().join("paper_plate.csv"));
+    assert_eq!(
+        rows.len(),
+        18,
+        "6 combinations × 3 speeds on the quick ladder"
+    );
+    let plate = paper_plate();
+    let corners: Vec<[f64; 2]> = plate
+        .supports()
+        .map(|s| [s.position.x, s.position.y])
+        .collect();
+    let mut semi_held = 0;
+    for r in &rows {
+        let friction = FrictionType::ALL
+            .into_iter()
+            .find(|f| f.as_str() == r["friction"])
+            .unwrap();
+        let contacts = FootContacts::ALL
+            .into_iter()
+            .find(|c| c.as_str() == r["contacts"])
+            .unwrap();
+        let mu = val(r, "mu");
+        let feet: Vec<Support> = plate
+            .supports()
+            .enumerate()
+            .map(|(i, s)| Support {
+                friction: mu * val(r, &format!("rest_load_{i}")),
+                ..s
+            })
+            .collect();
+        let body = Body::new(1.0, plate.inertia_cm(), plate.contact(), &feet).unwrap();
+        let push = Push {
+            duration: 1.0,
+            speed: val(r, "speed"),
+            phi: val(r, "phi"),
+        };
+        let law = friction.law(contacts, &[0, 1, 2, 3], &corners);
+        let (m0, h) = lock_moments(&body, &push, law);
+        let (_, s) = rest_moments(&body, &push, law);
+        for (k, want) in [("M0", m0), ("H", h), ("S", s)] {
+            assert!(
+                (val(r, k) - want).abs() < 1e-9,
+                "{k}: {} vs {want}",
+                val(r, k)
+            );
+        }
+        let (w, star) = (val(r, "omega_engine"), val(r, "omega_star"));
+        let root = steady_omega(&body, &push, law, 0.0).omega;
+        let class = at_rest(&body, &push, law);
+        match class {
+            AtRest::Locked => assert!(w.abs() <= 1e-2 * star.abs(), "{r:?}"),
+            AtRest::Turns => assert!(rel(w, root) <= 1e-2, "{w} vs {root}"),
+            AtRest::SemiStable => {
+                let held = w.abs() <= 1e-2 * star.abs();
+                // Held, or escaped to the side of M₀, where G(0±) points.
+                assert!(
+                    held || (w * m0 > 0.0 && root * m0 > 0.0),
+                    "{w} vs 0 or {root}"
+                );
+                semi_held += held as usize;
+            }
+        }
+        let name = match class {
+            AtRest::Locked => "locked",
+            AtRest::SemiStable => "semi-stable",
+            AtRest::Turns => "turns",
+        };
+        assert_eq!(r["at_rest"], name);
+        if friction == FrictionType::OneDirectional && contacts == FootContacts::Welded {
+            assert_eq!(class, AtRest::SemiStable, "paper plate: H < |M₀| ≤ S");
+            assert!(m0.abs() > h && m0.abs() <= s);
+        }
+    }
+    assert_eq!(semi_held, 3, "PhysX holds the semi-stable paper plate");
+    let readme = std::fs::read_to_string(physx_dir().join("README.md")).unwrap();
+    for bad in ["NaN", " inf"] {
+        assert!(!readme.contains(bad), "README holds '{bad}'");
+    }
+    assert!(readme.contains("| physx_one_directional (welded) | 0.2 |"));
+}
+
+#[cfg(feature = "physx")]
+#[test]
+fn physx_shards_merged_equal_a_single_run_byte_for_byte() {
+    shards_merge_into_the_single_run("physx", physx_dir());
+}
+
+/// Without the feature, `study physx` exits 2 naming it.
+#[cfg(not(feature = "physx"))]
+#[test]
+fn physx_study_without_the_feature_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = study(&["physx", "--quick"], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--features physx"));
+}
+
+/// `study NAME --quick` in two shards and a merge writes exactly the files
+/// of the single run in `single` (and the shards write no outputs).
+#[cfg(any(feature = "avian", feature = "physx"))]
+fn shards_merge_into_the_single_run(name: &str, single: &Path) {
+    let sharded = tempfile::tempdir().unwrap();
+    for k in ["1/2", "2/2"] {
+        ok(study(&[name, "--quick", "--shard", k], sharded.path()));
+    }
+    assert!(!sharded.path().join(name).exists(), "a shard wrote outputs");
+    ok(study(&[name, "--quick", "--merge"], sharded.path()));
+    let (a, b) = (files(single), files(&sharded.path().join(name)));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x.file_name(), y.file_name());
+        assert!(
+            std::fs::read(x).unwrap() == std::fs::read(y).unwrap(),
+            "{} differs between the single and the merged run",
+            x.display()
+        );
+    }
 }

@@ -40,11 +40,15 @@
 //!
 //! At ω = 0 every point slides along `v_cm = v_c n_φ`, so every `t1` row
 //! changes sign there and `G` jumps: the `t1` rows hold the orientation when
-//! the jump straddles 0 ([`locks`]). On the paper plate every law with `t1`
-//! rows locks — patch and two-directional in either scene, and welded
-//! one-directional — and only the one-directional law on separate feet
-//! ([`Law::Line`]), which has no `t1` row, turns. On feet close to the centre
-//! of mass the lock fails and every law has an ordinary root.
+//! the jump straddles 0 ([`locks`], `|M₀| ≤ H`). The rows are set-valued one
+//! by one, so a run that starts at ω = 0 can also stay there when the
+//! sticking `t1` rows merely balance the `t0` rows ([`holds_at_rest`],
+//! `|M₀| ≤ S`, S ≥ H); between the two, ω = 0 is semi-stable ([`at_rest`]).
+//! On the paper plate patch and two-directional friction lock in either
+//! scene; welded one-directional friction is semi-stable and PhysX holds it;
+//! the one-directional law on separate feet ([`Law::Line`]), which has no
+//! `t1` row, turns. On feet close to the centre of mass the lock fails and
+//! every law has an ordinary root.
 
 use pushval_model::{cross, perp, Body, Push, Vec2};
 
@@ -246,10 +250,10 @@ pub fn moment(body: &Body, push: &Push, omega: f64, law: Law) -> f64 {
 /// `H = Σ_{t1} c sgn(p·n_φ) (p − p_c)·n_φ`, and ω = 0 attracts (the rows hold
 /// it, Filippov's sliding mode) iff `|M₀| ≤ H`. False for [`Law::Coulomb`].
 ///
-/// (That the `t1` rows could balance `M₀` at ω = 0, `|M₀| ≤ Σ_{t1} c
-/// |(p − p_c)·n_φ|`, is not enough: a row whose point lies behind the centre
-/// of mass, `p·n_φ < 0`, pushes ω away from 0 on both sides, and PhysX,
-/// which re-aims `t0` at the centre-of-mass velocity every step, leaves 0.)
+/// That the `t1` rows, sticking, can balance `M₀` at ω = 0 is the weaker
+/// condition [`holds_at_rest`]: a row whose point lies behind the centre of
+/// mass (`p·n_φ < 0`) counts against `H` but for `S`, and between the two ω
+/// = 0 is semi-stable ([`AtRest`]).
 pub fn locks(body: &Body, push: &Push, law: Law) -> bool {
     if law == Law::Coulomb {
         return false;
@@ -271,6 +275,79 @@ pub fn lock_moments(body: &Body, push: &Push, law: Law) -> (f64, f64) {
         }
     }
     (m0, h)
+}
+
+/// Whether the `t1` rows, sticking, can balance the `t0` rows' moment at
+/// ω = 0: `|M₀| ≤ S` with `S = Σ_{t1} c |(p − p_c)·n_φ|` ([`rest_moments`]).
+/// This is the balance of a velocity-level (Moreau) step that ends at ω = 0
+/// from ω = 0: every `t1` row then has zero velocity and may take any force
+/// in `[−c, c]`, every `t0` row slides at its cap. It asks nothing of the
+/// sign of `p·n_φ`, so it holds wherever [`locks`] does and also where a
+/// `t1` row behind the centre of mass would, in continuous time, push ω away
+/// from 0 (Filippov's condition fails, the static balance does not). False
+/// for [`Law::Coulomb`].
+pub fn holds_at_rest(body: &Body, push: &Push, law: Law) -> bool {
+    if law == Law::Coulomb {
+        return false;
+    }
+    let (m0, s) = rest_moments(body, push, law);
+    m0.abs() <= s
+}
+
+/// `(M₀, S)` of [`holds_at_rest`] (N m): the `t0` rows' moment about the
+/// contact point at ω = 0 and the largest moment the `t1` rows can hold.
+pub fn rest_moments(body: &Body, push: &Push, law: Law) -> (f64, f64) {
+    let pc = body.contact();
+    let n = push.direction();
+    let (mut m0, mut s) = (0.0, 0.0);
+    for r in rows(body, law) {
+        let d = r.point - pc;
+        match r.axis {
+            Axis::T0 => m0 -= r.cap * cross(&d, &n),
+            Axis::T1 => s += r.cap * d.dot(&n).abs(),
+        }
+    }
+    (m0, s)
+}
+
+/// What ω = 0 is for a run started there, from the two criteria.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AtRest {
+    /// `|M₀| ≤ H` ([`locks`]): ω = 0 attracts from both sides.
+    Locked,
+    /// `H < |M₀| ≤ S` ([`holds_at_rest`] but not [`locks`]): the sticking
+    /// `t1` rows hold ω = 0, and ω returns to 0 from the side opposite to
+    /// `M₀`; a disturbance to the side of `M₀` leaves for the root
+    /// [`steady_omega`] finds from 0. Which of the two a run shows depends on
+    /// the solver's disturbances, not on the law.
+    SemiStable,
+    /// `|M₀| > S`: ω leaves 0 for the root [`steady_omega`] finds from 0.
+    Turns,
+}
+
+/// The class of ω = 0 under `law` ([`AtRest`]).
+pub fn at_rest(body: &Body, push: &Push, law: Law) -> AtRest {
+    if locks(body, push, law) {
+        AtRest::Locked
+    } else if holds_at_rest(body, push, law) {
+        AtRest::SemiStable
+    } else {
+        AtRest::Turns
+    }
+}
+
+/// The steady ω a run started at ω = 0 reaches when the sticking `t1` rows
+/// hold whatever they can balance and nothing disturbs it: 0 where
+/// [`holds_at_rest`], else [`steady_omega`] from 0.
+pub fn steady_from_rest(body: &Body, push: &Push, law: Law) -> Steady {
+    if holds_at_rest(body, push, law) {
+        Steady {
+            omega: 0.0,
+            sticks: true,
+        }
+    } else {
+        steady_omega(body, push, law, 0.0)
+    }
 }
 
 /// A steady state of a friction law.

@@ -8,7 +8,9 @@ mod common;
 
 use common::*;
 use pushval_model::Body;
-use pushval_physx::predict::{lock_moments, locks, steady_omega, Law};
+use pushval_physx::predict::{
+    at_rest, holds_at_rest, lock_moments, locks, steady_omega, AtRest, Law,
+};
 use pushval_physx::{FootContacts, FrictionType, PhysxRun, PhysxSettings, PhysxSimulator};
 
 fn run(body: &Body, p: pushval_model::Push, s: PhysxSettings) -> PhysxRun {
@@ -36,9 +38,9 @@ fn coulomb(body: &Body, p: &pushval_model::Push) -> f64 {
 /// The registered models (welded feet, PhysX's default) hold the paper plate
 /// at ω = 0 while the Coulomb model turns it at ω* = −0.217, −0.474,
 /// −0.649 rad/s. Patch and two-directional: the closed-form lock (the `t1`
-/// rows' jump in G straddles 0). One-directional: the engine holds 0 too,
-/// although the continuous law says G(0±) < 0 and drifts — the one
-/// discrepancy left unexplained.
+/// rows' jump in G straddles 0). One-directional: G(0±) < 0, so ω = 0 is no
+/// Filippov lock, but the sticking `t1` rows of feet 1 and 3 balance M₀
+/// (`holds_at_rest`): ω = 0 is semi-stable, and PhysX holds it.
 #[test]
 fn registered_models_hold_the_paper_plate_still() {
     let b = plate();
@@ -62,6 +64,8 @@ fn registered_models_hold_the_paper_plate_still() {
                     let (m0, h) = lock_moments(&eb, &p, law);
                     assert!(m0 + h < 0.0 && m0 - h < 0.0, "{m0} {h}");
                     assert!(steady_omega(&eb, &p, law, 0.0).omega < -0.1);
+                    assert!(holds_at_rest(&eb, &p, law));
+                    assert_eq!(at_rest(&eb, &p, law), AtRest::SemiStable);
                 }
             }
         }

@@ -6,7 +6,8 @@ mod common;
 use common::*;
 use pushval_model::SegmentDynamics;
 use pushval_physx::predict::{
-    alternating_mask, lock_moments, locks, moment, patch_anchors, steady_omega, Law,
+    alternating_mask, holds_at_rest, lock_moments, locks, moment, patch_anchors, rest_moments,
+    steady_from_rest, steady_omega, Law,
 };
 
 #[test]
@@ -108,4 +109,62 @@ fn alternating_mask_takes_every_other_point() {
     assert_eq!(alternating_mask(&[2, 1, 0, 3]), 0b0101);
     assert_eq!(alternating_mask(&[1, 0, 2, 3]), 0b0110);
     assert_eq!(alternating_mask(&[0, 1, 2]), 0b101);
+}
+
+#[test]
+fn static_balance_contains_the_lock() {
+    // |M₀| ≤ H implies |M₀| ≤ S (S ≥ H term by term), and with every `t1`
+    // point ahead of the centre of mass (p·n ≥ 0) the two are one condition.
+    for (half, phi, v) in [
+        (HALF, PHI, 0.5),
+        (0.05, 0.15, 0.3),
+        (0.08, 0.6, 1.0),
+        (HALF, 0.2, 0.4),
+        (HALF, 1.3, 0.4),
+    ] {
+        let b = plate_with(half, [1.4, 1.05, 1.4, 1.05]);
+        let p = push(v, phi, 1.0);
+        for law in [Law::Box, Law::Alternating(0b0101), Law::Anchors(0, 2)] {
+            let (m0, h) = lock_moments(&b, &p, law);
+            let (m0s, s) = rest_moments(&b, &p, law);
+            assert_eq!(m0, m0s);
+            assert!(s >= h.abs() - 1e-15, "{law:?}: {s} < {h}");
+            if locks(&b, &p, law) {
+                assert!(holds_at_rest(&b, &p, law), "{law:?}");
+            }
+        }
+        assert!(!holds_at_rest(&b, &p, Law::Line), "no t1 rows, S = 0");
+        assert!(!holds_at_rest(&b, &p, Law::Coulomb));
+    }
+}
+
+#[test]
+fn static_balance_holds_welded_one_directional_on_the_paper_plate() {
+    // The paper plate with PhysX's PGS loads: foot 1 (t1 row) lies behind the
+    // centre of mass along n_φ, so G(0±) < 0 (no Filippov lock) while the
+    // sticking t1 rows of feet 1 and 3 can hold |M₀| (the static balance).
+    let b = with_friction(&plate(), &[1.401, 1.051, 1.401, 1.051]);
+    let law = Law::Alternating(0b0101);
+    for v in [0.2, 0.5, 1.0] {
+        let p = push(v, PHI, 1.0);
+        let n = p.direction();
+        assert!(b.support(1).position.dot(&n) < 0.0);
+        assert!(!locks(&b, &p, law));
+        assert!(holds_at_rest(&b, &p, law));
+        // By hand: M₀ = −c₂ (p₂ − p_c) × n, S = c₁ |(p₁ − p_c)·n| + c₃ |(p₃ − p_c)·n|.
+        let pc = b.contact();
+        let d = |i: usize| b.support(i).position - pc;
+        let m0 = -1.401 * (d(2).x * n.y - d(2).y * n.x);
+        let s = 1.051 * d(1).dot(&n).abs() + 1.051 * d(3).dot(&n).abs();
+        let (m0c, sc) = rest_moments(&b, &p, law);
+        assert!((m0 - m0c).abs() < 1e-12 && (s - sc).abs() < 1e-12);
+        let r = steady_from_rest(&b, &p, law);
+        assert_eq!(r.omega, 0.0);
+        assert!(r.sticks);
+        // Where the static balance fails, the prediction is the law's root.
+        assert_eq!(
+            steady_from_rest(&b, &p, Law::Line),
+            steady_omega(&b, &p, Law::Line, 0.0)
+        );
+    }
 }
