@@ -242,19 +242,29 @@ fn unknown_and_missing_studies_exit_2() {
     }
 }
 
+/// A quick study run once per test binary: its temporary output and the
+/// study's folder in it.
+type QuickStudy = OnceLock<(tempfile::TempDir, PathBuf)>;
+
+/// `pushval study NAME --quick` into a temporary folder, run on first use
+/// and shared by the tests that read it; returns `OUT/NAME/`.
+fn quick_study(cell: &'static QuickStudy, name: &str) -> &'static Path {
+    let (_, path) = cell.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        ok(study(&[name, "--quick"], dir.path()));
+        let path = dir.path().join(name);
+        (dir, path)
+    });
+    path
+}
+
 // Issue "More engines": the Box2D study (`pushval study box2d`).
 
 /// One quick Box2D study (its folder `OUT/box2d/`), shared by the tests
 /// that read it.
 fn box2d_dir() -> &'static Path {
-    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    let (_, path) = DIR.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        ok(study(&["box2d", "--quick"], dir.path()));
-        let path = dir.path().join("box2d");
-        (dir, path)
-    });
-    path
+    static DIR: QuickStudy = OnceLock::new();
+    quick_study(&DIR, "box2d")
 }
 
 /// The plate of a `geometry` column: the paper plate, or the same plate on
@@ -606,14 +616,8 @@ fn coulomb_fit_shards_merge_into_the_single_run() {
 /// that read it.
 #[cfg(feature = "avian")]
 fn avian_dir() -> &'static Path {
-    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    let (_, path) = DIR.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        ok(study(&["avian", "--quick"], dir.path()));
-        let path = dir.path().join("avian");
-        (dir, path)
-    });
-    path
+    static DIR: QuickStudy = OnceLock::new();
+    quick_study(&DIR, "avian")
 }
 
 /// avian3d against `PlateScene::steady`, recomputed from each row's push and
@@ -756,14 +760,8 @@ fn avian_study_without_the_feature_exits_2() {
 /// that read it.
 #[cfg(feature = "physx")]
 fn physx_dir() -> &'static Path {
-    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    let (_, path) = DIR.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        ok(study(&["physx", "--quick"], dir.path()));
-        let path = dir.path().join("physx");
-        (dir, path)
-    });
-    path
+    static DIR: QuickStudy = OnceLock::new();
+    quick_study(&DIR, "physx")
 }
 
 /// The paper-plate table against the closed forms: the class of ω = 0 and
