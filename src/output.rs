@@ -136,6 +136,7 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "omega_steady_rel": limit(sc.tolerance.omega_steady_rel),
                 "position_max": limit(sc.tolerance.position_max),
                 "theta_max": limit(sc.tolerance.theta_max),
+                "auto_ceiling": sc.tolerance.auto_ceiling.map(num),
             },
         },
         "segments": segments,
@@ -245,6 +246,29 @@ pub fn table(reports: &[ScenarioReport]) -> String {
                 notes.push(e.clone());
             }
             notes.extend(c.failed.iter().cloned());
+            if let Some(t) = &c.tolerance {
+                if let Some((dt, source, met)) = t.dt {
+                    notes.push(format!(
+                        "dt {dt:.3e} s ({}, ladder {})",
+                        source.as_str(),
+                        if met {
+                            "met its target"
+                        } else {
+                            "missed its target"
+                        }
+                    ));
+                }
+                if let Some(k) = &t.catches {
+                    let f = |c: &Option<(f64, &str)>| {
+                        c.map_or("-".to_string(), |(m, _)| format!("{m:.1e}"))
+                    };
+                    notes.push(format!(
+                        "catches relative errors of I_cm {}, mu {}",
+                        f(&k.inertia_cm),
+                        f(&k.mu_all)
+                    ));
+                }
+            }
             if let (Some(t), true) = (&c.tolerance, c.failed.is_empty()) {
                 let src = |k: usize| t.source[k].as_str();
                 notes.push(format!(

@@ -50,7 +50,17 @@ pub fn read_csv(path: &Path) -> anyhow::Result<Outside> {
         find("omega")?,
     );
     let mut runs: Vec<(String, Vec<Sample>)> = Vec::new();
-    for (n, line) in lines {
+    for (rows, (n, line)) in lines.enumerate() {
+        // The loader's sample cap, per file (a trajectory the scenario
+        // could not ask for is refused before it is held in memory).
+        if rows as f64 >= pushval_scenario::MAX_SAMPLES {
+            bail!(
+                "{}: line {}: more than {:e} data rows (the most samples a scenario may ask for)",
+                path.display(),
+                n + 1,
+                pushval_scenario::MAX_SAMPLES
+            );
+        }
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
         if f.len() != cols.len() {
             bail!(
@@ -116,6 +126,13 @@ pub fn compare_outside(
     }
     if !(sc.sample_dt > 0.0) {
         bail!("{}: t must increase", file.display());
+    }
+    // The loader's cap, before the models allocate one sample per step.
+    if let Err(m) = pushval_scenario::check_sample_count(sc.problem().duration(), sc.sample_dt) {
+        bail!(
+            "{}: column t: its first two rows set the sample interval: {m}",
+            file.display()
+        );
     }
     // The dynamic model and the scenario's gated engines.
     sc.models = std::iter::once("dynamic".to_string())

@@ -54,7 +54,9 @@
 //!  "covariance": [[...], ...],
 //!  "residual": {"position_rms": 0.001, "theta_rms": 0.001},
 //!  "converged": true,
-//!  "unidentifiable": ["inertia_cm", ...]}
+//!  "unidentifiable": ["inertia_cm", ...],
+//!  "lack_of_fit": {"test": "...", "statistic": 2987.1, "dof": 3003,
+//!                  "p_value": 0.58, "alpha": 0.001, "verdict": "fits"}}
 //! ```
 //!
 //! Units: `mu_scale` 1, `inertia_cm` kg m², `center_of_friction` m (the
@@ -248,6 +250,59 @@ pub struct Fit {
     pub fisher: Fisher,
     /// Parameters with an unidentifiable component.
     pub unidentifiable: Vec<Param>,
+    /// The χ² test of the residuals against the stated noise.
+    pub lack_of_fit: LackOfFit,
+}
+
+/// Significance below which the residuals reject the model: 1e-3, so a
+/// right model with the stated noise is called wrong once in a thousand
+/// fits (a CI gate must rarely cry wolf), while a model off by more than
+/// the noise (s² a few per cent above 1 on a few thousand residuals) is
+/// still caught.
+pub const LACK_OF_FIT_ALPHA: f64 = 1e-3;
+
+/// Whether the model explains the data: the whitened residual sum of
+/// squares `χ² = |r|²` (residuals divided by the stated σ) against the χ²
+/// distribution with `3K − n` degrees of freedom it follows when the model
+/// is right and the noise is Gaussian at the stated σ. Only the upper tail
+/// rejects: a fit better than the noise (a noiseless trajectory) is not a
+/// lack of fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LackOfFit {
+    /// χ² = |r|² (whitened).
+    pub statistic: f64,
+    /// Degrees of freedom, 3K − n.
+    pub dof: usize,
+    /// P(χ²_dof ≥ statistic).
+    pub p_value: f64,
+    /// True when `p_value < LACK_OF_FIT_ALPHA`.
+    pub rejected: bool,
+}
+
+impl LackOfFit {
+    /// The test for a whitened residual sum of squares with `dof` degrees
+    /// of freedom.
+    pub fn new(statistic: f64, dof: usize) -> Self {
+        use statrs::distribution::{ChiSquared, ContinuousCDF};
+        let p_value = ChiSquared::new(dof.max(1) as f64)
+            .map(|d| d.sf(statistic))
+            .unwrap_or(f64::NAN);
+        Self {
+            statistic,
+            dof,
+            p_value,
+            rejected: !(p_value >= LACK_OF_FIT_ALPHA),
+        }
+    }
+
+    /// `"fits"` or `"lack of fit"`.
+    pub fn verdict(&self) -> &'static str {
+        if self.rejected {
+            "lack of fit"
+        } else {
+            "fits"
+        }
+    }
 }
 
 impl Fit {
@@ -300,6 +355,14 @@ impl Fit {
             "residual": {"position_rms": num(self.position_rms), "theta_rms": num(self.theta_rms)},
             "converged": self.converged,
             "unidentifiable": self.unidentifiable.iter().map(|p| p.name()).collect::<Vec<_>>(),
+            "lack_of_fit": {
+                "test": "chi-squared: whitened residual sum of squares against chi2(3K - n)",
+                "statistic": num(self.lack_of_fit.statistic),
+                "dof": self.lack_of_fit.dof,
+                "p_value": num(self.lack_of_fit.p_value),
+                "alpha": LACK_OF_FIT_ALPHA,
+                "verdict": self.lack_of_fit.verdict(),
+            },
         })
     }
 }
@@ -416,6 +479,7 @@ fn summarise(
         evaluations,
         fisher,
         unidentifiable,
+        lack_of_fit: LackOfFit::new(r.norm_squared(), dof),
     })
 }
 
@@ -464,7 +528,7 @@ pub struct Request {
 }
 
 /// `pushval fit`: exit 0 converged and every parameter identifiable, 1 not
-/// converged or a parameter unidentifiable (named on stderr), Err (exit 2)
+/// converged, a parameter unidentifiable or a lack of fit (named on stderr), Err (exit 2)
 /// on bad input, with nothing written.
 pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
     let sc = crate::registry::load(&req.scenario)?;
@@ -521,6 +585,22 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
             "FAIL {}: unidentifiable from this trajectory: {}",
             sc.name,
             names_of(&fit.unidentifiable)
+        );
+        code = ExitCode::from(1);
+    }
+    let l = &fit.lack_of_fit;
+    if l.rejected {
+        eprintln!(
+            "FAIL {}: lack of fit: the model cannot explain this trajectory: residual RMS {:.3e} m, {:.3e} rad against the stated sigma {:.1e} m, {:.1e} rad (s^2 = {:.3e}); chi-squared {:.4e} on {} degrees of freedom, p = {:.2e} < {LACK_OF_FIT_ALPHA:e}",
+            sc.name,
+            fit.position_rms,
+            fit.theta_rms,
+            req.settings.sigma_position,
+            req.settings.sigma_theta,
+            fit.residual_variance,
+            l.statistic,
+            l.dof,
+            l.p_value
         );
         code = ExitCode::from(1);
     }

@@ -51,6 +51,16 @@ pub enum DtSource {
     Automatic,
 }
 
+impl DtSource {
+    /// `"scenario"` or `"automatic"`, as summary.json writes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DtSource::Scenario => "scenario",
+            DtSource::Automatic => "automatic",
+        }
+    }
+}
+
 /// The engine's self-convergence error estimate at one time step h, from
 /// the runs at 2h and h alone (never against the model): Richardson's
 /// `|X(2h) − X(h)| / (2^p − 1)` for the scheme's order p, for each

@@ -435,6 +435,84 @@ pub fn compare_trajectory(
     }
 }
 
+/// The smallest model errors a gated row's tolerances would catch, from
+/// the model's sensitivities: each error is injected at ±[`CATCH_PROBE`]
+/// (relative) into the dynamic model ([`crate::power::inject`]), each gated
+/// figure's change divided by the probe is its sensitivity `|∂X/∂p|`, and
+/// `tolerance / |∂X/∂p|` is the error that moves that figure past its
+/// tolerance. Any figure failing fails the row, so the most sensitive
+/// figure decides. Linear: `pushval power` bisects the same question with
+/// the engine in the loop (results/gate_power.csv, column
+/// `linear_estimate`, compares the two).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Catches {
+    /// Smallest relative error in I_cm caught, and the figure that catches
+    /// it; None where no figure sees I_cm.
+    pub inertia_cm: Option<(f64, &'static str)>,
+    /// The same for every support's μ scaled together.
+    pub mu_all: Option<(f64, &'static str)>,
+}
+
+/// The relative probe of [`Catches`]: small enough to stay linear (the
+/// figures are smooth in the parameters except at a switch of sticking),
+/// large enough to sit far above the model's own error (about 1e-10 m).
+pub const CATCH_PROBE: f64 = 1e-4;
+
+impl Catches {
+    /// The record in summary.json.
+    pub fn json(&self) -> serde_json::Value {
+        let one = |c: &Option<(f64, &str)>| match c {
+            Some((m, by)) => serde_json::json!({"relative": crate::output::num(*m), "figure": by}),
+            None => serde_json::Value::Null,
+        };
+        serde_json::json!({
+            "method": format!("linear: tolerance / |dX/dp| per gated figure, the smallest deciding; probe ±{CATCH_PROBE} relative"),
+            "inertia_cm": one(&self.inertia_cm),
+            "mu_all": one(&self.mu_all),
+        })
+    }
+}
+
+/// [`Catches`] for tolerances `tol` on a scenario whose dynamic-model
+/// trajectory is `reference`.
+pub fn catchable(
+    sc: &Scenario,
+    segments: &[SegmentInfo],
+    reference: &Trajectory,
+    tol: &Figures,
+) -> Catches {
+    use crate::power::{inject, ErrorKind};
+    let one = |kind: ErrorKind| -> Option<(f64, &'static str)> {
+        // Mean of |ΔX| over the two signs, per figure.
+        let mut sens = [0.0f64; 3];
+        for sign in [1.0, -1.0] {
+            let tr = inject(sc, kind, sign * CATCH_PROBE)?;
+            let c = compare_trajectory(
+                sc,
+                segments,
+                reference,
+                "probe",
+                &tr,
+                SteadyRead::SegmentEnd,
+                None,
+            );
+            sens[0] += 0.5 * c.position_max / CATCH_PROBE;
+            sens[1] += 0.5 * c.theta_max / CATCH_PROBE;
+            sens[2] += 0.5 * c.omega_steady_rel_max.unwrap_or(0.0) / CATCH_PROBE;
+        }
+        let tols = [tol.position_max, tol.theta_max, tol.omega_steady_rel];
+        let names = ["position_max", "theta_max", "omega_steady_rel"];
+        (0..3)
+            .filter(|&i| sens[i] > 0.0 && sens[i].is_finite())
+            .map(|i| (tols[i] / sens[i], names[i]))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    };
+    Catches {
+        inertia_cm: one(ErrorKind::InertiaCm),
+        mu_all: one(ErrorKind::MuAll),
+    }
+}
+
 /// Runs every model the scenario asks for (the dynamic model always, as the
 /// reference) and compares each with the dynamic model. The engines named in
 /// `[run] gate` are gated by the scenario's `[tolerance]` at the time step
@@ -534,7 +612,11 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
         gated_runs
             .iter()
             .find(|g| g.0.name() == name)
-            .map(|(_, choice, _)| tolerance::resolve(sc, choice.rungs.last(), model_error))
+            .map(|(_, choice, _)| {
+                let mut r = tolerance::resolve(sc, choice.rungs.last(), model_error);
+                r.dt = Some((choice.dt, choice.source, choice.met));
+                r
+            })
     };
     let mut comparisons: Vec<Comparison> = runs
         .iter()
@@ -562,6 +644,17 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             done,
         )?;
         for c in comparisons.iter_mut().filter(|c| c.model == engine.name()) {
+            if let Some(res) = c.tolerance.as_mut() {
+                if let Some(p) = tolerance::order_problem(res, &conv) {
+                    res.problems.push(p);
+                }
+                res.catches = Some(catchable(sc, &segments, &reference, &res.value));
+                // A gate that cannot stand on its tolerances fails, saying why.
+                if !res.problems.is_empty() {
+                    c.failed.extend(res.problems.iter().cloned());
+                    c.pass = Some(false);
+                }
+            }
             c.convergence = Some(conv.clone());
         }
     }

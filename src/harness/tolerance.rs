@@ -68,6 +68,19 @@ pub struct Resolved {
     pub engine_estimate: Option<Figures>,
     /// The dynamic model's own error estimate.
     pub model_error: Figures,
+    /// The ceiling no auto figure may pass (`[tolerance] auto_ceiling`).
+    pub ceiling: Figures,
+    /// Why the gate cannot stand on its auto tolerances (the engine's
+    /// accuracy at its dt misses the ceiling, or its observed order strays
+    /// from the declared one): each a sentence; any makes the row FAIL.
+    pub problems: Vec<String>,
+    /// The smallest relative errors in I_cm and in every μ the tolerances
+    /// would catch (linear estimate from the model's sensitivities); None
+    /// until [`super::catchable`] fills it.
+    pub catches: Option<super::Catches>,
+    /// The gated engine's time step (s), where it came from and whether the
+    /// ladder's estimate met its targets there; None outside `validate`.
+    pub dt: Option<(f64, super::DtSource, bool)>,
 }
 
 impl Resolved {
@@ -90,9 +103,15 @@ impl Resolved {
                 "theta_max": self.source[1].as_str(),
                 "omega_steady_rel": self.source[2].as_str(),
             },
-            "rule": format!("auto = {AUTO_FACTOR} x max(engine self-convergence estimate at its dt, target) + model error"),
+            "rule": format!("auto = {AUTO_FACTOR} x max(engine self-convergence estimate at its dt, target) + model error; never above auto_ceiling (the row fails instead)"),
             "engine_estimate": self.engine_estimate.as_ref().map_or(serde_json::Value::Null, f),
             "model_error": f(&self.model_error),
+            "auto_ceiling": f(&self.ceiling),
+            "problems": self.problems,
+            "catches": self.catches.as_ref().map_or(serde_json::Value::Null, |c| c.json()),
+            "dt": self.dt.map_or(serde_json::Value::Null, |d| num(d.0)),
+            "dt_source": self.dt.map_or(serde_json::Value::Null, |d| d.1.as_str().into()),
+            "ladder_met": self.dt.map(|d| d.2),
         })
     }
 }
@@ -125,30 +144,66 @@ pub fn resolve(sc: &Scenario, estimate: Option<&DtEstimate>, model_error: Figure
         theta_max: e.theta_max,
         omega_steady_rel: e.omega_steady_rel_max.unwrap_or(0.0),
     });
+    let c = sc.tolerance.auto_ceiling;
+    let ceiling = Figures {
+        position_max: c[0],
+        theta_max: c[1],
+        omega_steady_rel: c[2],
+    };
     let auto = |e: Option<f64>, target: f64, model: f64| {
         AUTO_FACTOR * e.unwrap_or(target).max(target) + model
     };
-    let pick = |l: Limit, e: Option<f64>, target: f64, model: f64| match l {
-        Limit::Value(v) => (v, Source::Scenario),
-        Limit::Auto => (auto(e, target, model), Source::Auto),
+    let mut problems = Vec::new();
+    let dt = estimate.map_or(String::new(), |e| format!(" at dt = {:.4e} s", e.dt));
+    let mut pick = |l: Limit,
+                    e: Option<f64>,
+                    target: f64,
+                    model: f64,
+                    cap: f64,
+                    key: &str,
+                    unit: &str| {
+        match l {
+            Limit::Value(v) => (v, Source::Scenario),
+            Limit::Auto => {
+                let a = auto(e, target, model);
+                if a > cap {
+                    problems.push(format!(
+                            "the engine cannot back an auto {key}{dt}: {AUTO_FACTOR} x its self-convergence estimate {:.2e} {unit} + model error {model:.2e} = {a:.2e} {unit} is above the auto ceiling {cap:.2e} {unit}; set a finer [engine] dt, or write the number the gate should assert as [tolerance] {key}",
+                            e.unwrap_or(target)
+                        ));
+                    (cap, Source::Auto)
+                } else {
+                    (a, Source::Auto)
+                }
+            }
+        }
     };
     let (p, sp) = pick(
         l[0],
         est.map(|e| e.position_max),
         AUTO_TARGET.position_max,
         model_error.position_max,
+        ceiling.position_max,
+        "position_max",
+        "m",
     );
     let (t, st) = pick(
         l[1],
         est.map(|e| e.theta_max),
         AUTO_TARGET.theta_max,
         model_error.theta_max,
+        ceiling.theta_max,
+        "theta_max",
+        "rad",
     );
     let (w, sw) = pick(
         l[2],
         est.map(|e| e.omega_steady_rel),
         AUTO_TARGET.omega_steady_rel,
         model_error.omega_steady_rel,
+        ceiling.omega_steady_rel,
+        "omega_steady_rel",
+        "(relative)",
     );
     Resolved {
         value: Figures {
@@ -159,7 +214,36 @@ pub fn resolve(sc: &Scenario, estimate: Option<&DtEstimate>, model_error: Figure
         source: [sp, st, sw],
         engine_estimate: est,
         model_error,
+        ceiling,
+        problems,
+        catches: None,
+        dt: None,
     }
+}
+
+/// How far an engine's observed order in dt may stray from the order it
+/// declares before its auto tolerances are refused: the Richardson estimate
+/// behind them divides by `2^p − 1` with the declared p, so an engine
+/// converging at p − 0.5 has its error underestimated by up to 40 % per
+/// halving, and one not converging at all not estimated.
+pub const ORDER_BAND: f64 = 0.5;
+
+/// The sentence that refuses auto tolerances when the observed order
+/// (median over the settled segments, runs at 4h, 2h, h) strays from the
+/// declared one by more than [`ORDER_BAND`]; None when it does not, or when
+/// no figure is auto, or no segment settles.
+pub fn order_problem(res: &Resolved, conv: &super::Convergence) -> Option<String> {
+    if !res.source.contains(&Source::Auto) {
+        return None;
+    }
+    let observed = conv.order()?;
+    let declared = conv.expected_order;
+    (!((observed - declared).abs() <= ORDER_BAND)).then(|| {
+        format!(
+            "the engine's observed order in dt is {observed:.2} (steady omega at dt {:.3e}, {:.3e}, {:.3e} s), not the declared {declared} within {ORDER_BAND}: its self-convergence estimate cannot back an auto tolerance; write the numbers the gate should assert in [tolerance], or fix the engine's declared order",
+            conv.dts[0], conv.dts[1], conv.dts[2]
+        )
+    })
 }
 
 /// The dynamic model's own error, bounded by its distance from a run at a

@@ -252,6 +252,23 @@ fn time_shifted(sc: &Scenario, delay: f64) -> Trajectory {
     reference
 }
 
+/// A gate that refuses its auto tolerances (the engine's accuracy misses
+/// the ceiling, or its order strays): `validate` fails it as it stands.
+#[derive(Debug)]
+pub struct Refused(pub String);
+
+impl std::fmt::Display for Refused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the gate refuses its auto tolerances: {}", self.0)
+    }
+}
+
+impl std::error::Error for Refused {}
+
+fn refused(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<Refused>().is_some()
+}
+
 /// One gate as `validate` runs it: the true model, the engine's run and the
 /// tolerances it is held to.
 pub struct Gate {
@@ -279,6 +296,9 @@ impl Gate {
             .iter()
             .find(|c| &c.model == name)
             .context("the gated engine ran")?;
+        if let Some(t) = c.tolerance.as_ref().filter(|t| !t.problems.is_empty()) {
+            return Err(Refused(t.problems.join("; ")).into());
+        }
         anyhow::ensure!(
             c.pass == Some(true),
             "{}: the gate fails without any injected error: {:?}",
@@ -402,6 +422,9 @@ pub struct Row {
     pub dt: f64,
     /// Wall time of the gate (the engine runs, the ladder, the comparison) (s).
     pub gate_seconds: f64,
+    /// The linear estimate `validate` prints for the same kind
+    /// ([`crate::harness::Catches`]; I_cm and every μ only).
+    pub linear: Option<f64>,
 }
 
 impl Row {
@@ -467,7 +490,16 @@ pub fn measure(scenarios: &[Scenario], extra: &[&str], iters: usize) -> anyhow::
             v.models = std::iter::once("dynamic".to_string())
                 .chain(v.gate.iter().cloned())
                 .collect();
-            let gate = Gate::new(&v)?;
+            // A gate whose engine cannot back its auto tolerances (the
+            // ceiling, the order) refuses to run at all: nothing to measure.
+            let gate = match Gate::new(&v) {
+                Ok(g) => g,
+                Err(e) if refused(&e) => {
+                    eprintln!("pushval power: {} / {label}: skipped: {e:#}", sc.name);
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
             for kind in ErrorKind::ALL.into_iter().filter(|k| applies(sc, *k)) {
                 let (plus, minus) = (
                     gate.smallest(kind, 1.0, iters, &Gate::catches),
@@ -496,6 +528,11 @@ pub fn measure(scenarios: &[Scenario], extra: &[&str], iters: usize) -> anyhow::
                     tolerance: gate.tolerance.value,
                     dt: gate.dt,
                     gate_seconds: gate.seconds,
+                    linear: gate.tolerance.catches.as_ref().and_then(|c| match kind {
+                        ErrorKind::InertiaCm => c.inertia_cm.map(|x| x.0),
+                        ErrorKind::MuAll => c.mu_all.map(|x| x.0),
+                        _ => None,
+                    }),
                 });
             }
         }
@@ -516,7 +553,7 @@ pub fn applies(sc: &Scenario, kind: ErrorKind) -> bool {
 /// The CSV text.
 pub fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "scenario,engine,kind,unit,smallest_caught,smallest_caught_plus,smallest_caught_minus,smallest_caught_by_compare,at_search_floor,target,meets_target,tolerance_position_m,tolerance_theta_rad,tolerance_omega_rel,engine_dt_s,gate_wall_time_s\n",
+        "scenario,engine,kind,unit,smallest_caught,smallest_caught_plus,smallest_caught_minus,smallest_caught_by_compare,at_search_floor,target,meets_target,tolerance_position_m,tolerance_theta_rad,tolerance_omega_rel,engine_dt_s,gate_wall_time_s,linear_estimate\n",
     );
     for r in rows {
         let meets = match (r.kind.target(), r.both()) {
@@ -525,7 +562,7 @@ pub fn csv(rows: &[Row]) -> String {
             (None, _) => "".into(),
         };
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{:.3e},{:.3e},{:.3e},{:.4e},{:.3}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{:.3e},{:.3e},{:.3e},{:.4e},{:.3},{}\n",
             r.scenario,
             r.engine,
             r.kind.name(),
@@ -549,7 +586,8 @@ pub fn csv(rows: &[Row]) -> String {
             r.tolerance.theta_max,
             r.tolerance.omega_steady_rel,
             r.dt,
-            r.gate_seconds
+            r.gate_seconds,
+            r.linear.map_or(String::new(), |x| format!("{x:.3e}"))
         ));
     }
     s

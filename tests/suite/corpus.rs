@@ -238,6 +238,10 @@ const TOKENS: &[&str] = &[
     "9999999999999999999999",
     "uniform_grid = 1e-9",
     "load = \"uniform\"",
+    "gravity = 1e308",
+    "mass = 1e300",
+    "dt = 1e-300",
+    "auto_ceiling = [1e-3]",
 ];
 
 fn load_never_panics(text: &str) {

@@ -83,6 +83,13 @@ fn noisy_paper_trajectory_estimates_lie_within_two_sigma() {
             "seed {seed}: s² = {}",
             f.residual_variance
         );
+        // ... and the χ² test does not reject the right model (α = 1e-3,
+        // four seeds: a false alarm here has odds of 4 in 1000).
+        assert!(
+            !f.lack_of_fit.rejected,
+            "seed {seed}: p = {}",
+            f.lack_of_fit.p_value
+        );
         for (j, ((v, s), t)) in f.value.iter().zip(f.std()).zip(&truth).enumerate() {
             assert!(
                 s > 0.0 && s.is_finite(),
@@ -181,12 +188,14 @@ fn cli_recovers_scaled_mu_and_inertia_from_the_exact_paper_trajectory() {
         [
             "converged",
             "covariance",
+            "lack_of_fit",
             "parameters",
             "residual",
             "unidentifiable"
         ]
     );
     assert_eq!(j["covariance"].as_array().unwrap().len(), 2);
+    assert_eq!(j["lack_of_fit"]["verdict"], "fits");
     assert!(j["residual"]["position_rms"].as_f64().unwrap() < 1e-8);
     assert!(j["residual"]["theta_rms"].as_f64().unwrap() < 1e-8);
     // Only fit.json, no temporary file left behind.
@@ -508,4 +517,93 @@ fn fit_study_quick_writes_csv_svg_and_text() {
     assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"));
     let md = std::fs::read_to_string(dir.path().join("fit.md")).unwrap();
     assert!(md.contains("**Answer:"), "{md}");
+}
+
+/// Lack of fit: rapier2d's impulse-disk idiom is not Coulomb's law (its
+/// friction acts at the centre as one disc), so no μ scale and I_cm bring
+/// the model onto its trajectory: the fit converges, but the χ² test of its
+/// residuals against σ = 1 mm rejects it; exit 1 naming the residual, σ and
+/// the test, and fit.json's `lack_of_fit` says so. The same scene's own
+/// dynamic-model trajectory with 1 mm noise is not rejected.
+#[test]
+fn a_trajectory_the_model_cannot_explain_exits_1_naming_lack_of_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = root().join("scenarios/paper-square-v1.0.toml");
+    let text = std::fs::read_to_string(&scenario).unwrap().replace(
+        "[run]",
+        "[run]\nmodels = [\"dynamic\", \"rapier2d_impulse_disk\"]",
+    );
+    let sc_path = dir.path().join("disk.toml");
+    std::fs::write(&sc_path, text).unwrap();
+    let run_dir = dir.path().join("run");
+    let st = pushval()
+        .arg("run")
+        .arg(&sc_path)
+        .arg("--out")
+        .arg(&run_dir)
+        .output()
+        .unwrap();
+    assert!(st.status.code().is_some_and(|c| c <= 1), "{st:?}");
+    let out = dir.path().join("fit");
+    let st = fit_cli(
+        &scenario,
+        &run_dir.join("trajectory.csv"),
+        "mu_scale,inertia_cm",
+        &out,
+        &["--model", "rapier2d_impulse_disk"],
+    );
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(st.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("lack of fit") && err.contains("sigma") && err.contains("chi-squared"),
+        "{err}"
+    );
+    let j = read_json(&out.join("fit.json"));
+    assert_eq!(j["converged"], true);
+    assert_eq!(j["lack_of_fit"]["verdict"], "lack of fit");
+    assert!(j["lack_of_fit"]["p_value"].as_f64().unwrap() < 1e-3);
+    // The model's own trajectory with the stated noise passes the test.
+    let sc = paper();
+    let data = noise::add_noise(&exact(&sc), 1e-3, 1e-3, 7);
+    let csv = dir.path().join("noisy.csv");
+    write_csv(&csv, &[("noisy", &data)]);
+    let out = dir.path().join("fit2");
+    let st = fit_cli(&scenario, &csv, "mu_scale,inertia_cm", &out, &[]);
+    assert_eq!(
+        st.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    assert_eq!(
+        read_json(&out.join("fit.json"))["lack_of_fit"]["verdict"],
+        "fits"
+    );
+}
+
+/// `compare` takes its sample interval from the CSV: a two-row file with
+/// Δt = 1e-9 s would mean 1e10 model samples; it is refused before anything
+/// is allocated, exit 2 naming the file and the column.
+#[test]
+fn compare_applies_the_sample_cap_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("tiny.csv");
+    std::fs::write(
+        &csv,
+        "model,t,x,y,theta,omega\nmine,0,0,0,0,0\nmine,1e-9,0,0,0,0\n",
+    )
+    .unwrap();
+    let st = pushval()
+        .arg("compare")
+        .arg(root().join("scenarios/paper-square-v1.0.toml"))
+        .arg("--trajectory")
+        .arg(&csv)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(st.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("tiny.csv: column t") && err.contains("more than 1e7 samples"),
+        "{err}"
+    );
 }

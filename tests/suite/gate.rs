@@ -128,6 +128,8 @@ fn engine_converges_at_its_order_and_extrapolates_to_the_root(
 #[rstest]
 fn engine_meets_steady_target(#[files("scenarios/*.toml")] path: PathBuf) {
     let mut sc = load(&path);
+    // rapier2d gated whatever the file gates (the Box2D scene gates Box2D).
+    sc.gate = vec!["rapier2d".into()];
     sc.engine.dt = Some(1e-3);
     let report = run_scenario(&sc, &RunOptions::default()).unwrap();
     let c = report
@@ -188,7 +190,11 @@ fn estimate(sc: &Scenario, settled: &[usize], h: f64) -> (f64, f64, f64) {
 fn automatic_dt_is_the_largest_rung_that_meets_its_criterion(
     #[files("scenarios/*.toml")] path: PathBuf,
 ) {
-    let sc = load(&path);
+    let mut sc = load(&path);
+    // rapier2d gated whatever the file gates (the Box2D scene gates Box2D,
+    // at numbers sized for Box2D: auto here, as everywhere else).
+    sc.gate = vec!["rapier2d".into()];
+    sc.tolerance = pushval_scenario::Tolerance::default();
     assert_eq!(sc.engine.dt, None, "shipped scenarios leave dt automatic");
     let report = run_scenario(&sc, &RunOptions::default()).unwrap();
     let run = report.runs.iter().find(|r| r.name == "rapier2d").unwrap();
@@ -207,7 +213,7 @@ fn automatic_dt_is_the_largest_rung_that_meets_its_criterion(
         .map(|s| s.index)
         .collect();
     // The ladder's targets: DT_FRACTION of a number in [tolerance], the auto
-    // target otherwise (every shipped scenario leaves them auto).
+    // target otherwise (auto here).
     let t = ladder_targets(&sc, DT_FRACTION);
     assert_eq!(t, AUTO_TARGET);
     let within = |(p, th, w): (f64, f64, f64), f: f64| {
@@ -355,4 +361,120 @@ fn friction_engines_are_informational_rows_with_their_findings() {
             );
         }
     }
+}
+
+/// Runs `pushval validate` on the paper scene with extra lines appended
+/// (an `[engine]` or `[tolerance]` table) and returns (exit code, stdout + stderr).
+fn validate_paper_with(extra: &str) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("scenarios/paper-square-v1.0.toml")).unwrap();
+    let path = dir.path().join("paper.toml");
+    std::fs::write(&path, format!("{text}\n{extra}\n")).unwrap();
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .arg("validate")
+        .arg(&path)
+        .output()
+        .unwrap();
+    let all = format!(
+        "{}{}",
+        String::from_utf8_lossy(&st.stdout),
+        String::from_utf8_lossy(&st.stderr)
+    );
+    (st.status.code(), all)
+}
+
+/// Gate soundness: at dt = 0.02 s rapier2d's own error (4.4 mm) is far above
+/// the 1 mm auto ceiling, so auto tolerances cannot stand: exit 1 with a
+/// sentence naming the ceiling and the remedy, never a wider tolerance.
+/// With numbers in the file for what dt 0.02 s can back (θ too: its
+/// estimate there is 2e-3 rad, above the 1 mrad ceiling), the gate passes.
+#[test]
+fn a_coarse_dt_cannot_loosen_an_auto_tolerance_but_a_stated_number_can() {
+    let (code, out) = validate_paper_with("[engine]\ndt = 0.02");
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.contains("above the auto ceiling 1.00e-3 m"), "{out}");
+    assert!(out.contains("set a finer [engine] dt"), "{out}");
+    assert!(out.contains("dt 2.000e-2 s (scenario"), "{out}");
+    let (code, out) = validate_paper_with(
+        "[engine]\ndt = 0.02\n[tolerance]\nposition_max = 0.02\ntheta_max = 0.02\nomega_steady_rel = 0.02",
+    );
+    assert_eq!(code, Some(0), "{out}");
+    // Only position stated: θ is still auto and still refused.
+    let (code, out) = validate_paper_with("[engine]\ndt = 0.02\n[tolerance]\nposition_max = 0.02");
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.contains("auto theta_max"), "{out}");
+    assert!(!out.contains("auto position_max"), "{out}");
+}
+
+/// A raised ceiling is honoured where the engine's order holds: at dt =
+/// 1/240 s rapier2d's leapfrog mode is in its asymptotic range, its auto
+/// tolerance (4 × estimate) is above a ceiling of 1e-6 and below 1e-3.
+#[test]
+fn auto_ceiling_moves_the_verdict_and_nothing_else() {
+    let dt = "[engine]\ndt = 0.004166666666666667";
+    let (code, out) = validate_paper_with(dt);
+    assert_eq!(code, Some(0), "{out}");
+    let (code, out) = validate_paper_with(&format!(
+        "{dt}\n[tolerance]\nauto_ceiling = [1e-6, 1e-6, 1e-6]"
+    ));
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.contains("above the auto ceiling 1.00e-6"), "{out}");
+}
+
+/// Every gated row of summary.json says the dt it ran at, where the dt came
+/// from, whether the ladder met its target, and which I_cm and μ errors its
+/// tolerances catch; the catch estimate is checked against the model
+/// itself: an I_cm error twice the estimate moves the named figure past its
+/// tolerance, half of it does not.
+#[test]
+fn gated_rows_say_their_dt_ladder_verdict_and_what_they_catch() {
+    let sc = load(&root().join("scenarios/paper-square-v1.0.toml"));
+    let r = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let summary = pushval::output::summary(&r);
+    let t = &summary["models"]["rapier2d"]["tolerance"];
+    assert!(t["dt"].as_f64().unwrap() > 0.0, "{t}");
+    assert_eq!(t["dt_source"], "automatic");
+    assert_eq!(t["ladder_met"], true);
+    let c = r
+        .comparisons
+        .iter()
+        .find(|c| c.model == "rapier2d")
+        .unwrap();
+    let res = c.tolerance.as_ref().unwrap();
+    let (m, figure) = res.catches.as_ref().unwrap().inertia_cm.unwrap();
+    assert_eq!(t["catches"]["inertia_cm"]["relative"].as_f64(), Some(m));
+    let tol = match figure {
+        "position_max" => res.value.position_max,
+        "theta_max" => res.value.theta_max,
+        _ => res.value.omega_steady_rel,
+    };
+    let reference = &r.dynamic().trajectory;
+    let figure_at = |scale: f64| {
+        let tr =
+            pushval::power::inject(&sc, pushval::power::ErrorKind::InertiaCm, scale * m).unwrap();
+        let cmp = pushval::harness::compare_trajectory(
+            &sc,
+            &r.segments,
+            reference,
+            "probe",
+            &tr,
+            pushval::harness::SteadyRead::SegmentEnd,
+            None,
+        );
+        match figure {
+            "position_max" => cmp.position_max,
+            "theta_max" => cmp.theta_max,
+            _ => cmp.omega_steady_rel_max.unwrap(),
+        }
+    };
+    assert!(
+        figure_at(2.0) > tol,
+        "{figure}: {} vs {tol}",
+        figure_at(2.0)
+    );
+    assert!(
+        figure_at(0.5) < tol,
+        "{figure}: {} vs {tol}",
+        figure_at(0.5)
+    );
 }

@@ -158,3 +158,28 @@ fn default_gate_meets_the_power_targets() {
         }
     }
 }
+
+/// The linear estimate `validate` prints (tolerance / |∂X/∂p|) against the
+/// bisection with the engine in the loop, on the paper scene: within a
+/// factor of 2 for I_cm and μ (the engine's own error, a fraction of the
+/// tolerance, moves the bisection's threshold by at most that share).
+#[test]
+fn the_linear_catch_estimate_agrees_with_the_bisection() {
+    let sc = load(&root().join("scenarios/paper-square-v1.0.toml"));
+    let rows = pushval::power::measure(&[sc], &[], 12).unwrap();
+    let mut seen = 0;
+    for r in rows.iter().filter(|r| {
+        matches!(r.kind, ErrorKind::InertiaCm | ErrorKind::MuAll)
+            && r.engine == "rapier2d[leapfrog]"
+    }) {
+        let (lin, bis) = (r.linear.unwrap(), r.both().unwrap());
+        let ratio = lin / bis;
+        assert!(
+            (0.5..=2.0).contains(&ratio),
+            "{:?}: linear {lin:e}, bisection {bis:e}",
+            r.kind
+        );
+        seen += 1;
+    }
+    assert_eq!(seen, 2);
+}

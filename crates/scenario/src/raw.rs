@@ -182,6 +182,8 @@ pub struct RawTolerance {
     pub position_max: Option<RawLimit>,
     /// rad, largest angle difference
     pub theta_max: Option<RawLimit>,
+    /// [m, rad, relative]: the most an `"auto"` figure may be
+    pub auto_ceiling: Option<Vec<f64>>,
 }
 
 /// A tolerance figure as written: a number, or a word (`"auto"`).

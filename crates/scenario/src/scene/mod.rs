@@ -22,9 +22,10 @@ use std::path::{Path, PathBuf};
 use pushval_engine::EngineOptions;
 use pushval_model::{Body, ContactLimits, Initial, Problem, Push, Support, Switching, Vec2};
 
-pub use run::{ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS};
+pub use engine::MAX_ENGINE_STEPS;
+pub use run::{check_sample_count, ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS, MAX_SAMPLES};
 pub use supports::SupportLoad;
-pub use tolerance::{Limit, Tolerance};
+pub use tolerance::{Limit, Tolerance, DEFAULT_AUTO_CEILING};
 
 use crate::raw::RawScenario;
 use crate::ScenarioError;
@@ -144,8 +145,8 @@ impl Scenario {
         let initial = schedule::initial(raw.initial, file)?;
         let run = run::from_raw(raw.run, &pushes, file)?;
         let tolerance = tolerance::from_raw(raw.tolerance, file)?;
-        let engine = engine::from_raw(raw.engine, file)?;
-        Ok(Self {
+        let engine = engine::from_raw(raw.engine, file, &pushes)?;
+        let sc = Self {
             name: raw.name,
             description: raw.description.unwrap_or_default(),
             path: file.to_path_buf(),
@@ -168,11 +169,28 @@ impl Scenario {
             gate: run.gate,
             tolerance,
             engine,
-        })
+        };
+        // The model's own checks, last: whatever the tables above let
+        // through that the model refuses is still bad input, named here.
+        if let Err(e) = sc.try_body() {
+            return Err(ScenarioError::new(
+                file,
+                "object",
+                format!("the scene is not a valid body for the model: {e}"),
+            ));
+        }
+        Ok(sc)
     }
 
     /// The body in the model frame (origin at the centre of mass).
     pub fn body(&self) -> Body {
+        self.try_body()
+            .expect("Scenario::from_raw checked that the body is valid")
+    }
+
+    /// [`Scenario::body`], or the model's reason to refuse it (for scenarios
+    /// changed after loading, e.g. by `pushval fit` or `power`).
+    pub fn try_body(&self) -> Result<Body, pushval_model::ModelError> {
         let supports: Vec<Support> = self
             .supports
             .iter()
@@ -187,7 +205,6 @@ impl Scenario {
             self.contact - self.center_of_mass,
             &supports,
         )
-        .expect("validated scenario gives a valid body")
     }
 
     /// The problem the models run.

@@ -29,6 +29,22 @@ pub(super) struct Run {
     pub(super) gate: Vec<String>,
 }
 
+/// Most samples one trajectory may have: 1e7 samples of four f64 each is a
+/// few hundred megabytes per model; anything denser is a typo.
+pub const MAX_SAMPLES: f64 = 1e7;
+
+/// Whether `sample_dt` (s) over `total` (s) stays within [`MAX_SAMPLES`];
+/// the sentence to report when not. Every reader of a trajectory (the
+/// loader, `compare`, `fit`) applies it before allocating.
+pub fn check_sample_count(total: f64, sample_dt: f64) -> Result<(), String> {
+    if !(total / sample_dt <= MAX_SAMPLES) {
+        return Err(format!(
+            "{sample_dt:e} s over {total} s gives more than {MAX_SAMPLES:e} samples"
+        ));
+    }
+    Ok(())
+}
+
 /// The run settings for the schedule `pushes`: a sample interval that gives
 /// at most 1e7 samples, a known switching rule, model and gate lists (names
 /// are checked against the engine registry by the command line).
@@ -41,11 +57,8 @@ pub(super) fn from_raw(
     let rr = raw.unwrap_or_default();
     let sample_dt = finite_pos(file, "run.sample_dt", rr.sample_dt.unwrap_or(0.01))?;
     let total: f64 = pushes.iter().map(|p| p.duration).sum();
-    if total / sample_dt > 1e7 {
-        return Err(err(
-            "run.sample_dt",
-            format!("{sample_dt} s over {total} s gives more than 1e7 samples"),
-        ));
+    if let Err(m) = check_sample_count(total, sample_dt) {
+        return Err(err("run.sample_dt", m));
     }
     let switching = match rr.switching.as_deref().unwrap_or("impulsive") {
         "impulsive" => Switching::Impulsive,

@@ -40,6 +40,18 @@ pub(super) fn from_raw(
 ) -> Result<Supports, ScenarioError> {
     let gravity = finite_pos(file, "supports.gravity", raw.gravity.unwrap_or(9.81))?;
     let weight = object.mass * gravity;
+    if !weight.is_finite() {
+        // Each factor is finite; their product is not: the model's forces
+        // (μ N, m a) would be infinite and every comparison NaN.
+        return Err(ScenarioError::new(
+            file,
+            "supports.gravity",
+            format!(
+                "object.mass × supports.gravity = {:e} kg × {gravity:e} m/s² overflows (the weight must be a finite number of newtons)",
+                object.mass
+            ),
+        ));
+    }
     let (positions, grid_weights) = positions(raw, object, file)?;
     let mu = friction(&raw.mu, positions.len(), file)?;
     check_tipping(&positions, object, file)?;
@@ -51,6 +63,20 @@ pub(super) fn from_raw(
         weight,
         file,
     )?;
+    if let Some(i) = loads
+        .iter()
+        .zip(&mu)
+        .position(|(l, m)| !(l * m).is_finite())
+    {
+        return Err(ScenarioError::new(
+            file,
+            "supports.mu",
+            format!(
+                "support {i}: μ × N = {:e} × {:e} N overflows (the friction force must be finite)",
+                mu[i], loads[i]
+            ),
+        ));
+    }
     if loads.iter().zip(&mu).all(|(l, m)| l * m == 0.0) {
         return Err(ScenarioError::new(
             file,

@@ -31,7 +31,7 @@ impl Limit {
 
 /// `[tolerance]`: what `validate` asserts between a gated engine and the
 /// dynamic model.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerance {
     /// Relative error of the steady ω per settled segment.
     pub omega_steady_rel: Limit,
@@ -39,7 +39,29 @@ pub struct Tolerance {
     pub position_max: Limit,
     /// Largest angle difference (rad).
     pub theta_max: Limit,
+    /// The most an `"auto"` figure may be, `[position (m), theta (rad),
+    /// steady ω (relative)]` (`[tolerance] auto_ceiling`; default
+    /// [`DEFAULT_AUTO_CEILING`]). An engine whose own accuracy cannot back
+    /// an auto figure below it fails the gate; the tolerance never widens
+    /// past it.
+    pub auto_ceiling: [f64; 3],
 }
+
+impl Default for Tolerance {
+    fn default() -> Self {
+        Self {
+            omega_steady_rel: Limit::Auto,
+            position_max: Limit::Auto,
+            theta_max: Limit::Auto,
+            auto_ceiling: DEFAULT_AUTO_CEILING,
+        }
+    }
+}
+
+/// `[tolerance] auto_ceiling` when absent: 1 mm, 1 mrad, 0.1 % of steady ω.
+/// At these a 1 % error in I_cm or μ still moves the shipped paper pushes
+/// past the tolerance (results/gate_power.csv has the figures per scene).
+pub const DEFAULT_AUTO_CEILING: [f64; 3] = [1e-3, 1e-3, 1e-3];
 
 /// Each figure a finite number > 0 or `"auto"`; absent: `"auto"`.
 pub(super) fn from_raw(raw: Option<RawTolerance>, file: &Path) -> Result<Tolerance, ScenarioError> {
@@ -54,7 +76,26 @@ pub(super) fn from_raw(raw: Option<RawTolerance>, file: &Path) -> Result<Toleran
             format!("must be a finite number > 0 or \"auto\", got \"{w}\""),
         )),
     };
+    let auto_ceiling = match rt.auto_ceiling {
+        None => DEFAULT_AUTO_CEILING,
+        Some(v) if v.len() == 3 => [
+            finite_pos(file, "tolerance.auto_ceiling[0]", v[0])?,
+            finite_pos(file, "tolerance.auto_ceiling[1]", v[1])?,
+            finite_pos(file, "tolerance.auto_ceiling[2]", v[2])?,
+        ],
+        Some(v) => {
+            return Err(ScenarioError::new(
+                file,
+                "tolerance.auto_ceiling",
+                format!(
+                    "must be [position m, theta rad, steady omega relative], 3 numbers; got {}",
+                    v.len()
+                ),
+            ))
+        }
+    };
     Ok(Tolerance {
+        auto_ceiling,
         omega_steady_rel: limit("tolerance.omega_steady_rel", rt.omega_steady_rel)?,
         position_max: limit("tolerance.position_max", rt.position_max)?,
         theta_max: limit("tolerance.theta_max", rt.theta_max)?,
