@@ -463,6 +463,12 @@ fn variants(sc: &Scenario, extra: &[&str]) -> Vec<(String, Scenario)> {
         body.engine
             .values
             .insert("friction_velocity".into(), serde_json::json!("body"));
+        // First order: at the ladder's floor its self-convergence estimate
+        // is a few mm on the 1 m/s scenes, so `validate` refuses auto
+        // tolerances for it (the 1e-3 ceiling). Measured here as a gate
+        // that states the uncapped auto rule's numbers, for the comparison
+        // with leapfrog; its tolerance columns show how loose that is.
+        body.tolerance.auto_ceiling = [f64::MAX; 3];
         out.push((label(&body, "rapier2d"), body));
     }
     for name in extra {

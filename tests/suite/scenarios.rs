@@ -45,7 +45,8 @@ fn scenario_runs_and_writes_contract_outputs(#[files("scenarios/*.toml")] path: 
     }
     // The engine's time step and where it came from (the choice's reason
     // included) are part of its settings.
-    let engine = &summary["models"]["rapier2d"]["settings"];
+    let gated = sc.gate.first().map_or("rapier2d", String::as_str);
+    let engine = &summary["models"][gated]["settings"];
     assert!(engine["dt"].as_f64().is_some_and(|dt| dt > 0.0));
     assert!(["automatic", "scenario"].contains(&engine["dt_source"].as_str().unwrap()));
     assert!(engine["dt_choice"]["reason"]
