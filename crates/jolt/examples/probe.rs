@@ -17,8 +17,8 @@ fn main() {
     let phi: f64 = args.get(1).map_or(std::f64::consts::FRAC_PI_4 + 0.3, |s| s.parse().unwrap());
     let dt: f64 = args.get(2).map_or(1e-3, |s| s.parse().unwrap());
     let vs: u32 = args.get(3).map_or(10, |s| s.parse().unwrap());
-    for scene in Scene::ALL {
-        for v in [0.2, 0.5, 1.0] {
+    for scene in [Scene::Feet] {
+        for v in [0.5] {
             let p = Problem {
                 body: plate(),
                 limits: Default::default(),
@@ -40,6 +40,19 @@ fn main() {
                 scene, r.segment_tail_omega[0], r.segment_tail_omega_std[0], wl, wi,
                 r.rest_loads.iter().map(|x| (x*1e4).round()/1e4).collect::<Vec<_>>(), r.manifold_sizes,
                 r.segment_tail_max_angle[0], r.segment_tail_max_angle_vs_law[0], r.max_tilt, r.max_lift, r.max_joint_drift);
+            if std::env::var_os("SERIES").is_some() {
+                let l = law(Direction::EffectiveMass);
+                for k in 1..=16 {
+                    let t = 0.25 * k as f64;
+                    let w = predict::tail_omega(&l, &p.body, &push, t / 0.8 * 0.0 + t, (0.0, 0.0), 1e-4);
+                    let _ = w;
+                    let i = (t / dt).round() as usize;
+                    let hrec = &r.history[i];
+                    println!("  t={t} engine w={:.4} th={:.4}", hrec.omega, hrec.theta);
+                }
+                let (th, w) = predict::integrate(&l, &p.body, &push, 4.0, (0.0, 0.0), 1e-4, 0.25);
+                println!("  law: {:?}", th.iter().zip(&w).map(|(a,b)| format!("{:.4}/{:.4}", b, a)).collect::<Vec<_>>());
+            }
             let c = &r.segment_tail_contacts[0];
             for (i, x) in c.iter().enumerate() {
                 println!("   sup {i}: N={:.4} F=({:.4},{:.4}) |F|/N={:.4} twist={:.4} slip=({:.4},{:.4})", x.normal, x.friction[0], x.friction[1], (x.friction[0].hypot(x.friction[1]))/x.normal, x.twist, x.slip[0], x.slip[1]);

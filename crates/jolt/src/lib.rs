@@ -222,6 +222,10 @@ pub struct JoltRun {
     /// manifold's measured friction–slip angle and the angle of
     /// [`predict::Direction::EffectiveMass`] for the same slip and point.
     pub segment_tail_max_angle_vs_law: Vec<f64>,
+    /// Per segment, each support's smallest and largest normal force (N)
+    /// over the tail: four rigid feet leave the split undetermined, and
+    /// Jolt's solver moves along it while the plate slides.
+    pub segment_tail_load_range: Vec<Vec<[f64; 2]>>,
     /// Largest tilt (rad) over the push.
     pub max_tilt: f64,
     /// Largest vertical displacement of the centre of mass from its height

@@ -317,6 +317,39 @@ pub fn tail_omega(
     acc / cnt as f64
 }
 
+/// The reduced dynamics of [`tail_omega`], sampled every `every` s:
+/// `(θ, ω)` at each sample (rad, rad/s).
+pub fn integrate(
+    law: &Law,
+    body: &Body,
+    push: &Push,
+    duration: f64,
+    (theta0, omega0): (f64, f64),
+    h: f64,
+    every: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let n = (duration / h).ceil().max(1.0) as usize;
+    let h = duration / n as f64;
+    let stride = ((every / h).round() as usize).max(1);
+    let ip = body.inertia_contact();
+    let t_cap = law.twist_cap();
+    let (mut theta, mut omega) = (theta0, omega0);
+    let (mut ths, mut ws) = (Vec::new(), Vec::new());
+    for k in 0..n {
+        let g = linear_moment(law, body, push, omega, theta + 0.5 * h * omega);
+        let free = omega + h * g / ip;
+        let twist = (-free * ip / h).clamp(-t_cap, t_cap);
+        let next = free + h * twist / ip;
+        theta += 0.5 * h * (omega + next);
+        omega = next;
+        if (k + 1) % stride == 0 {
+            ths.push(theta);
+            ws.push(omega);
+        }
+    }
+    (ths, ws)
+}
+
 /// The steady ω (rad/s) a yaw-independent law reaches from ω = 0 at yaw 0:
 /// 0 when [`at_rest`] says locked, otherwise the first root of
 /// `G(ω, 0)` marching from 0 in the direction of `G(0±)` and bisecting

@@ -365,6 +365,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
     let mut tail_contacts = Vec::new();
     let mut tail_angle = Vec::new();
     let mut tail_angle_law = Vec::new();
+    let mut tail_load_range = Vec::new();
     let mut t_seg = 0.0;
     for (j, push) in problem.pushes.iter().enumerate() {
         let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
@@ -374,6 +375,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         let mut acc_c = vec![SupportContact::default(); n_sup];
         let mut max_angle = 0.0f64;
         let mut max_angle_vs_law = 0.0f64;
+        let mut load_range = vec![[f64::INFINITY, f64::NEG_INFINITY]; n_sup];
         let vc = push.velocity();
         for k in 0..n {
             let t0 = t_seg + k as f64 * h;
@@ -407,6 +409,10 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
                 acc_w2 += w * w * h;
                 acc_t += h;
                 let c = contacts(&world, (mass, iz), &st, &targets, h)?;
+                for (r, x) in load_range.iter_mut().zip(&c.supports) {
+                    r[0] = r[0].min(x.normal);
+                    r[1] = r[1].max(x.normal);
+                }
                 for &(a, l) in &c.angles {
                     max_angle = max_angle.max(a.abs());
                     max_angle_vs_law = max_angle_vs_law.max((a - l).abs());
@@ -446,6 +452,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         );
         tail_angle.push(max_angle);
         tail_angle_law.push(max_angle_vs_law);
+        tail_load_range.push(load_range);
         t_seg += push.duration;
     }
     let (samples, segments) = pushval_engine::resample(problem, &history);
@@ -472,6 +479,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         segment_tail_contacts: tail_contacts,
         segment_tail_max_angle: tail_angle,
         segment_tail_max_angle_vs_law: tail_angle_law,
+        segment_tail_load_range: tail_load_range,
         max_tilt,
         max_lift,
         max_joint_drift: max_drift,
