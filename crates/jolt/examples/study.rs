@@ -133,6 +133,28 @@ struct Cell {
     angle_vs_law: f64,
     load_min: f64,
     load_max: f64,
+    band: (f64, f64),
+}
+
+/// The law's ω over the loads four rigid feet (or corners) allow with the
+/// centre of mass at the centre: `N₀ = N₂ = a`, `N₁ = N₃ = W/2 − a`, for
+/// a in 0, W/16, …, W/2: `(min, max)` of the tail means.
+fn band(scene: Scene, p: &Problem, mu: f64, t: f64) -> (f64, f64) {
+    let w = MASS * G;
+    let push = p.pushes[0];
+    (0..=8)
+        .map(|k| {
+            let a = 0.5 * w * k as f64 / 8.0;
+            let caps = [mu * a, mu * (0.5 * w - a), mu * a, mu * (0.5 * w - a)];
+            let l = match scene {
+                Scene::Box => Law::jolt_box(&p.body, Some(&caps), Direction::EffectiveMass),
+                Scene::Feet => Law::jolt_feet(&p.body, Some(&caps), Direction::EffectiveMass),
+            };
+            predict::tail_omega(&l, &p.body, &push, t, (0.0, 0.0), LAW_H)
+        })
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        })
 }
 
 fn main() {
@@ -159,7 +181,14 @@ fn main() {
             let r = run(scene, &p, 1e-3, 10);
             let (wl, _) = predict_cell(scene, &p, &r, T_RUN);
             let wc = coulomb_star(&p.body, &p.pushes[0]);
-            writeln!(table, "{v},{},{},{}", f(r.segment_tail_omega[0]), f(wc), f(wl)).unwrap();
+            writeln!(
+                table,
+                "{v},{},{},{}",
+                f(r.segment_tail_omega[0]),
+                f(wc),
+                f(wl)
+            )
+            .unwrap();
             table_rows.push((v, r.segment_tail_omega[0], wc, wl, r));
         }
         write(&dir.join("paper_plate.csv"), &table);
@@ -184,12 +213,13 @@ fn main() {
                     angle_vs_law: r.segment_tail_max_angle_vs_law[0],
                     load_min: range.iter().map(|x| x[0]).fold(f64::INFINITY, f64::min),
                     load_max: range.iter().map(|x| x[1]).fold(0.0, f64::max),
+                    band: band(scene, &p, r.mu, T_MAP),
                 });
             }
         }
         let mut map = String::from("froude,phi,omega_engine,omega_coulomb,omega_law,class\n");
         let mut diag = String::from(
-            "froude,phi,speed,omega_engine,omega_law,max_friction_slip_angle,max_angle_vs_law,min_load,max_load\n",
+            "froude,phi,speed,omega_engine,omega_law,max_friction_slip_angle,max_angle_vs_law,min_load,max_load,omega_law_band_min,omega_law_band_max\n",
         );
         for c in &cells {
             writeln!(
@@ -205,7 +235,7 @@ fn main() {
             .unwrap();
             writeln!(
                 diag,
-                "{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{}",
                 c.fr,
                 f(c.phi),
                 f(c.speed),
@@ -214,7 +244,9 @@ fn main() {
                 f(c.angle),
                 f(c.angle_vs_law),
                 f(c.load_min),
-                f(c.load_max)
+                f(c.load_max),
+                f(c.band.0),
+                f(c.band.1)
             )
             .unwrap();
         }
@@ -269,17 +301,25 @@ fn readme(scene: Scene, dir: &Path) -> String {
     let loads = read("loads.csv");
     let n = map.len();
     let (mut law_ok, mut coul_ok, mut locked, mut turns, mut still) = (0, 0, 0, 0, 0);
+    let mut in_band = 0;
     for (row, d) in map.iter().zip(&diag) {
         let (we, wc, wl) = (num(&row[2]), num(&row[3]), num(&row[4]));
         let v = num(&d[2]);
         law_ok += within(we, wl, v) as usize;
+        let (lo, hi) = (num(&d[9]), num(&d[10]));
+        let slack = TOL * we.abs().max(1e-3 * v / length());
+        in_band += (we >= lo - slack && we <= hi + slack) as usize;
         coul_ok += within(we, wc, v) as usize;
         locked += (row[5] == "locked") as usize;
         turns += (row[5] == "turns") as usize;
         still += (we.abs() < 1e-3 * wc.abs().max(1e-9)) as usize;
     }
     let max_col = |col: usize| diag.iter().map(|d| num(&d[col])).fold(0.0, f64::max);
-    let min_col = |col: usize| diag.iter().map(|d| num(&d[col])).fold(f64::INFINITY, f64::min);
+    let min_col = |col: usize| {
+        diag.iter()
+            .map(|d| num(&d[col]))
+            .fold(f64::INFINITY, f64::min)
+    };
     let mut s = String::new();
     let name = scene.model_name();
     writeln!(s, "# {name}: Jolt 5.6 friction against its closed form\n").unwrap();
@@ -295,7 +335,11 @@ fn readme(scene: Scene, dir: &Path) -> String {
     )
     .unwrap();
     writeln!(s, "## Paper plate (φ = π/4 + 0.3, {T_RUN} s, dt = 1 ms)\n").unwrap();
-    writeln!(s, "| v_c (m/s) | engine ω | Coulomb ω* | law ω |\n|---|---|---|---|").unwrap();
+    writeln!(
+        s,
+        "| v_c (m/s) | engine ω | Coulomb ω* | law ω |\n|---|---|---|---|"
+    )
+    .unwrap();
     for r in &table {
         writeln!(s, "| {} | {} | {} | {} |", r[0], r[1], r[2], r[3]).unwrap();
     }
@@ -310,6 +354,13 @@ fn readme(scene: Scene, dir: &Path) -> String {
         s,
         "* cells within {TOL} of Coulomb: {coul_ok} of {n} ({:.1} %)",
         100.0 * coul_ok as f64 / n as f64
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "* cells whose engine ω lies within the law's band over the load splits four rigid \
+         supports allow (N₀ = N₂ = a, N₁ = N₃ = W/2 − a, a in 0 … W/2, slack {TOL}): {in_band} of {n} ({:.1} %)",
+        100.0 * in_band as f64 / n as f64
     )
     .unwrap();
     writeln!(

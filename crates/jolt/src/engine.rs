@@ -71,7 +71,10 @@ impl Engine for JoltModel {
         ENGINE_CRATE
     }
     fn version(&self) -> String {
-        format!("Jolt {JOLT_VERSION} ({} {})", ENGINE_CRATE.name, ENGINE_CRATE.version)
+        format!(
+            "Jolt {JOLT_VERSION} ({} {})",
+            ENGINE_CRATE.name, ENGINE_CRATE.version
+        )
     }
     /// Symplectic Euler with the pusher at the mid-step heading: first order.
     fn order(&self) -> f64 {

@@ -70,7 +70,11 @@ impl Manifold {
         let n = points.len() as f64;
         let c = points.iter().fold(Vec2::zeros(), |a, p| a + p) / n;
         let twist_cap = if points.len() > 1 {
-            points.iter().zip(caps).map(|(p, f)| (p - c).norm() * f).sum()
+            points
+                .iter()
+                .zip(caps)
+                .map(|(p, f)| (p - c).norm() * f)
+                .sum()
         } else {
             0.0
         };
@@ -264,10 +268,7 @@ impl AtRest {
 /// `(M₀, T)` (N m): the linear rows' moment about the contact point at
 /// ω = 0 and yaw θ, and the twist rows' clamp.
 pub fn rest_moments(law: &Law, body: &Body, push: &Push, theta: f64) -> (f64, f64) {
-    (
-        linear_moment(law, body, push, 0.0, theta),
-        law.twist_cap(),
-    )
+    (linear_moment(law, body, push, 0.0, theta), law.twist_cap())
 }
 
 /// The class of ω = 0 at yaw θ ([`AtRest`]).

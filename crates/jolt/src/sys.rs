@@ -303,8 +303,14 @@ impl World {
             cs.axisY1 = v3([0.0, 1.0, 0.0]);
             cs.axisX2 = v3([1.0, 0.0, 0.0]);
             cs.axisY2 = v3([0.0, 1.0, 0.0]);
-            JPH_SixDOFConstraintSettings_MakeFixedAxis(&mut cs, JPH_SixDOFConstraintAxis_TranslationX);
-            JPH_SixDOFConstraintSettings_MakeFixedAxis(&mut cs, JPH_SixDOFConstraintAxis_TranslationY);
+            JPH_SixDOFConstraintSettings_MakeFixedAxis(
+                &mut cs,
+                JPH_SixDOFConstraintAxis_TranslationX,
+            );
+            JPH_SixDOFConstraintSettings_MakeFixedAxis(
+                &mut cs,
+                JPH_SixDOFConstraintAxis_TranslationY,
+            );
             let c = JPH_SixDOFConstraint_Create(&cs, pusher, object);
             if c.is_null() {
                 return None;
@@ -423,7 +429,10 @@ impl Drop for World {
         unsafe {
             let bi = JPH_PhysicsSystem_GetBodyInterface(self.system);
             if !self.constraint.is_null() {
-                JPH_PhysicsSystem_RemoveConstraint(self.system, self.constraint as *mut JPH_Constraint);
+                JPH_PhysicsSystem_RemoveConstraint(
+                    self.system,
+                    self.constraint as *mut JPH_Constraint,
+                );
                 JPH_Constraint_Destroy(self.constraint as *mut JPH_Constraint);
             }
             for id in [self.pusher, self.object, self.floor] {

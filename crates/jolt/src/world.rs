@@ -181,20 +181,25 @@ fn contacts(
     let q = object.rotation;
     for m in manifolds {
         let object_is_1 = m.body1 == world.object;
-        if !(object_is_1 || m.body2 == world.object) || !(m.body1 == world.floor || m.body2 == world.floor) {
+        if !(object_is_1 || m.body2 == world.object)
+            || !(m.body1 == world.floor || m.body2 == world.floor)
+        {
             continue;
         }
         sizes.push(m.points.len());
         let n_local = m.normal.map(|x| x as f64);
         // Normal in body 2's space: the floor's is the world's.
-        let n = if object_is_1 { n_local } else { rotate_q(q, n_local) };
+        let n = if object_is_1 {
+            n_local
+        } else {
+            rotate_q(q, n_local)
+        };
         // Force on body 2 is +λ t / dt; on body 1, −λ t / dt.
         let sign = if object_is_1 { -1.0 } else { 1.0 };
         let force = |t1: [f64; 3]| {
             let t2 = cross3(n, t1);
-            [0, 1].map(|k| {
-                sign * (m.friction[0] as f64 * t1[k] + m.friction[1] as f64 * t2[k]) / dt
-            })
+            [0, 1]
+                .map(|k| sign * (m.friction[0] as f64 * t1[k] + m.friction[1] as f64 * t2[k]) / dt)
         };
         let twist = sign * m.twist as f64 * n[2] / dt;
         // Friction point: mean of the object-side points (COM frame).
@@ -343,7 +348,11 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         let (sn, cs) = theta.sin_cos();
         world.set_velocity(
             world.object,
-            [cs * local[0] - sn * local[1], sn * local[0] + cs * local[1], st.linear[2]],
+            [
+                cs * local[0] - sn * local[1],
+                sn * local[0] + cs * local[1],
+                st.linear[2],
+            ],
             [0.0, 0.0, init.omega],
         );
         st = world.state(world.object);
@@ -379,7 +388,11 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         let vc = push.velocity();
         for k in 0..n {
             let t0 = t_seg + k as f64 * h;
-            let t1 = if k + 1 == n { t_seg + push.duration } else { t0 + h };
+            let t1 = if k + 1 == n {
+                t_seg + push.duration
+            } else {
+                t0 + h
+            };
             let omega = st.angular[2];
             let (sn, cs) = (theta + 0.5 * h * omega).sin_cos();
             let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y, 0.0];
