@@ -17,6 +17,7 @@ pub const ENGINE_CRATES: &[fn() -> Vec<ModelEntry>] = &[
     pushval_physx::models,
     pushval_box2d::models,
     pushval_avian::models,
+    pushval_jolt::models,
 ];
 
 /// Every engine model, in registry order.

@@ -1,0 +1,131 @@
+//! The Jolt models as pushval engine plug-ins: `jolt_box` (the plate as one
+//! box collider) and `jolt_feet` (the plate on sphere feet), both on a
+//! floor with Jolt 5.6's own friction. Without the `jolt` feature they are
+//! listed but not available.
+
+use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_model::{ModelError, Problem};
+
+use crate::{JoltSettings, JoltSimulator, Scene, AVAILABLE};
+
+/// The engine crate and version this adapter is built against (the
+/// `oxijolt-sys` entry of the workspace's Cargo.toml).
+pub const ENGINE_CRATE: EngineCrate = EngineCrate {
+    name: "oxijolt-sys",
+    version: "1.5.0+jolt-5.6.0",
+};
+
+/// The Jolt Physics release oxijolt-sys vendors.
+pub const JOLT_VERSION: &str = "5.6.0";
+
+/// One Jolt model (a collider).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JoltModel {
+    /// The settings of a run (its `dt` is replaced by the run's).
+    pub settings: JoltSettings,
+}
+
+fn build(scene: Scene, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
+    let mut settings = JoltSettings {
+        scene,
+        ..Default::default()
+    };
+    if let Some(dt) = opts.dt {
+        settings.dt = dt;
+    }
+    Ok(Box::new(JoltModel { settings }))
+}
+
+/// The Jolt models: the crate's entries in pushval's engine registry.
+pub fn models() -> Vec<ModelEntry> {
+    vec![
+        ModelEntry {
+            name: "jolt_box",
+            build: |o| build(Scene::Box, o),
+        },
+        ModelEntry {
+            name: "jolt_feet",
+            build: |o| build(Scene::Feet, o),
+        },
+    ]
+}
+
+impl Engine for JoltModel {
+    fn name(&self) -> &'static str {
+        self.settings.scene.model_name()
+    }
+    fn description(&self) -> &'static str {
+        match self.settings.scene {
+            Scene::Box => {
+                "plate as one box collider on a floor, Jolt 5.6 (one 4-point manifold: friction disc at the points' average plus a twist row)"
+            }
+            Scene::Feet => {
+                "plate on sphere feet on a floor, Jolt 5.6 (one-point manifolds, manifold reduction off: a friction disc per foot)"
+            }
+        }
+    }
+    fn adapter(&self) -> &'static str {
+        "pushval-jolt"
+    }
+    fn engine_crate(&self) -> EngineCrate {
+        ENGINE_CRATE
+    }
+    fn version(&self) -> String {
+        format!(
+            "Jolt {JOLT_VERSION} ({} {})",
+            ENGINE_CRATE.name, ENGINE_CRATE.version
+        )
+    }
+    /// Symplectic Euler with the pusher at the mid-step heading: first order.
+    fn order(&self) -> f64 {
+        1.0
+    }
+    fn availability(&self) -> Result<(), String> {
+        if AVAILABLE {
+            Ok(())
+        } else {
+            Err("build with --features jolt (needs cmake: apt-get install cmake)".into())
+        }
+    }
+    fn default_dt(&self) -> f64 {
+        self.settings.dt
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        let s = JoltSettings {
+            dt,
+            ..self.settings
+        };
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": dt,
+            "scene": s.scene.as_str(),
+            "velocity_steps": s.velocity_steps,
+            "position_steps": s.position_steps,
+            "penetration_slop": s.penetration_slop,
+            "precision": "f64 positions, f32 solver",
+            "label": s.label(),
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let r = JoltSimulator::new(JoltSettings {
+            dt,
+            ..self.settings
+        })
+        .run(problem)?;
+        Ok(EngineRun {
+            dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_joint_drift": r.max_joint_drift,
+                "max_tilt": r.max_tilt,
+                "max_lift": r.max_lift,
+                "rest_loads": r.rest_loads,
+                "manifold_sizes": r.manifold_sizes,
+                "mu": r.mu,
+            }),
+            trajectory: r.trajectory,
+        })
+    }
+}

@@ -1,0 +1,507 @@
+//! The simulation loop and the reading of Jolt's contact cache.
+
+use std::f64::consts::{PI, TAU};
+
+use pushval_engine::StepRecord;
+use pushval_model::{ModelError, Problem, SolverStats, Trajectory, Vec2};
+
+use crate::predict::{box_corners, friction_slip_angle};
+use crate::sys::{BodyState, Collider, Spec, World};
+use crate::{JoltRun, JoltSettings, Scene, SupportContact};
+
+/// Share of a segment (and of the settle phase) averaged at its end.
+const TAIL: f64 = 0.2;
+
+/// One manifold of the contact cache (`ContactConstraintManager::
+/// ManifoldCache::SaveState`, Jolt 5.6.0).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct CachedManifold {
+    pub body1: u32,
+    pub body2: u32,
+    /// Contact normal in body 2's space.
+    pub normal: [f32; 3],
+    /// Impulses of the two linear friction rows (N s).
+    pub friction: [f32; 2],
+    /// Impulse of the twist row (N s).
+    pub twist: f32,
+    /// Per point: position on body 1 and on body 2 (each relative to that
+    /// body's centre of mass, in its frame) and the normal impulse (N s).
+    pub points: Vec<([f32; 3], [f32; 3], f32)>,
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
+        let b = self.bytes.get(self.at..self.at + N)?;
+        self.at += N;
+        b.try_into().ok()
+    }
+    fn u8(&mut self) -> Option<u8> {
+        self.take::<1>().map(|b| b[0])
+    }
+    fn u16(&mut self) -> Option<u16> {
+        self.take().map(u16::from_ne_bytes)
+    }
+    fn u32(&mut self) -> Option<u32> {
+        self.take().map(u32::from_ne_bytes)
+    }
+    fn f32(&mut self) -> Option<f32> {
+        self.take().map(f32::from_ne_bytes)
+    }
+    fn f3(&mut self) -> Option<[f32; 3]> {
+        Some([self.f32()?, self.f32()?, self.f32()?])
+    }
+}
+
+/// Parses the bytes of `PhysicsSystem::SaveState` with state `Contacts`:
+/// the state byte, then per body pair its key (two body ids), the cached
+/// pair (two `Float3`), its manifolds (key: body 1, sub-shape 1, body 2,
+/// sub-shape 2; point count `u16`; normal `Float3`; friction `Vector<2>`;
+/// twist `float`; per point two `Float3` and the normal `float`), then the
+/// CCD manifold keys. `None` when the bytes do not have that shape.
+pub(crate) fn parse_contacts(bytes: &[u8]) -> Option<Vec<CachedManifold>> {
+    let mut r = Reader { bytes, at: 0 };
+    let state = r.u8()?;
+    if state != 4 {
+        return None;
+    }
+    let pairs = r.u32()?;
+    let mut out = Vec::new();
+    for _ in 0..pairs {
+        let (_a, _b) = (r.u32()?, r.u32()?);
+        let (_dp, _dr) = (r.f3()?, r.f3()?);
+        let manifolds = r.u32()?;
+        for _ in 0..manifolds {
+            let (body1, _s1, body2, _s2) = (r.u32()?, r.u32()?, r.u32()?, r.u32()?);
+            let n = r.u16()? as usize;
+            let normal = r.f3()?;
+            let friction = [r.f32()?, r.f32()?];
+            let twist = r.f32()?;
+            let mut points = Vec::with_capacity(n);
+            for _ in 0..n {
+                points.push((r.f3()?, r.f3()?, r.f32()?));
+            }
+            out.push(CachedManifold {
+                body1,
+                body2,
+                normal,
+                friction,
+                twist,
+                points,
+            });
+        }
+    }
+    let ccd = r.u32()?;
+    r.at += 16 * ccd as usize;
+    (r.at == bytes.len()).then_some(out)
+}
+
+/// Jolt's first tangent of a unit normal (`Vec3::GetNormalizedPerpendicular`).
+fn perpendicular(n: [f64; 3]) -> [f64; 3] {
+    if n[0].abs() > n[1].abs() {
+        let l = n[0].hypot(n[2]);
+        [n[2] / l, 0.0, -n[0] / l]
+    } else {
+        let l = n[1].hypot(n[2]);
+        [0.0, n[2] / l, -n[1] / l]
+    }
+}
+
+/// The other branch of [`perpendicular`].
+fn other_perpendicular(n: [f64; 3]) -> [f64; 3] {
+    if n[0].abs() > n[1].abs() {
+        let l = n[1].hypot(n[2]);
+        [0.0, n[2] / l, -n[1] / l]
+    } else {
+        let l = n[0].hypot(n[2]);
+        [n[2] / l, 0.0, -n[0] / l]
+    }
+}
+
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Rotates `v` by the quaternion `q` (x, y, z, w).
+fn rotate_q(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    let u = [q[0], q[1], q[2]];
+    let t = cross3(u, v).map(|x| 2.0 * x);
+    let c = cross3(u, t);
+    [
+        v[0] + q[3] * t[0] + c[0],
+        v[1] + q[3] * t[1] + c[1],
+        v[2] + q[3] * t[2] + c[2],
+    ]
+}
+
+fn yaw_of(q: [f64; 4]) -> f64 {
+    let ex = rotate_q(q, [1.0, 0.0, 0.0]);
+    ex[1].atan2(ex[0])
+}
+
+fn tilt_of(q: [f64; 4]) -> f64 {
+    2.0 * q[0].hypot(q[1]).min(1.0).asin()
+}
+
+/// What one step's contact cache says, per support.
+struct StepContacts {
+    supports: Vec<SupportContact>,
+    sizes: Vec<usize>,
+    /// Per manifold: its friction force's angle from `−u` (rad) and the
+    /// angle the effective-mass law gives for the same slip and point.
+    angles: Vec<(f64, f64)>,
+}
+
+/// Reads the object–floor manifolds of the cache into per-support values:
+/// every point goes to the nearest support (`targets`, object frame); the
+/// impulses become forces over `dt`.
+fn contacts(
+    world: &World,
+    (mass, inertia): (f64, f64),
+    object: &BodyState,
+    targets: &[Vec2],
+    dt: f64,
+) -> Result<StepContacts, ModelError> {
+    let bytes = world.contact_state();
+    let manifolds = parse_contacts(&bytes).ok_or_else(|| ModelError::Integration {
+        t: 0.0,
+        reason: "Jolt: the contact cache did not parse (oxijolt-sys / Jolt version?)".into(),
+    })?;
+    let mut out = vec![SupportContact::default(); targets.len()];
+    let mut sizes = Vec::new();
+    let mut angles = Vec::new();
+    let q = object.rotation;
+    for m in manifolds {
+        let object_is_1 = m.body1 == world.object;
+        if !(object_is_1 || m.body2 == world.object)
+            || !(m.body1 == world.floor || m.body2 == world.floor)
+        {
+            continue;
+        }
+        sizes.push(m.points.len());
+        let n_local = m.normal.map(|x| x as f64);
+        // Normal in body 2's space: the floor's is the world's.
+        let n = if object_is_1 {
+            n_local
+        } else {
+            rotate_q(q, n_local)
+        };
+        // Force on body 2 is +λ t / dt; on body 1, −λ t / dt.
+        let sign = if object_is_1 { -1.0 } else { 1.0 };
+        let force = |t1: [f64; 3]| {
+            let t2 = cross3(n, t1);
+            [0, 1]
+                .map(|k| sign * (m.friction[0] as f64 * t1[k] + m.friction[1] as f64 * t2[k]) / dt)
+        };
+        let twist = sign * m.twist as f64 * n[2] / dt;
+        // Friction point: mean of the object-side points (COM frame).
+        let pts: Vec<[f64; 3]> = m
+            .points
+            .iter()
+            .map(|(p1, p2, _)| if object_is_1 { *p1 } else { *p2 }.map(|x| x as f64))
+            .collect();
+        let c = pts
+            .iter()
+            .fold([0.0; 3], |a, p| [a[0] + p[0], a[1] + p[1], a[2] + p[2]])
+            .map(|x| x / pts.len().max(1) as f64);
+        let cw = rotate_q(q, c);
+        let w = object.angular;
+        let wxr = cross3(w, cw);
+        let slip = [object.linear[0] + wxr[0], object.linear[1] + wxr[1]];
+        // Jolt's first tangent is world y or world x depending on which of
+        // the normal's tiny horizontal components is larger (float noise of
+        // the tilt): the two branches give forces 90° apart, so the reader
+        // takes the branch whose force opposes the slip (the law's angle is
+        // below 90° for any effective-mass ratio).
+        let fa = force(perpendicular(n));
+        let fb = force(other_perpendicular(n));
+        let opposes = |f: [f64; 2]| -(f[0] * slip[0] + f[1] * slip[1]);
+        let f = if opposes(fb) > opposes(fa) { fb } else { fa };
+        let (fv, uv) = (Vec2::new(f[0], f[1]), Vec2::new(slip[0], slip[1]));
+        if fv.norm() > 0.0 && uv.norm() > 1e-6 {
+            let mx = 1.0 / (1.0 / mass + cw[1] * cw[1] / inertia);
+            let my = 1.0 / (1.0 / mass + cw[0] * cw[0] / inertia);
+            let law = -Vec2::new(mx * uv.x, my * uv.y);
+            angles.push((friction_slip_angle(fv, uv), friction_slip_angle(law, uv)));
+        }
+        for (p, (_, _, lambda)) in pts.iter().zip(&m.points) {
+            let local = Vec2::new(p[0], p[1]);
+            let i = (0..targets.len())
+                .min_by(|&a, &b| {
+                    (targets[a] - local)
+                        .norm()
+                        .total_cmp(&(targets[b] - local).norm())
+                })
+                .unwrap_or(0);
+            out[i].normal += *lambda as f64 / dt;
+            out[i].friction = f;
+            out[i].twist = twist;
+            out[i].slip = slip;
+        }
+    }
+    Ok(StepContacts {
+        supports: out,
+        sizes,
+        angles,
+    })
+}
+
+fn jolt_error(what: &str) -> ModelError {
+    ModelError::Integration {
+        t: 0.0,
+        reason: format!("Jolt: {what}"),
+    }
+}
+
+/// Runs the problem in Jolt.
+pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, ModelError> {
+    let body = &problem.body;
+    let init = problem.initial;
+    let mass = body.mass();
+    let iz = body.inertia_cm();
+    let mu = body.total_friction() / (mass * s.gravity);
+    let t = s.plate_thickness;
+    let tilt = 0.5 * iz + mass * t * t / 12.0;
+    let (collider, targets): (Collider, Vec<Vec2>) = match s.scene {
+        Scene::Box => {
+            let c = box_corners(body);
+            (
+                Collider::Box {
+                    center: [0.5 * (c[0].x + c[2].x), 0.5 * (c[0].y + c[2].y), 0.5 * t],
+                    half: [0.5 * (c[2].x - c[0].x), 0.5 * (c[2].y - c[0].y), 0.5 * t],
+                },
+                c.to_vec(),
+            )
+        }
+        Scene::Feet => {
+            let pts: Vec<Vec2> = body.supports().map(|p| p.position).collect();
+            (
+                Collider::Spheres {
+                    centers: pts.iter().map(|p| [p.x, p.y, s.foot_radius]).collect(),
+                    radius: s.foot_radius,
+                },
+                pts,
+            )
+        }
+    };
+    let pc = body.contact();
+    let spec = Spec {
+        collider,
+        mass,
+        inertia: [tilt, tilt, iz],
+        friction: mu,
+        manifold_reduction: s.scene == Scene::Box,
+        gravity: s.gravity,
+        velocity_steps: s.velocity_steps,
+        position_steps: s.position_steps,
+        penetration_slop: s.penetration_slop,
+        position: [init.position.x, init.position.y, 0.0],
+        theta: init.theta,
+        anchor: [pc.x, pc.y, 0.0],
+    };
+    let mut world = World::new(&spec).ok_or_else(|| jolt_error("scene creation failed"))?;
+    let n_sup = targets.len();
+    let anchor = spec.anchor;
+
+    // Settle with the pusher at rest.
+    let mut st = world.state(world.object);
+    let mut theta = init.theta;
+    let settle_steps = (s.settle_time / s.dt).ceil() as usize;
+    let settle_tail = ((1.0 - TAIL) * settle_steps as f64).floor() as usize;
+    let mut rest_loads = vec![0.0; n_sup];
+    let mut count = 0usize;
+    let mut manifold_sizes = Vec::new();
+    for k in 0..settle_steps {
+        let a = world.anchor_world(st.com, theta, anchor);
+        world.drive_pusher(a, [0.0; 3]);
+        if !world.step(s.dt) {
+            return Err(jolt_error("update failed while settling"));
+        }
+        st = world.state(world.object);
+        theta = unwrap(theta, yaw_of(st.rotation));
+        if k >= settle_tail {
+            let c = contacts(&world, (mass, iz), &st, &targets, s.dt)?;
+            for (a, x) in rest_loads.iter_mut().zip(&c.supports) {
+                *a += x.normal;
+            }
+            manifold_sizes = c.sizes;
+            count += 1;
+        }
+    }
+    if count > 0 {
+        rest_loads.iter_mut().for_each(|a| *a /= count as f64);
+    }
+    let z_rest = st.com[2];
+
+    // Start moving with the first push at ω = initial.omega, unless from rest.
+    if !init.from_rest {
+        let vc = problem.pushes[0].velocity();
+        let local = [vc.x + init.omega * pc.y, vc.y - init.omega * pc.x];
+        let (sn, cs) = theta.sin_cos();
+        world.set_velocity(
+            world.object,
+            [
+                cs * local[0] - sn * local[1],
+                sn * local[0] + cs * local[1],
+                st.linear[2],
+            ],
+            [0.0, 0.0, init.omega],
+        );
+        st = world.state(world.object);
+    }
+
+    let mut history = vec![StepRecord {
+        segment: 0,
+        t0: 0.0,
+        t1: 0.0,
+        x: st.com[0],
+        y: st.com[1],
+        theta,
+        omega: st.angular[2],
+    }];
+    let mut steps = 0usize;
+    let (mut max_tilt, mut max_lift, mut max_drift) = (0.0f64, 0.0f64, 0.0f64);
+    let mut tail_omega = Vec::new();
+    let mut tail_omega_std = Vec::new();
+    let mut tail_contacts = Vec::new();
+    let mut tail_angle = Vec::new();
+    let mut tail_angle_law = Vec::new();
+    let mut tail_load_range = Vec::new();
+    let mut t_seg = 0.0;
+    for (j, push) in problem.pushes.iter().enumerate() {
+        let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+        let h = push.duration / n as f64;
+        let tail_from = ((1.0 - TAIL) * n as f64).floor() as usize;
+        let (mut acc_w, mut acc_w2, mut acc_t) = (0.0, 0.0, 0.0);
+        let mut acc_c = vec![SupportContact::default(); n_sup];
+        let mut max_angle = 0.0f64;
+        let mut max_angle_vs_law = 0.0f64;
+        let mut load_range = vec![[f64::INFINITY, f64::NEG_INFINITY]; n_sup];
+        let vc = push.velocity();
+        for k in 0..n {
+            let t0 = t_seg + k as f64 * h;
+            let t1 = if k + 1 == n {
+                t_seg + push.duration
+            } else {
+                t0 + h
+            };
+            let omega = st.angular[2];
+            let (sn, cs) = (theta + 0.5 * h * omega).sin_cos();
+            let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y, 0.0];
+            let a = world.anchor_world(st.com, theta, anchor);
+            if k > 0 || j > 0 {
+                let p = world.state(world.pusher).com;
+                max_drift = max_drift.max((p[0] - a[0]).hypot(p[1] - a[1]));
+            }
+            world.drive_pusher(a, vel);
+            if !world.step(h) {
+                return Err(ModelError::Integration {
+                    t: t1,
+                    reason: "Jolt: update failed".into(),
+                });
+            }
+            steps += 1;
+            st = world.state(world.object);
+            theta = unwrap(theta, yaw_of(st.rotation));
+            if !(st.com.iter().all(|x| x.is_finite()) && st.angular[2].is_finite()) {
+                return Err(ModelError::NonFinite { t: t1, step: steps });
+            }
+            max_tilt = max_tilt.max(tilt_of(st.rotation));
+            max_lift = max_lift.max((st.com[2] - z_rest).abs());
+            if k >= tail_from {
+                let w = st.angular[2];
+                acc_w += w * h;
+                acc_w2 += w * w * h;
+                acc_t += h;
+                let c = contacts(&world, (mass, iz), &st, &targets, h)?;
+                for (r, x) in load_range.iter_mut().zip(&c.supports) {
+                    r[0] = r[0].min(x.normal);
+                    r[1] = r[1].max(x.normal);
+                }
+                for &(a, l) in &c.angles {
+                    max_angle = max_angle.max(a.abs());
+                    max_angle_vs_law = max_angle_vs_law.max((a - l).abs());
+                }
+                for (a, x) in acc_c.iter_mut().zip(&c.supports) {
+                    a.normal += x.normal * h;
+                    a.twist += x.twist * h;
+                    for q in 0..2 {
+                        a.friction[q] += x.friction[q] * h;
+                        a.slip[q] += x.slip[q] * h;
+                    }
+                }
+            }
+            history.push(StepRecord {
+                segment: j,
+                t0,
+                t1,
+                x: st.com[0],
+                y: st.com[1],
+                theta,
+                omega: st.angular[2],
+            });
+        }
+        let mean = acc_w / acc_t;
+        tail_omega.push(mean);
+        tail_omega_std.push((acc_w2 / acc_t - mean * mean).max(0.0).sqrt());
+        tail_contacts.push(
+            acc_c
+                .iter()
+                .map(|a| SupportContact {
+                    normal: a.normal / acc_t,
+                    friction: a.friction.map(|x| x / acc_t),
+                    twist: a.twist / acc_t,
+                    slip: a.slip.map(|x| x / acc_t),
+                })
+                .collect(),
+        );
+        tail_angle.push(max_angle);
+        tail_angle_law.push(max_angle_vs_law);
+        tail_load_range.push(load_range);
+        t_seg += push.duration;
+    }
+    let (samples, segments) = pushval_engine::resample(problem, &history);
+    Ok(JoltRun {
+        trajectory: Trajectory {
+            model: String::new(),
+            samples,
+            segments,
+            stats: SolverStats {
+                rhs_evals: steps,
+                steps,
+                rejected: 0,
+            },
+            ..Default::default()
+        },
+        settings: *s,
+        steps,
+        wall_time: Default::default(),
+        mu,
+        rest_loads,
+        manifold_sizes,
+        segment_tail_omega: tail_omega,
+        segment_tail_omega_std: tail_omega_std,
+        segment_tail_contacts: tail_contacts,
+        segment_tail_max_angle: tail_angle,
+        segment_tail_max_angle_vs_law: tail_angle_law,
+        segment_tail_load_range: tail_load_range,
+        max_tilt,
+        max_lift,
+        max_joint_drift: max_drift,
+        history,
+    })
+}
+
+/// `prev` moved to the branch of `angle` nearest to it.
+fn unwrap(prev: f64, angle: f64) -> f64 {
+    let d = (angle - prev.rem_euclid(TAU) + PI).rem_euclid(TAU) - PI;
+    prev + d
+}
