@@ -524,6 +524,9 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
                     settings,
                 });
             }
+            // An engine that could not run at all (an outside process that
+            // failed, timed out or wrote malformed rows) is an input error.
+            Err(e @ ModelError::Adapter(_)) => return Err(e),
             Err(e) => failures.push((name.to_string(), e.to_string())),
         }
     }
