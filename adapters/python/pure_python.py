@@ -21,6 +21,9 @@ object starts from rest), the contact impulse has no moment about the
 contact point, so the angular momentum about it is kept and omega jumps.
 
 Options (command line, for tests and measurements):
+  --scheme euler|heun the step: semi-implicit Euler (default, first order) or
+                      Heun's method on (theta, omega, x, y) (second order;
+                      declare order = 2 for it)
   --inertia-scale S   multiply I_cm by S (a deliberately wrong engine)
   --timing            print the stepping time on standard error
 """
@@ -34,6 +37,7 @@ import time
 def main(argv):
     inertia_scale = 1.0
     timing = False
+    scheme = "euler"
     args = list(argv)
     while args:
         a = args.pop(0)
@@ -41,6 +45,11 @@ def main(argv):
             inertia_scale = float(args.pop(0))
         elif a == "--timing":
             timing = True
+        elif a == "--scheme":
+            scheme = args.pop(0)
+            if scheme not in ("euler", "heun"):
+                print(f"pure_python.py: unknown scheme {scheme!r} (euler, heun)", file=sys.stderr)
+                return 2
         else:
             print(f"pure_python.py: unknown argument {a!r}", file=sys.stderr)
             return 2
@@ -49,7 +58,7 @@ def main(argv):
         print(f"pure_python.py: unsupported format {doc.get('format')!r}", file=sys.stderr)
         return 2
     t0 = time.perf_counter()
-    rows = simulate(doc, inertia_scale)
+    rows = simulate(doc, inertia_scale, scheme)
     t1 = time.perf_counter()
     out = sys.stdout
     out.write("t,x,y,theta,omega\n")
@@ -61,7 +70,7 @@ def main(argv):
     return 0
 
 
-def simulate(doc, inertia_scale=1.0):
+def simulate(doc, inertia_scale=1.0, scheme="euler"):
     obj = doc["object"]
     m = float(obj["mass"])
     i_cm = float(obj["inertia_cm"]) * inertia_scale
@@ -76,7 +85,6 @@ def simulate(doc, inertia_scale=1.0):
     th = float(ini["theta"])
     w = 0.0 if ini["from_rest"] else float(ini["omega"])
     dt = float(doc["dt"])
-    t = 0.0
     # The pusher velocity before the first segment: at rest, or moving with
     # the first push (no jump).
     prev = None if ini["from_rest"] else doc["pushes"][0]
@@ -100,6 +108,25 @@ def simulate(doc, inertia_scale=1.0):
         vpx, vpy = pusher(push, th)
         return vpx + w * py, vpy - w * px
 
+    def omega_dot(c, s, pcx, pcy, vpx, vpy, vx, vy, w):
+        # Torque about the contact point (times I_P: returns I_P domega/dt).
+        torque = m * w * (pcx * vpx + pcy * vpy)
+        for sx, sy, f in sup:
+            px, py = c * sx - s * sy, s * sx + c * sy
+            ux, uy = vx - w * py, vy + w * px
+            norm = math.hypot(ux, uy)
+            if norm > 1e-15:
+                fx, fy = -f * ux / norm, -f * uy / norm
+                torque += (px - pcx) * fy - (py - pcy) * fx
+        return torque
+
+    def rates(th, w, speed, phi):
+        c, s = math.cos(th), math.sin(th)
+        pcx, pcy = c * rcx - s * rcy, s * rcx + c * rcy
+        vpx, vpy = speed * math.cos(th + phi), speed * math.sin(th + phi)
+        vx, vy = vpx + w * pcy, vpy - w * pcx
+        return w, omega_dot(c, s, pcx, pcy, vpx, vpy, vx, vy, w) / i_p, vx, vy
+
     for k, push in enumerate(doc["pushes"]):
         h_total = float(push["duration"])
         n = max(1, round(h_total / dt))
@@ -114,26 +141,27 @@ def simulate(doc, inertia_scale=1.0):
         speed = push["speed"]
         phi = push["phi"]
         t_start = float(push["t_start"])
+        if scheme == "heun":
+            for j in range(n):
+                d1 = rates(th, w, speed, phi)
+                d2 = rates(th + h * d1[0], w + h * d1[1], speed, phi)
+                th += 0.5 * h * (d1[0] + d2[0])
+                w += 0.5 * h * (d1[1] + d2[1])
+                x += 0.5 * h * (d1[2] + d2[2])
+                y += 0.5 * h * (d1[3] + d2[3])
+                rows.append((t_start + (j + 1) * h, x, y, th, w))
+            continue
         for j in range(n):
             c, s = math.cos(th), math.sin(th)
             pcx, pcy = c * rcx - s * rcy, s * rcx + c * rcy
             vpx, vpy = speed * math.cos(th + phi), speed * math.sin(th + phi)
             vx, vy = vpx + w * pcy, vpy - w * pcx
-            torque = m * w * (pcx * vpx + pcy * vpy)
-            for sx, sy, f in sup:
-                px, py = c * sx - s * sy, s * sx + c * sy
-                ux, uy = vx - w * py, vy + w * px
-                norm = math.hypot(ux, uy)
-                if norm > 1e-15:
-                    fx, fy = -f * ux / norm, -f * uy / norm
-                    torque += (px - pcx) * fy - (py - pcy) * fx
-            w += h * torque / i_p
+            w += h * omega_dot(c, s, pcx, pcy, vpx, vpy, vx, vy, w) / i_p
             th += h * w
             vx, vy = cm_velocity(push, th, w)
             x += h * vx
             y += h * vy
-            t = t_start + (j + 1) * h
-            rows.append((t, x, y, th, w))
+            rows.append((t_start + (j + 1) * h, x, y, th, w))
     return rows
 
 
