@@ -289,7 +289,9 @@ fn compare(file: PathBuf, csv: PathBuf) -> anyhow::Result<ExitCode> {
 
 fn problem(file: PathBuf, dt: Option<f64>, engine: Option<String>) -> anyhow::Result<ExitCode> {
     let sc = pushval::registry::load(&file)?;
-    let dt = dt.or(sc.engine.dt).unwrap_or(pushval::registry::OUTSIDE_DEFAULT_DT);
+    let dt = dt
+        .or(sc.engine.dt)
+        .unwrap_or(pushval::registry::OUTSIDE_DEFAULT_DT);
     if !(dt.is_finite() && dt > 0.0) {
         bail!("--dt must be a finite number > 0, got {dt}");
     }

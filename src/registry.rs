@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 
 use pushval_engine::{Build, Engine, EngineOptions, ModelEntry, OptionError};
-use pushval_outside::{Config, OutsideEngine, Spec};
 pub use pushval_outside::{csv, problem_document, DEFAULT_DT as OUTSIDE_DEFAULT_DT};
+use pushval_outside::{Config, OutsideEngine, Spec};
 use pushval_scenario::{Scenario, ScenarioError, ANALYTIC_MODELS};
 
 /// The engine crates' model tables, one row per crate.

@@ -274,7 +274,10 @@ pub fn choose_engine_dt(
     };
     // The first rung's two runs are independent: side by side.
     if let [top, ..] = ladder[..] {
-        let (a, b) = rayon::join(|| engine.run(problem, 2.0 * top), || engine.run(problem, top));
+        let (a, b) = rayon::join(
+            || engine.run(problem, 2.0 * top),
+            || engine.run(problem, top),
+        );
         for r in [a, b] {
             match r {
                 Ok(r) => runs.push(r),

@@ -50,7 +50,8 @@ fn scenario() -> PathBuf {
 fn single_gate(dir: &Path) -> PathBuf {
     let text = std::fs::read_to_string(scenario())
         .unwrap()
-        .replace(", \"pure_python_heun\"", "").replace("\"rapier2d\", \"pure_python\"", "\"pure_python\"");
+        .replace(", \"pure_python_heun\"", "")
+        .replace("\"rapier2d\", \"pure_python\"", "\"pure_python\"");
     let p = dir.join("one.toml");
     std::fs::write(&p, text).unwrap();
     p
@@ -58,7 +59,11 @@ fn single_gate(dir: &Path) -> PathBuf {
 
 #[test]
 fn engines_lists_the_outside_engines_of_pushval_toml() {
-    let o = pushval().arg("engines").current_dir(root()).output().unwrap();
+    let o = pushval()
+        .arg("engines")
+        .current_dir(root())
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", text(&o));
     let out = String::from_utf8(o.stdout).unwrap();
     let row = out
@@ -69,7 +74,11 @@ fn engines_lists_the_outside_engines_of_pushval_toml() {
     assert!(row.contains("pure_python.py (Coulomb per support"), "{row}");
     // Not listed without a pushval.toml in the current directory.
     let dir = tempfile::tempdir().unwrap();
-    let o = pushval().arg("engines").current_dir(dir.path()).output().unwrap();
+    let o = pushval()
+        .arg("engines")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
     assert!(!String::from_utf8(o.stdout).unwrap().contains("pure_python"));
 }
 
@@ -84,7 +93,10 @@ fn the_shipped_outside_scenario_gates_and_passes() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let s = v.to_string();
-    assert!(s.contains("\"pure_python\"") && s.contains("\"pure_python_heun\""), "{s}");
+    assert!(
+        s.contains("\"pure_python\"") && s.contains("\"pure_python_heun\""),
+        "{s}"
+    );
 }
 
 /// The same adapter with I_cm 1 % high fails the gate (exit 1) where the
@@ -100,16 +112,32 @@ fn an_adapter_with_inertia_one_percent_off_fails_the_gate() {
         &["python3", &a, "--scheme", "heun"],
         "order = 2\n",
     );
-    let o = pushval().arg("validate").arg(&sc).arg("--engines").arg(&right).output().unwrap();
+    let o = pushval()
+        .arg("validate")
+        .arg(&sc)
+        .arg("--engines")
+        .arg(&right)
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let wrong = engines_file(
         dir.path(),
         &["python3", &a, "--scheme", "heun", "--inertia-scale", "1.01"],
         "order = 2\n",
     );
-    let o = pushval().arg("validate").arg(&sc).arg("--engines").arg(&wrong).output().unwrap();
+    let o = pushval()
+        .arg("validate")
+        .arg(&sc)
+        .arg("--engines")
+        .arg(&wrong)
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert!(text(&o).contains("FAIL outside-pure-python / pure_python: position_max"), "{}", text(&o));
+    assert!(
+        text(&o).contains("FAIL outside-pure-python / pure_python: position_max"),
+        "{}",
+        text(&o)
+    );
 }
 
 /// Runs `pushval run` on the single-gate scenario with `pure_python`
@@ -140,8 +168,14 @@ fn an_adapter_exiting_3_is_an_input_error_naming_it() {
     );
     let t = text(&o);
     assert_eq!(o.status.code(), Some(2), "{t}");
-    assert!(t.contains("outside engine \"pure_python\"") && t.contains("exited with status 3"), "{t}");
-    assert!(t.contains("no licence for mysim"), "the last stderr lines: {t}");
+    assert!(
+        t.contains("outside engine \"pure_python\"") && t.contains("exited with status 3"),
+        "{t}"
+    );
+    assert!(
+        t.contains("no licence for mysim"),
+        "the last stderr lines: {t}"
+    );
     assert!(t.contains("python3 -c"), "the command: {t}");
     assert!(!written, "nothing is written");
 }
@@ -154,7 +188,11 @@ fn a_malformed_row_names_its_line_and_column() {
     );
     let t = text(&o);
     assert_eq!(o.status.code(), Some(2), "{t}");
-    assert!(t.contains("outside engine \"pure_python\"") && t.contains("line 3: column `y`: `zero` is not a number"), "{t}");
+    assert!(
+        t.contains("outside engine \"pure_python\"")
+            && t.contains("line 3: column `y`: `zero` is not a number"),
+        "{t}"
+    );
     assert!(!written);
 }
 
@@ -167,11 +205,18 @@ fn an_adapter_past_its_timeout_is_killed_and_named() {
     );
     let t = text(&o);
     assert_eq!(o.status.code(), Some(2), "{t}");
-    assert!(t.contains("outside engine \"pure_python\"") && t.contains("timeout of 1 s: killed"), "{t}");
+    assert!(
+        t.contains("outside engine \"pure_python\"") && t.contains("timeout of 1 s: killed"),
+        "{t}"
+    );
     assert!(t.contains("thinking"), "{t}");
     assert!(!written);
     // Killed at the first timeout, not once per ladder rung.
-    assert!(start.elapsed().as_secs_f64() < 30.0, "{:?}", start.elapsed());
+    assert!(
+        start.elapsed().as_secs_f64() < 30.0,
+        "{:?}",
+        start.elapsed()
+    );
 }
 
 #[test]
@@ -179,7 +224,10 @@ fn a_missing_program_says_how_to_get_it() {
     let (o, _) = run_with(&["python3-not-installed-anywhere", "x.py"], "");
     let t = text(&o);
     assert_eq!(o.status.code(), Some(2), "{t}");
-    assert!(t.contains("run.gate[0]") && t.contains("python3-not-installed-anywhere on PATH"), "{t}");
+    assert!(
+        t.contains("run.gate[0]") && t.contains("python3-not-installed-anywhere on PATH"),
+        "{t}"
+    );
     assert!(t.contains("install Python 3"), "{t}");
 }
 
@@ -201,18 +249,37 @@ fn a_scenario_cannot_define_an_engine() {
     );
     let sc = dir.path().join("evil.toml");
     std::fs::write(&sc, evil).unwrap();
-    let o = pushval().arg("validate").arg(&sc).current_dir(dir.path()).output().unwrap();
+    let o = pushval()
+        .arg("validate")
+        .arg(&sc)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
     let t = text(&o);
     assert_eq!(o.status.code(), Some(2), "{t}");
-    assert!(t.contains("run.models[1]") && t.contains("unknown model \"evil\""), "{t}");
-    assert!(t.contains("pushval.toml (not found)"), "the file searched: {t}");
+    assert!(
+        t.contains("run.models[1]") && t.contains("unknown model \"evil\""),
+        "{t}"
+    );
+    assert!(
+        t.contains("pushval.toml (not found)"),
+        "the file searched: {t}"
+    );
     assert!(!marker.exists());
     let gated = base.replace("[run]\n", "[run]\ngate = [\"evil\"]\n");
     std::fs::write(&sc, gated).unwrap();
-    let o = pushval().arg("validate").arg(&sc).current_dir(dir.path()).output().unwrap();
+    let o = pushval()
+        .arg("validate")
+        .arg(&sc)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
     let t = text(&o);
     assert_eq!(o.status.code(), Some(2), "{t}");
-    assert!(t.contains("run.gate[0]") && t.contains("pushval.toml (not found)"), "{t}");
+    assert!(
+        t.contains("run.gate[0]") && t.contains("pushval.toml (not found)"),
+        "{t}"
+    );
 }
 
 #[test]
@@ -237,10 +304,23 @@ fn problem_prints_the_document() {
 fn a_bad_engines_file_is_an_input_error() {
     let dir = tempfile::tempdir().unwrap();
     let f = engines_file(dir.path(), &["python3"], "shell = true\n");
-    let o = pushval().arg("engines").arg("--engines").arg(&f).output().unwrap();
+    let o = pushval()
+        .arg("engines")
+        .arg("--engines")
+        .arg(&f)
+        .output()
+        .unwrap();
     let t = text(&o);
     assert_eq!(o.status.code(), Some(2), "{t}");
-    assert!(t.contains("engines.toml: engine.pure_python.shell: unknown key"), "{t}");
-    let o = pushval().arg("engines").arg("--engines").arg(dir.path().join("none.toml")).output().unwrap();
+    assert!(
+        t.contains("engines.toml: engine.pure_python.shell: unknown key"),
+        "{t}"
+    );
+    let o = pushval()
+        .arg("engines")
+        .arg("--engines")
+        .arg(dir.path().join("none.toml"))
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }

@@ -161,7 +161,10 @@ impl Config {
                 ));
             }
             let Some(tables) = value.as_table() else {
-                return Err(err("engine", "must be a table of [engine.NAME] tables".into()));
+                return Err(err(
+                    "engine",
+                    "must be a table of [engine.NAME] tables".into(),
+                ));
             };
             for (name, t) in tables {
                 engines.push(spec(name, t, file, &dir)?);
@@ -205,7 +208,12 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
         }
     }
     let command: Vec<String> = match t.get("command") {
-        None => return Err(err("command", "missing: the program and its arguments, e.g. [\"python3\", \"adapter.py\"]".into())),
+        None => {
+            return Err(err(
+                "command",
+                "missing: the program and its arguments, e.g. [\"python3\", \"adapter.py\"]".into(),
+            ))
+        }
         Some(toml::Value::Array(a)) => a
             .iter()
             .map(|v| {
@@ -214,7 +222,12 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
                     .ok_or_else(|| err("command", format!("must be an array of strings, got {v}")))
             })
             .collect::<Result<_, _>>()?,
-        Some(v) => return Err(err("command", format!("must be an array of strings, got {v}"))),
+        Some(v) => {
+            return Err(err(
+                "command",
+                format!("must be an array of strings, got {v}"),
+            ))
+        }
     };
     if command.first().is_none_or(|p| p.trim().is_empty()) {
         return Err(err("command", "must name a program first".into()));

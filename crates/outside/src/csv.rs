@@ -66,11 +66,13 @@ pub fn read<'a>(
         .collect::<Vec<_>>()
         .join(",");
     let find = |name: &str| {
-        cols.iter().position(|c| *c == name).ok_or_else(|| CsvError {
-            line: h + 1,
-            column: None,
-            problem: format!("the header lacks the column `{name}` (need {need})"),
-        })
+        cols.iter()
+            .position(|c| *c == name)
+            .ok_or_else(|| CsvError {
+                line: h + 1,
+                column: None,
+                problem: format!("the header lacks the column `{name}` (need {need})"),
+            })
     };
     let il: Vec<usize> = labels.iter().map(|c| find(c)).collect::<Result<_, _>>()?;
     let inum: Vec<usize> = numbers.iter().map(|c| find(c)).collect::<Result<_, _>>()?;

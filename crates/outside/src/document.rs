@@ -24,7 +24,12 @@ const DEFAULT_GRAVITY: f64 = 9.81;
 /// 9.81 m/s² and the loads share `m g` in proportion to the friction.
 /// `options` is the scenario's `[engine]` table verbatim (`dt` included when
 /// set).
-pub fn problem_document(engine: &str, problem: &Problem, options: &EngineOptions, dt: f64) -> Value {
+pub fn problem_document(
+    engine: &str,
+    problem: &Problem,
+    options: &EngineOptions,
+    dt: f64,
+) -> Value {
     let body = &problem.body;
     let m = body.mass();
     let supports: Vec<_> = body.supports().collect();
@@ -64,7 +69,9 @@ pub fn problem_document(engine: &str, problem: &Problem, options: &EngineOptions
                 .chain(std::iter::once([body.contact().x, body.contact().y]))
                 .collect();
             pts = convex_hull(&mut pts);
-            pts.iter().map(|p| [p[0] + offset[0], p[1] + offset[1]]).collect()
+            pts.iter()
+                .map(|p| [p[0] + offset[0], p[1] + offset[1]])
+                .collect()
         }
     };
     let times = problem.segment_times();
@@ -134,7 +141,9 @@ fn convex_hull(pts: &mut [[f64; 2]]) -> Vec<[f64; 2]> {
             Box::new(uniq.iter().rev())
         };
         for &p in iter {
-            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
                 hull.pop();
             }
             hull.push(p);

@@ -30,10 +30,10 @@ impl OutsideEngine {
     /// The engine `spec` declares, with the scenario's `[engine]` options
     /// (passed verbatim in the document's `options`).
     pub fn new(spec: Arc<Spec>, options: &EngineOptions) -> Self {
-        let file = spec
-            .file
-            .file_name()
-            .map_or_else(|| spec.file.display().to_string(), |f| f.to_string_lossy().into_owned());
+        let file = spec.file.file_name().map_or_else(
+            || spec.file.display().to_string(),
+            |f| f.to_string_lossy().into_owned(),
+        );
         Self {
             adapter: format!("outside: {file}"),
             description: format!(

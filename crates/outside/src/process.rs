@@ -91,7 +91,9 @@ pub fn run_process(
         Ok((buf, _)) => buf,
         Err(_) => {
             kill(&mut child);
-            let stderr = erx.recv_timeout(Duration::from_millis(200)).unwrap_or_default();
+            let stderr = erx
+                .recv_timeout(Duration::from_millis(200))
+                .unwrap_or_default();
             return Err(ProcessError {
                 what: format!(
                     "still running after its timeout of {} s: killed",
@@ -107,7 +109,9 @@ pub fn run_process(
             Ok(Some(s)) => break s,
             Ok(None) if Instant::now() >= deadline => {
                 kill(&mut child);
-                let stderr = erx.recv_timeout(Duration::from_millis(200)).unwrap_or_default();
+                let stderr = erx
+                    .recv_timeout(Duration::from_millis(200))
+                    .unwrap_or_default();
                 return Err(ProcessError {
                     what: format!(
                         "closed its standard output but was still running after its timeout of {} s: killed",

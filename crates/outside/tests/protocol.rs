@@ -26,32 +26,73 @@ fn pushval_toml_defaults_and_folder() {
 #[test]
 fn pushval_toml_errors_name_file_and_key() {
     for (text, key) in [
-        ("[engine.a]\ncommand = [\"x\"]\nshell = true\n", "engine.a.shell"),
+        (
+            "[engine.a]\ncommand = [\"x\"]\nshell = true\n",
+            "engine.a.shell",
+        ),
         ("[engine.a]\norder = 1\n", "engine.a.command"),
-        ("[engine.a]\ncommand = \"python3 a.py\"\n", "engine.a.command"),
+        (
+            "[engine.a]\ncommand = \"python3 a.py\"\n",
+            "engine.a.command",
+        ),
         ("[engine.a]\ncommand = []\n", "engine.a.command"),
         ("[engine.a]\ncommand = [\"x\"]\ndt = -1\n", "engine.a.dt"),
-        ("[engine.a]\ncommand = [\"x\"]\ntimeout_s = \"long\"\n", "engine.a.timeout_s"),
+        (
+            "[engine.a]\ncommand = [\"x\"]\ntimeout_s = \"long\"\n",
+            "engine.a.timeout_s",
+        ),
         ("[engine.\"a b\"]\ncommand = [\"x\"]\n", "engine.a b"),
         ("[models]\nx = 1\n", "models"),
     ] {
         let e = cfg(text).unwrap_err();
-        assert!(e.starts_with("/proj/pushval.toml: ") && e.contains(&format!("{key}:")), "{e}");
+        assert!(
+            e.starts_with("/proj/pushval.toml: ") && e.contains(&format!("{key}:")),
+            "{e}"
+        );
     }
 }
 
 #[test]
 fn malformed_rows_name_line_and_column() {
-    let e = csv::read("t,x,y,theta,omega\n0,0,0,0,0\n0.1,abc,0,0,0\n", &[], &["t", "x", "y", "theta", "omega"]).unwrap_err();
+    let e = csv::read(
+        "t,x,y,theta,omega\n0,0,0,0,0\n0.1,abc,0,0,0\n",
+        &[],
+        &["t", "x", "y", "theta", "omega"],
+    )
+    .unwrap_err();
     assert_eq!(e.to_string(), "line 3: column `x`: `abc` is not a number");
-    let e = csv::read("t,x,y,theta\n0,0,0,0\n", &[], &["t", "x", "y", "theta", "omega"]).unwrap_err();
-    assert!(e.to_string().starts_with("line 1: the header lacks the column `omega`"), "{e}");
-    let e = csv::read("t,x,y,theta,omega\n0,0,0,0\n", &[], &["t", "x", "y", "theta", "omega"]).unwrap_err();
+    let e = csv::read(
+        "t,x,y,theta\n0,0,0,0\n",
+        &[],
+        &["t", "x", "y", "theta", "omega"],
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("line 1: the header lacks the column `omega`"),
+        "{e}"
+    );
+    let e = csv::read(
+        "t,x,y,theta,omega\n0,0,0,0\n",
+        &[],
+        &["t", "x", "y", "theta", "omega"],
+    )
+    .unwrap_err();
     assert_eq!(e.to_string(), "line 2: 4 fields, the header has 5");
-    let e = csv::read("t,x,y,theta,omega\n0,0,0,inf,0\n", &[], &["t", "x", "y", "theta", "omega"]).unwrap_err();
+    let e = csv::read(
+        "t,x,y,theta,omega\n0,0,0,inf,0\n",
+        &[],
+        &["t", "x", "y", "theta", "omega"],
+    )
+    .unwrap_err();
     assert_eq!(e.to_string(), "line 2: column `theta`: inf is not finite");
     // Extra columns and their order do not matter.
-    let r = csv::read("omega,t,extra,x,y,theta\n4,0,z,1,2,3\n", &[], &["t", "x", "y", "theta", "omega"]).unwrap();
+    let r = csv::read(
+        "omega,t,extra,x,y,theta\n4,0,z,1,2,3\n",
+        &[],
+        &["t", "x", "y", "theta", "omega"],
+    )
+    .unwrap();
     assert_eq!(r[0].numbers, vec![0.0, 1.0, 2.0, 3.0, 4.0]);
 }
 
@@ -81,7 +122,10 @@ fn rows_become_steps_covering_the_run() {
     // Short of the end.
     let text = rows_text(&ts[..900]);
     let e = history_from_rows(&p, &csv::read(&text, &[], &cols).unwrap()).unwrap_err();
-    assert!(e.contains("line 901") && e.contains("before the end"), "{e}");
+    assert!(
+        e.contains("line 901") && e.contains("before the end"),
+        "{e}"
+    );
     // Not from 0, or not increasing.
     let text = rows_text(&ts[1..]);
     let e = history_from_rows(&p, &csv::read(&text, &[], &cols).unwrap()).unwrap_err();

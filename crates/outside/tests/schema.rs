@@ -14,7 +14,8 @@ fn root() -> PathBuf {
 }
 
 fn schema() -> Value {
-    let text = std::fs::read_to_string(root().join("adapters/pushval-problem-1.schema.json")).unwrap();
+    let text =
+        std::fs::read_to_string(root().join("adapters/pushval-problem-1.schema.json")).unwrap();
     serde_json::from_str(&text).unwrap()
 }
 
@@ -139,7 +140,11 @@ fn the_validator_rejects_broken_documents() {
 /// loads and μ as resolved, points not shifted to the centre of mass.
 #[test]
 fn the_document_carries_the_scenario_in_its_own_frame() {
-    for file in ["paper-square-v1.0.toml", "triangle-statics.toml", "printed-inertia-v1.0.toml"] {
+    for file in [
+        "paper-square-v1.0.toml",
+        "triangle-statics.toml",
+        "printed-inertia-v1.0.toml",
+    ] {
         let (sc, doc) = doc_of(file, 2.5e-4);
         assert_eq!(doc["dt"], 2.5e-4);
         assert_eq!(doc["engine"], "mysim");
@@ -149,13 +154,26 @@ fn the_document_carries_the_scenario_in_its_own_frame() {
         assert_eq!(com[0], sc.center_of_mass.x, "{file}");
         assert_eq!(com[1], sc.center_of_mass.y, "{file}");
         for (s, d) in sc.supports.iter().zip(doc["supports"].as_array().unwrap()) {
-            let close = |a: &Value, b: f64| (a.as_f64().unwrap() - b).abs() <= 1e-12 * b.abs().max(1.0);
-            assert!(close(&d["point"][0], s.position.x) && close(&d["point"][1], s.position.y), "{file}");
-            assert!(close(&d["mu"], s.mu) && close(&d["normal_force"], s.load), "{file}: {d}");
+            let close =
+                |a: &Value, b: f64| (a.as_f64().unwrap() - b).abs() <= 1e-12 * b.abs().max(1.0);
+            assert!(
+                close(&d["point"][0], s.position.x) && close(&d["point"][1], s.position.y),
+                "{file}"
+            );
+            assert!(
+                close(&d["mu"], s.mu) && close(&d["normal_force"], s.load),
+                "{file}: {d}"
+            );
         }
         let c = &doc["contact"]["point"];
-        assert!((c[0].as_f64().unwrap() - sc.contact.x).abs() < 1e-12, "{file}");
-        assert!((c[1].as_f64().unwrap() - sc.contact.y).abs() < 1e-12, "{file}");
+        assert!(
+            (c[0].as_f64().unwrap() - sc.contact.x).abs() < 1e-12,
+            "{file}"
+        );
+        assert!(
+            (c[1].as_f64().unwrap() - sc.contact.y).abs() < 1e-12,
+            "{file}"
+        );
         assert_eq!(doc["pushes"].as_array().unwrap().len(), sc.pushes.len());
         assert_eq!(doc["initial"]["from_rest"], sc.initial.from_rest);
     }
@@ -170,7 +188,12 @@ fn without_a_scene_the_loads_sum_to_the_weight() {
     let doc = problem_document("x", &sc.problem(), &Default::default(), 1e-3);
     assert_eq!(errors(&doc), Vec::<String>::new());
     let body = sc.problem().body;
-    let n: f64 = doc["supports"].as_array().unwrap().iter().map(|s| s["normal_force"].as_f64().unwrap()).sum();
+    let n: f64 = doc["supports"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["normal_force"].as_f64().unwrap())
+        .sum();
     assert!((n - body.mass() * 9.81).abs() < 1e-9);
     for (s, d) in body.supports().zip(doc["supports"].as_array().unwrap()) {
         let f = d["mu"].as_f64().unwrap() * d["normal_force"].as_f64().unwrap();
