@@ -108,7 +108,7 @@ fn main() {
     let repeats = if quick { 1 } else { 5 };
     let mut rows = Vec::new();
     for entry in registry::entries() {
-        let engine = (entry.build)(&Default::default()).expect("default options");
+        let engine = entry.build(&Default::default()).expect("default options");
         if let Err(why) = engine.availability() {
             eprintln!("{}: skipped ({why})", entry.name);
             continue;

@@ -20,6 +20,11 @@ use pushval_scenario::Scenario;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Outside engines: the pushval.toml-format file declaring them (default:
+    /// ./pushval.toml when present). Trusted like a build script: its
+    /// commands run.
+    #[arg(long, global = true, value_name = "FILE")]
+    engines: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -138,6 +143,19 @@ enum Command {
         /// Only the paper scenario at 1 m/s, coarser bisection (for tests).
         #[arg(long)]
         quick: bool,
+    },
+    /// Print the pushval-problem/1 JSON document an outside engine receives
+    /// for this scenario (adapters/pushval-problem-1.schema.json).
+    Problem {
+        file: PathBuf,
+        /// The time step written into the document (s); default the
+        /// scenario's [engine] dt, else 1e-3.
+        #[arg(long, value_name = "H")]
+        dt: Option<f64>,
+        /// The engine name written into the document; default the
+        /// scenario's first gated engine.
+        #[arg(long, value_name = "NAME")]
+        engine: Option<String>,
     },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
@@ -269,6 +287,22 @@ fn compare(file: PathBuf, csv: PathBuf) -> anyhow::Result<ExitCode> {
     })
 }
 
+fn problem(file: PathBuf, dt: Option<f64>, engine: Option<String>) -> anyhow::Result<ExitCode> {
+    let sc = pushval::registry::load(&file)?;
+    let dt = dt
+        .or(sc.engine.dt)
+        .unwrap_or(pushval::registry::OUTSIDE_DEFAULT_DT);
+    if !(dt.is_finite() && dt > 0.0) {
+        bail!("--dt must be a finite number > 0, got {dt}");
+    }
+    let engine = engine
+        .or_else(|| sc.gate.first().cloned())
+        .unwrap_or_default();
+    let doc = pushval::registry::problem_document(&engine, &sc.problem(), &sc.engine, dt);
+    println!("{}", serde_json::to_string_pretty(&doc)?);
+    Ok(ExitCode::SUCCESS)
+}
+
 fn stress(out: PathBuf, quick: bool) -> anyhow::Result<ExitCode> {
     let cases = if quick {
         pushval::stress::quick_grid()
@@ -291,10 +325,15 @@ fn stress(out: PathBuf, quick: bool) -> anyhow::Result<ExitCode> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = pushval::registry::use_engines_file(cli.engines.as_deref()) {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     let result = match cli.command {
         None => validate(Vec::new(), false, None),
         Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Problem { file, dt, engine }) => problem(file, dt, engine),
         Some(Command::Power { out, quick }) => pushval::power::cli(&out, quick),
         Some(Command::Fit {
             file,

@@ -5,8 +5,18 @@
 //! crate, one row here, and its Cargo entries (the workspace dependency, the
 //! root package's dependency and, for heavy engines, a feature). Nothing else
 //! in the harness, the studies or the benches names an engine.
+//!
+//! After the crates' rows come the outside engines of the `pushval.toml` the
+//! command line loaded ([`use_engines_file`]): processes speaking the
+//! `pushval-problem/1` protocol (crate `pushval-outside`). Their constructor
+//! is the only place they differ from a compiled-in engine.
 
-use pushval_engine::{Engine, EngineOptions, ModelEntry};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, RwLock};
+
+use pushval_engine::{Build, Engine, EngineOptions, ModelEntry, OptionError};
+pub use pushval_outside::{csv, problem_document, DEFAULT_DT as OUTSIDE_DEFAULT_DT};
+use pushval_outside::{Config, OutsideEngine, Spec};
 use pushval_scenario::{Scenario, ScenarioError, ANALYTIC_MODELS};
 
 /// The engine crates' model tables, one row per crate.
@@ -20,13 +30,133 @@ pub const ENGINE_CRATES: &[fn() -> Vec<ModelEntry>] = &[
     pushval_jolt::models,
 ];
 
-/// Every engine model, in registry order.
-pub fn entries() -> Vec<ModelEntry> {
+/// The file outside engines are declared in when `--engines` names none:
+/// `pushval.toml` in the current directory.
+pub const ENGINES_FILE: &str = "pushval.toml";
+
+/// The outside engines in use: the file searched and what it declared
+/// (None: the file does not exist).
+#[derive(Debug, Clone)]
+struct Outside {
+    searched: PathBuf,
+    config: Option<Config>,
+}
+
+static OUTSIDE: RwLock<Option<Outside>> = RwLock::new(None);
+
+/// Loads the outside engines: `file` (from `--engines`; it must exist), or
+/// [`ENGINES_FILE`] in the current directory when present. A name that is
+/// already an analytic model or a compiled-in engine is refused, naming the
+/// file and the key. Replaces what an earlier call loaded.
+pub fn use_engines_file(file: Option<&Path>) -> Result<(), pushval_outside::ConfigError> {
+    let (searched, required) = match file {
+        Some(f) => (f.to_path_buf(), true),
+        None => (PathBuf::from(ENGINES_FILE), false),
+    };
+    let searched = std::path::absolute(&searched).unwrap_or(searched);
+    let config = if required || searched.is_file() {
+        let c = Config::from_path(&searched)?;
+        let crates = crate_entries();
+        for spec in &c.engines {
+            if ANALYTIC_MODELS.contains(&spec.name.as_str())
+                || crates.iter().any(|e| e.name == spec.name)
+            {
+                return Err(pushval_outside::ConfigError {
+                    file: c.file.clone(),
+                    key: format!("engine.{}", spec.name),
+                    problem: "this name is already a built-in model; choose another".into(),
+                });
+            }
+        }
+        Some(c)
+    } else {
+        None
+    };
+    *OUTSIDE.write().expect("not poisoned") = Some(Outside { searched, config });
+    Ok(())
+}
+
+/// Where outside engines were looked for, for messages: the file and
+/// whether it exists.
+pub fn engines_file() -> String {
+    match OUTSIDE.read().expect("not poisoned").as_ref() {
+        Some(Outside {
+            searched,
+            config: Some(_),
+        }) => searched.display().to_string(),
+        Some(Outside {
+            searched,
+            config: None,
+        }) => format!("{} (not found)", searched.display()),
+        None => "none loaded".to_string(),
+    }
+}
+
+/// One engine model the registry can build: a crate's row or an outside
+/// engine.
+#[derive(Clone)]
+pub struct Entry {
+    /// The model name.
+    pub name: String,
+    build: Builder,
+}
+
+#[derive(Clone)]
+enum Builder {
+    Crate(Build),
+    Outside(Arc<Spec>),
+}
+
+impl std::fmt::Debug for Entry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Entry").field("name", &self.name).finish()
+    }
+}
+
+impl Entry {
+    /// The model built from a scenario's `[engine]` options.
+    pub fn build(&self, options: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
+        match &self.build {
+            Builder::Crate(b) => b(options),
+            Builder::Outside(spec) => Ok(Box::new(OutsideEngine::new(spec.clone(), options))),
+        }
+    }
+    /// The model with default options (for listings).
+    pub fn default_engine(&self) -> Box<dyn Engine> {
+        self.build(&EngineOptions::default())
+            .expect("default options are valid for every engine")
+    }
+}
+
+/// The compiled-in engine models, in registry order.
+fn crate_entries() -> Vec<ModelEntry> {
     ENGINE_CRATES.iter().flat_map(|models| models()).collect()
 }
 
+/// Every engine model, in registry order: the crates', then the outside
+/// engines loaded by [`use_engines_file`].
+pub fn entries() -> Vec<Entry> {
+    let mut out: Vec<Entry> = crate_entries()
+        .into_iter()
+        .map(|e| Entry {
+            name: e.name.to_string(),
+            build: Builder::Crate(e.build),
+        })
+        .collect();
+    if let Some(Outside {
+        config: Some(c), ..
+    }) = OUTSIDE.read().expect("not poisoned").as_ref()
+    {
+        out.extend(c.engines.iter().map(|s| Entry {
+            name: s.name.clone(),
+            build: Builder::Outside(Arc::new(s.clone())),
+        }));
+    }
+    out
+}
+
 /// The engine model called `name`, if the registry has one.
-pub fn entry(name: &str) -> Option<ModelEntry> {
+pub fn entry(name: &str) -> Option<Entry> {
     entries().into_iter().find(|e| e.name == name)
 }
 
@@ -39,15 +169,16 @@ pub fn is_engine(name: &str) -> bool {
 /// Panics on an unknown name or bad options: [`check`] refuses both at load.
 pub fn engine(name: &str, options: &EngineOptions) -> Box<dyn Engine> {
     let e = entry(name).unwrap_or_else(|| panic!("`{name}` is not in the engine registry"));
-    (e.build)(options).unwrap_or_else(|e| panic!("engine options were checked at load: {e}"))
+    e.build(options)
+        .unwrap_or_else(|e| panic!("engine options were checked at load: {e}"))
 }
 
 /// Every model name a scenario may list: the analytic models, then the engines.
-pub fn known_models() -> Vec<&'static str> {
+pub fn known_models() -> Vec<String> {
     ANALYTIC_MODELS
         .iter()
-        .copied()
-        .chain(entries().iter().map(|e| e.name))
+        .map(|m| m.to_string())
+        .chain(entries().into_iter().map(|e| e.name))
         .collect()
 }
 
@@ -59,16 +190,17 @@ pub fn check(sc: &Scenario) -> Result<(), ScenarioError> {
     let engines = entries();
     for (i, g) in sc.gate.iter().enumerate() {
         let key = format!("run.gate[{i}]");
-        let Some(e) = engines.iter().find(|e| e.name == g) else {
+        let Some(e) = engines.iter().find(|e| e.name == *g) else {
             return Err(err(
                 &key,
                 format!(
-                    "unknown engine \"{g}\"; a gate names an engine model: {}",
+                    "unknown engine \"{g}\"; a gate names an engine model: {}; outside engines are declared in pushval.toml or the --engines file, never in a scenario (searched: {})",
                     engines
                         .iter()
-                        .map(|e| e.name)
+                        .map(|e| e.name.as_str())
                         .collect::<Vec<_>>()
-                        .join(", ")
+                        .join(", "),
+                    engines_file()
                 ),
             ));
         };
@@ -85,19 +217,29 @@ pub fn check(sc: &Scenario) -> Result<(), ScenarioError> {
     }
     let known = known_models();
     for (i, m) in sc.models.iter().enumerate() {
-        if !known.contains(&m.as_str()) {
+        if !known.contains(m) {
             return Err(err(
                 &format!("run.models[{i}]"),
-                format!("unknown model \"{m}\"; known: {}", known.join(", ")),
+                format!(
+                    "unknown model \"{m}\"; known: {}; outside engines are declared in pushval.toml or the --engines file, never in a scenario (searched: {})",
+                    known.join(", "),
+                    engines_file()
+                ),
             ));
         }
     }
-    // Every `[engine]` key must be read by some engine; every listed engine
-    // must accept the values.
+    // Every `[engine]` key must be read by some compiled-in engine or by an
+    // engine the scenario lists; every listed engine must accept the values.
+    let listed: Vec<Box<dyn Engine>> = engines
+        .iter()
+        .filter(|e| sc.models.contains(&e.name) || sc.gate.contains(&e.name))
+        .map(Entry::default_engine)
+        .collect();
     for key in sc.engine.values.keys() {
         if !engines
             .iter()
             .any(|e| e.default_engine().option_keys().contains(&key.as_str()))
+            && !listed.iter().any(|e| e.accepts_option(key))
         {
             let mut all: Vec<&str> = vec!["dt"];
             for e in &engines {
@@ -114,8 +256,9 @@ pub fn check(sc: &Scenario) -> Result<(), ScenarioError> {
         }
     }
     for m in &sc.models {
-        if let Some(e) = engines.iter().find(|e| e.name == m) {
-            (e.build)(&sc.engine).map_err(|o| err(&format!("engine.{}", o.key), o.problem))?;
+        if let Some(e) = engines.iter().find(|e| e.name == *m) {
+            e.build(&sc.engine)
+                .map_err(|o| err(&format!("engine.{}", o.key), o.problem))?;
         }
     }
     Ok(())
@@ -135,7 +278,7 @@ pub fn engines_table() -> String {
         .map(|e| {
             let engine = e.default_engine();
             [
-                e.name.to_string(),
+                e.name.clone(),
                 engine.adapter().to_string(),
                 engine.version(),
                 format!("{}", engine.order()),

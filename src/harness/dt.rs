@@ -254,7 +254,10 @@ pub fn choose_engine_dt(
     if let Some(dt) = sc.engine.dt {
         // Kept exactly; the run at 2 dt gives the estimate an auto tolerance
         // needs (and is the convergence check's first partner).
-        let (a, b) = (engine.run(problem, 2.0 * dt)?, engine.run(problem, dt)?);
+        // The two runs are independent: side by side (an outside engine's
+        // are two processes).
+        let (a, b) = rayon::join(|| engine.run(problem, 2.0 * dt), || engine.run(problem, dt));
+        let (a, b) = (a?, b?);
         let est = dt_estimate(sc, segments, dt, &a.trajectory, &b.trajectory, order);
         return Ok((
             DtChoice {
@@ -279,6 +282,20 @@ pub fn choose_engine_dt(
         runs.push(engine.run(problem, dt)?);
         Ok(runs.len() - 1)
     };
+    // The first rung's two runs are independent: side by side.
+    if let [top, ..] = ladder[..] {
+        let (a, b) = rayon::join(
+            || engine.run(problem, 2.0 * top),
+            || engine.run(problem, top),
+        );
+        for r in [a, b] {
+            match r {
+                Ok(r) => runs.push(r),
+                Err(e @ ModelError::Adapter(_)) => return Err(e),
+                Err(_) => {}
+            }
+        }
+    }
     let mut last_err = None;
     let mut announced = false;
     for (i, &h) in ladder.iter().enumerate() {
@@ -295,6 +312,8 @@ pub fn choose_engine_dt(
         let pair = run_at(2.0 * h, &mut runs).and_then(|a| Ok((a, run_at(h, &mut runs)?)));
         let (a, b) = match pair {
             Ok(p) => p,
+            // The engine could not run at all: no rung will do better.
+            Err(e @ ModelError::Adapter(_)) => return Err(e),
             Err(e) => {
                 last_err = Some(e);
                 continue;
@@ -358,6 +377,7 @@ pub fn engine_convergence(
         richardson1_rel_max: 0.0,
         richardson2_rel_max: 0.0,
         plain_rel_max: 0.0,
+        diff_rel: Vec::new(),
     };
     for s in segments.iter().filter(|s| s.settles()) {
         // The same reading (tail mean) of the dynamic model: within 1e-6 of ω*
@@ -381,6 +401,8 @@ pub fn engine_convergence(
         out.richardson1_rel_max = out.richardson1_rel_max.max(e(r1));
         out.richardson2_rel_max = out.richardson2_rel_max.max(e(r2));
         out.plain_rel_max = out.plain_rel_max.max(e(w1));
+        out.diff_rel
+            .push((s.index, rel_err(w2, w1, s.speed, sc.froude_length())));
     }
     Ok(out)
 }

@@ -148,6 +148,10 @@ pub struct Convergence {
     pub richardson2_rel_max: f64,
     /// The same for the plain run at h.
     pub plain_rel_max: f64,
+    /// Per settled segment, `|ω(2h) − ω(h)|` relative (with [`rel_err`]'s
+    /// floor): below the auto target the order is not resolved (the
+    /// difference is at the level of the tail mean's own noise).
+    pub diff_rel: Vec<(usize, f64)>,
 }
 
 impl Convergence {
@@ -602,6 +606,9 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
                     settings,
                 });
             }
+            // An engine that could not run at all (an outside process that
+            // failed, timed out or wrote malformed rows) is an input error.
+            Err(e @ ModelError::Adapter(_)) => return Err(e),
             Err(e) => failures.push((name.to_string(), e.to_string())),
         }
     }

@@ -229,14 +229,26 @@ pub fn resolve(sc: &Scenario, estimate: Option<&DtEstimate>, model_error: Figure
 pub const ORDER_BAND: f64 = 0.5;
 
 /// The sentence that refuses auto tolerances when the observed order
-/// (median over the settled segments, runs at 4h, 2h, h) strays from the
+/// (median over the settled segments whose `|ω(2h) − ω(h)|` is at least
+/// the auto target, runs at 4h, 2h, h) strays from the
 /// declared one by more than [`ORDER_BAND`]; None when it does not, or when
 /// no figure is auto, or no segment settles.
 pub fn order_problem(res: &Resolved, conv: &super::Convergence) -> Option<String> {
     if !res.source.contains(&Source::Auto) {
         return None;
     }
-    let observed = conv.order()?;
+    // Only segments whose ω(2h) − ω(h) is resolved: below the auto target
+    // the auto tolerance sits on its floor whatever the order, and the
+    // ratio of two differences at the tail mean's noise level is no order.
+    let mut o: Vec<f64> = conv
+        .orders
+        .iter()
+        .zip(&conv.diff_rel)
+        .filter(|(p, d)| p.1.is_finite() && d.1 >= AUTO_TARGET.omega_steady_rel)
+        .map(|(p, _)| p.1)
+        .collect();
+    o.sort_by(f64::total_cmp);
+    let observed = *o.get(o.len() / 2)?;
     let declared = conv.expected_order;
     (!((observed - declared).abs() <= ORDER_BAND)).then(|| {
         format!(

@@ -657,7 +657,7 @@ fn switching_figure(base: &Scenario, w: &mut Writer) -> anyhow::Result<Entry> {
         {
             let e = reference_engine(&sc);
             e.run(&impulsive, e.default_dt())
-                .with_context(|| e.name())?
+                .with_context(|| e.name().to_string())?
                 .trajectory
         },
     );

@@ -90,8 +90,20 @@ pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Loads a scenario with the repository's outside engines (pushval.toml)
+/// in the registry, as the command line run from the repository does.
 pub fn load(p: &Path) -> Scenario {
+    use_repo_engines();
     pushval::registry::load(p).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Loads the repository's pushval.toml into the registry (once).
+pub fn use_repo_engines() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        pushval::registry::use_engines_file(Some(&root().join("pushval.toml")))
+            .unwrap_or_else(|e| panic!("{e}"))
+    });
 }
 
 /// The paper plate with one heavily loaded corner (−a, a) on the line through

@@ -82,7 +82,7 @@ fn engines_lists_one_row_per_engine_model() {
         let engine = e.default_engine();
         let row = out
             .lines()
-            .find(|l| l.split_whitespace().next() == Some(e.name))
+            .find(|l| l.split_whitespace().next() == Some(e.name.as_str()))
             .unwrap_or_else(|| panic!("no row for {}:\n{out}", e.name));
         assert!(row.contains(engine.adapter()), "{row}");
         assert!(row.contains(&engine.version()), "{row}");

@@ -10,6 +10,7 @@ mod engines;
 mod fit;
 mod gate;
 mod kappa;
+mod outside;
 mod power;
 mod properties;
 mod report;

@@ -23,7 +23,7 @@ use pushval_model::{ModelError, Problem, Trajectory};
 mod options;
 mod resample;
 
-pub use options::{EngineOptions, OptionError};
+pub use options::{EngineOptions, OptionError, SceneFrame};
 pub use resample::{
     resample, sample, segment_reports, step_tail_omega, tail_mean_omega, trajectory_from_steps,
     StepRecord,
@@ -59,11 +59,14 @@ pub struct EngineCrate {
 /// time step. Implemented by each engine crate; used through `dyn Engine`.
 pub trait Engine: Send + Sync {
     /// The model name used in scenarios and outputs (`"rapier2d"`, …).
-    fn name(&self) -> &'static str;
+    /// Compiled-in adapters return a `&'static str`; an outside engine
+    /// (declared in `pushval.toml`) returns the name it was declared under.
+    fn name(&self) -> &str;
     /// One line saying what the model is (scene and friction law).
-    fn description(&self) -> &'static str;
-    /// The adapter crate (`pushval-rapier2d`, …).
-    fn adapter(&self) -> &'static str;
+    fn description(&self) -> &str;
+    /// The adapter crate (`pushval-rapier2d`, …), or where an outside
+    /// engine was declared (`outside: pushval.toml`).
+    fn adapter(&self) -> &str;
     /// The engine crate this adapter depends on, with its version.
     fn engine_crate(&self) -> EngineCrate;
     /// The engine's version as shown to users; defaults to the engine crate's
@@ -91,6 +94,12 @@ pub trait Engine: Send + Sync {
     /// The `[engine]` keys this model reads, besides `dt`.
     fn option_keys(&self) -> &'static [&'static str] {
         &[]
+    }
+    /// Whether the model reads the `[engine]` key `key`: by default, whether
+    /// [`Engine::option_keys`] lists it. An outside engine receives the whole
+    /// table verbatim and accepts every key.
+    fn accepts_option(&self, key: &str) -> bool {
+        self.option_keys().contains(&key)
     }
     /// The settings that produce a run at `dt`, as JSON for the outputs
     /// (includes `"engine"`: the version, and `"dt"`).

@@ -13,6 +13,27 @@ pub struct EngineOptions {
     pub dt: Option<f64>,
     /// The other keys with their values.
     pub values: BTreeMap<String, serde_json::Value>,
+    /// What the scenario file says about the scene beyond the
+    /// [`pushval_model::Problem`] (its frame, outline, gravity and loads), for
+    /// adapters that hand the scene to another program; None when the
+    /// options were not read from a scenario.
+    pub scene: Option<SceneFrame>,
+}
+
+/// The scenario's own description of the scene, which the
+/// [`pushval_model::Problem`] (centre-of-mass frame, friction magnitudes
+/// `μ_i N_i` only) does not keep.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneFrame {
+    /// Centre of mass in the file's object frame (m).
+    pub center_of_mass: [f64; 2],
+    /// The outline in the file's object frame (m), counter-clockwise.
+    pub polygon: Vec<[f64; 2]>,
+    /// Gravity (m/s²).
+    pub gravity: f64,
+    /// Normal load of each support as the scenario resolved it (N), in the
+    /// order of the problem's supports.
+    pub normal_forces: Vec<f64>,
 }
 
 /// A bad `[engine]` value: the key (without the `engine.` prefix) and what

@@ -49,6 +49,12 @@ pub enum ModelError {
         /// The limit |ω| passed (rad/s).
         limit: f64,
     },
+    /// The engine could not be run at all (an outside engine's process
+    /// failed to start, exited with an error, timed out or wrote rows that
+    /// do not parse): an input error, not a result. The harness stops with
+    /// it (exit 2) instead of reading it as a failed run.
+    #[error("{0}")]
+    Adapter(String),
 }
 
 impl ModelError {

@@ -19,7 +19,7 @@ mod tolerance;
 
 use std::path::{Path, PathBuf};
 
-use pushval_engine::EngineOptions;
+use pushval_engine::{EngineOptions, SceneFrame};
 use pushval_model::{Body, ContactLimits, Initial, Problem, Push, Support, Switching, Vec2};
 
 pub use engine::MAX_ENGINE_STEPS;
@@ -145,7 +145,13 @@ impl Scenario {
         let initial = schedule::initial(raw.initial, file)?;
         let run = run::from_raw(raw.run, &pushes, file)?;
         let tolerance = tolerance::from_raw(raw.tolerance, file)?;
-        let engine = engine::from_raw(raw.engine, file, &pushes)?;
+        let mut engine = engine::from_raw(raw.engine, file, &pushes)?;
+        engine.scene = Some(SceneFrame {
+            center_of_mass: [object.center_of_mass.x, object.center_of_mass.y],
+            polygon: object.polygon.iter().map(|p| [p.x, p.y]).collect(),
+            gravity: supports.gravity,
+            normal_forces: supports.list.iter().map(|s| s.load).collect(),
+        });
         let sc = Self {
             name: raw.name,
             description: raw.description.unwrap_or_default(),

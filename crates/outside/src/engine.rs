@@ -1,0 +1,237 @@
+//! [`OutsideEngine`]: an engine model that runs as a process.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use pushval_engine::{
+    trajectory_from_steps, Engine, EngineCrate, EngineOptions, EngineRun, StepRecord,
+};
+use pushval_model::{ModelError, Problem};
+
+use crate::config::Spec;
+use crate::csv;
+use crate::document::problem_document;
+use crate::process::{last_lines, run_process};
+
+/// How many lines of a failed process's standard error a message quotes.
+const STDERR_LINES: usize = 8;
+
+/// An outside engine with a scenario's `[engine]` options: one process per
+/// run (see the crate docs).
+#[derive(Debug, Clone)]
+pub struct OutsideEngine {
+    spec: Arc<Spec>,
+    options: EngineOptions,
+    adapter: String,
+    description: String,
+}
+
+impl OutsideEngine {
+    /// The engine `spec` declares, with the scenario's `[engine]` options
+    /// (passed verbatim in the document's `options`).
+    pub fn new(spec: Arc<Spec>, options: &EngineOptions) -> Self {
+        let file = spec.file.file_name().map_or_else(
+            || spec.file.display().to_string(),
+            |f| f.to_string_lossy().into_owned(),
+        );
+        Self {
+            adapter: format!("outside: {file}"),
+            description: format!(
+                "outside engine: `{}` run from {} (declared in {})",
+                spec.command_line(),
+                spec.dir.display(),
+                spec.file.display()
+            ),
+            options: options.clone(),
+            spec,
+        }
+    }
+
+    /// Its declaration.
+    pub fn spec(&self) -> &Spec {
+        &self.spec
+    }
+
+    /// The sentence that starts every error of a run: the engine and its
+    /// command.
+    fn who(&self) -> String {
+        format!(
+            "outside engine \"{}\" (command `{}`, run from {})",
+            self.spec.name,
+            self.spec.command_line(),
+            self.spec.dir.display()
+        )
+    }
+}
+
+impl Engine for OutsideEngine {
+    fn name(&self) -> &str {
+        &self.spec.name
+    }
+    fn description(&self) -> &str {
+        &self.description
+    }
+    fn adapter(&self) -> &str {
+        &self.adapter
+    }
+    /// The protocol's crate: an outside engine links no engine crate.
+    fn engine_crate(&self) -> EngineCrate {
+        EngineCrate {
+            name: "pushval-outside",
+            version: env!("CARGO_PKG_VERSION"),
+        }
+    }
+    fn version(&self) -> String {
+        self.spec
+            .version
+            .clone()
+            .unwrap_or_else(|| format!("unversioned ({} gives no version)", self.adapter))
+    }
+    fn order(&self) -> f64 {
+        self.spec.order
+    }
+    fn availability(&self) -> Result<(), String> {
+        self.spec.availability()
+    }
+    fn default_dt(&self) -> f64 {
+        self.options.dt.unwrap_or(self.spec.dt)
+    }
+    /// Every key: the process receives the whole `[engine]` table.
+    fn accepts_option(&self, _key: &str) -> bool {
+        true
+    }
+    fn settings(&self, dt: f64) -> serde_json::Value {
+        serde_json::json!({
+            "engine": self.version(),
+            "dt": dt,
+            "command": self.spec.command,
+            "declared_in": self.spec.file.display().to_string(),
+            "order": self.spec.order,
+            "timeout_s": self.spec.timeout_s,
+        })
+    }
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        let start = Instant::now();
+        problem.check()?;
+        let doc = problem_document(&self.spec.name, problem, &self.options, dt);
+        let input = serde_json::to_vec(&doc).expect("a JSON value serialises");
+        let out = run_process(
+            &self.spec.program(),
+            &self.spec.command[1..],
+            &self.spec.dir,
+            &input,
+            Duration::from_secs_f64(self.spec.timeout_s),
+        )
+        .map_err(|e| {
+            ModelError::Adapter(format!(
+                "{}: {}; {}",
+                self.who(),
+                e.what,
+                last_lines(&e.stderr, STDERR_LINES)
+            ))
+        })?;
+        let fail = |what: String| {
+            ModelError::Adapter(format!(
+                "{}: {what}; {}",
+                self.who(),
+                last_lines(&out.stderr, STDERR_LINES)
+            ))
+        };
+        if !out.status.success() {
+            return Err(fail(match out.status.code() {
+                Some(c) => format!("exited with status {c}"),
+                None => format!("was ended by a signal ({})", out.status),
+            }));
+        }
+        let parse_start = Instant::now();
+        let text = std::str::from_utf8(&out.stdout)
+            .map_err(|e| fail(format!("wrote standard output that is not UTF-8 ({e})")))?;
+        let rows = csv::read(text, &[], &["t", "x", "y", "theta", "omega"])
+            .map_err(|e| fail(format!("wrote a malformed row on its standard output: {e}")))?;
+        let history = history_from_rows(problem, &rows)
+            .map_err(|e| fail(format!("wrote rows that do not cover the run: {e}")))?;
+        let trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
+        let parse_time = parse_start.elapsed();
+        Ok(EngineRun {
+            trajectory,
+            dt,
+            steps: history.len() - 1,
+            wall_time: start.elapsed(),
+            diagnostics: serde_json::json!({
+                "rows": rows.len(),
+                "process_wall_time_s": out.elapsed.as_secs_f64(),
+                "parse_resample_time_s": parse_time.as_secs_f64(),
+                "input_bytes": input.len(),
+                "output_bytes": out.stdout.len(),
+            }),
+        })
+    }
+}
+
+/// An outside engine's rows (`t, x, y, theta, omega`) as a step history for
+/// the shared resampler: the first row is the state at t = 0, each further
+/// row the end of one step whose ω is the one the engine held over it (a
+/// semi-implicit Euler engine's ω after the step; for rows per sample, the
+/// sample's ω). A step belongs to the segment holding its middle. The rows
+/// must start at t = 0, increase strictly and reach the problem's end.
+pub fn history_from_rows(
+    problem: &Problem,
+    rows: &[csv::Record<'_>],
+) -> Result<Vec<StepRecord>, String> {
+    let end = problem.duration();
+    let tol = 1e-9 * end.max(1.0);
+    let times = problem.segment_times();
+    let Some(first) = rows.first() else {
+        return Err("a header and no rows".into());
+    };
+    if first.numbers[0].abs() > tol {
+        return Err(format!(
+            "line {}: the first row is at t = {} s, not at 0",
+            first.line, first.numbers[0]
+        ));
+    }
+    let segment_of = |t: f64| {
+        times
+            .iter()
+            .position(|&(_, t1)| t < t1 - tol)
+            .unwrap_or(times.len() - 1)
+    };
+    let mut history = Vec::with_capacity(rows.len());
+    let r = &first.numbers;
+    history.push(StepRecord {
+        segment: 0,
+        t0: 0.0,
+        t1: 0.0,
+        x: r[1],
+        y: r[2],
+        theta: r[3],
+        omega: r[4],
+    });
+    let mut t_prev = 0.0;
+    for row in &rows[1..] {
+        let r = &row.numbers;
+        if !(r[0] > t_prev) {
+            return Err(format!(
+                "line {}: column `t`: {} s does not increase (the row before is at {} s)",
+                row.line, r[0], t_prev
+            ));
+        }
+        history.push(StepRecord {
+            segment: segment_of(0.5 * (t_prev + r[0])),
+            t0: t_prev,
+            t1: r[0],
+            x: r[1],
+            y: r[2],
+            theta: r[3],
+            omega: r[4],
+        });
+        t_prev = r[0];
+    }
+    if t_prev < end - 1e-6 * end.max(1.0) {
+        return Err(format!(
+            "the last row (line {}) is at t = {t_prev} s, before the end of the problem at {end} s",
+            rows[rows.len() - 1].line
+        ));
+    }
+    Ok(history)
+}
