@@ -12,6 +12,7 @@ mod gate;
 mod kappa;
 mod power;
 mod properties;
+mod readme;
 mod report;
 mod scenarios;
 mod stress;
