@@ -10,16 +10,31 @@
 //!   ω over the last 20 % of the push against the root ω*) and the largest
 //!   centre-of-mass distance over the samples (m).
 //!
+//! Every engine model whose `[engine]` options include `friction_velocity`
+//! also runs as `NAME[body]` (`friction_velocity = "body"`): its default
+//! mode reads the model's contact kinematics (each support's sliding
+//! velocity from the commanded contact velocity plus `ω × (p_i − p_c)`, the
+//! pusher re-pinned onto the contact point every step), while `body` takes
+//! the engine body's own velocities, as every other engine does: the
+//! like-for-like row. The `kinematics` column says which (`model` or
+//! `engine`).
+//!
 //! Writes `results/engine_work_precision.csv` (one row per engine, mode and
 //! dt), `results/engine_work_precision.svg` and
 //! `results/engine_work_precision_summary.csv`: per engine, the cheapest
-//! row at ≤ 1e-3 relative steady-ω error (if any) and the exponent b of
-//! cost ∝ dt^(−b) fitted over the ladder.
+//! row at ≤ 1e-3 relative steady-ω error (if any), its cost over the
+//! cheapest engine's, and the exponent b of cost ∝ dt^(−b) fitted over the
+//! ladder.
 //!
 //! `cargo bench --bench engine_work_precision` (add `-- --quick` for one
 //! repeat and a shorter ladder; `-- --replot` redraws the SVG from the CSV
-//! without running anything). With `--features mujoco` the MuJoCo rows are
-//! measured too.
+//! without running anything). With `--features mujoco,avian,physx` those
+//! engines' rows are measured too. `-- --only A,B` measures only the named
+//! rows (e.g. `rapier2d,rapier2d[body]`), and `-- --merge` keeps the
+//! committed CSV's rows of every engine this run does not measure: each row
+//! carries the number of the run that measured it (`run`), and the
+//! summary's `# run N:` lines say what each run was, so rows measured side
+//! by side are those with the same run number.
 
 use std::time::Duration;
 
@@ -45,6 +60,11 @@ struct Row {
     omega_rel: f64,
     position: f64,
     steps: usize,
+    /// `model` when the engine reads the model's contact kinematics,
+    /// `engine` when it uses its own body velocities.
+    kinematics: String,
+    /// The run that measured the row (1, 2, …; see the summary).
+    run: u32,
 }
 
 /// The rows of a written `engine_work_precision.csv` (for `--replot`).
@@ -64,13 +84,75 @@ fn read_rows(text: &str) -> Vec<Row> {
                 omega_rel: f.get(2)?.parse().ok()?,
                 position: f.get(3)?.parse().ok()?,
                 steps: f.get(4)?.parse().ok()?,
+                // Columns added with the `[body]` rows; rows written before
+                // them come from run 1, by engines without a
+                // `friction_velocity` option (theirs is the default mode).
+                kinematics: f
+                    .get(5)
+                    .map_or_else(|| default_kinematics(engine), |k| k.to_string()),
+                run: f.get(6).and_then(|r| r.parse().ok()).unwrap_or(1),
             })
         })
         .collect()
 }
 
+/// What a row written without a `kinematics` column reads: the registry's
+/// answer when this build has the engine, else `engine` (only an engine
+/// with a `friction_velocity` option reads the model's kinematics, and every
+/// such engine is in the default build).
+fn default_kinematics(name: &str) -> String {
+    registry::entry(name).map_or("engine".into(), |e| {
+        kinematics(&*e.default_engine()).to_string()
+    })
+}
+
+/// `model` when the engine's settings take the sliding velocities from the
+/// model's contact kinematics (a `friction_velocity` mode other than
+/// `body`), else `engine`.
+fn kinematics(engine: &dyn pushval_engine::Engine) -> &'static str {
+    let settings = engine.settings(engine.default_dt());
+    match settings.get("friction_velocity").and_then(|v| v.as_str()) {
+        Some(mode) if mode != "body" => "model",
+        _ => "engine",
+    }
+}
+
+/// The value after `flag` on the command line.
+fn arg_value(flag: &str) -> Option<String> {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == flag)
+        .and_then(|i| args.get(i + 1).cloned())
+}
+
+/// The engine models this build runs: each registry entry, and `NAME[body]`
+/// for each whose options include `friction_velocity`.
+fn variants() -> Vec<(String, Box<dyn pushval_engine::Engine>)> {
+    let mut out = Vec::new();
+    for entry in registry::entries() {
+        let engine = entry.build(&Default::default()).expect("default options");
+        if let Err(why) = engine.availability() {
+            eprintln!("{}: skipped ({why})", entry.name);
+            continue;
+        }
+        let body = engine.option_keys().contains(&"friction_velocity");
+        out.push((entry.name.to_string(), engine));
+        if body {
+            let mut opts = pushval_engine::EngineOptions::default();
+            opts.values
+                .insert("friction_velocity".into(), serde_json::json!("body"));
+            let e = entry.build(&opts).expect("body is a friction_velocity mode");
+            out.push((format!("{}[body]", entry.name), e));
+        }
+    }
+    out
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
+    let merge = std::env::args().any(|a| a == "--merge");
+    let only: Option<Vec<String>> =
+        arg_value("--only").map(|l| l.split(',').map(|s| s.trim().to_string()).collect());
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     if std::env::args().any(|a| a == "--replot") {
         let csv = root.join("results/engine_work_precision.csv");
@@ -106,11 +188,42 @@ fn main() {
         ]
     };
     let repeats = if quick { 1 } else { 5 };
+    let out = root.join("results");
+    let csv_path = out.join("engine_work_precision.csv");
+    let summary_path = out.join("engine_work_precision_summary.csv");
+    // With --merge: the committed rows, and the run descriptions.
+    let (old_rows, mut runs) = if merge {
+        let rows =
+            read_rows(&std::fs::read_to_string(&csv_path).expect("read the CSV to merge into"));
+        let mut runs: Vec<String> = std::fs::read_to_string(&summary_path)
+            .unwrap_or_default()
+            .lines()
+            .filter(|l| l.starts_with("# run "))
+            .map(str::to_string)
+            .collect();
+        if runs.is_empty() {
+            runs.push(
+                "# run 1: `cargo bench --features mujoco,avian,physx --bench engine_work_precision` (every engine model, side by side)"
+                    .to_string(),
+            );
+        }
+        (rows, runs)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let run = old_rows.iter().map(|r| r.run).max().unwrap_or(0) + 1;
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--bench")
+        .collect();
+    runs.push(format!(
+        "# run {run}: `cargo bench --bench engine_work_precision{}{}` (these rows side by side)",
+        if args.is_empty() { "" } else { " -- " },
+        args.join(" ")
+    ));
     let mut rows = Vec::new();
-    for entry in registry::entries() {
-        let engine = entry.build(&Default::default()).expect("default options");
-        if let Err(why) = engine.availability() {
-            eprintln!("{}: skipped ({why})", entry.name);
+    for (name, engine) in variants() {
+        if only.as_ref().is_some_and(|o| !o.contains(&name)) {
             continue;
         }
         for &dt in &ladder {
@@ -122,15 +235,15 @@ fn main() {
                 times.push((thread_cpu_time() - t0).as_secs_f64());
                 last = Some(r);
             }
-            let run = match last.expect("ran") {
+            let result = match last.expect("ran") {
                 Ok(r) => r,
                 Err(e) => {
-                    eprintln!("{} at dt = {dt:.3e}: {e}", entry.name);
+                    eprintln!("{name} at dt = {dt:.3e}: {e}");
                     continue;
                 }
             };
             times.sort_by(f64::total_cmp);
-            let tr = &run.trajectory;
+            let tr = &result.trajectory;
             let w = tail_omega(tr, seg.t_start, seg.t_end).unwrap_or(f64::NAN);
             let position = tr
                 .samples
@@ -139,13 +252,15 @@ fn main() {
                 .map(|(p, q)| ((p.x - q.x).powi(2) + (p.y - q.y).powi(2)).sqrt())
                 .fold(0.0, f64::max);
             let row = Row {
-                engine: entry.name.to_string(),
+                engine: name.clone(),
                 version: engine.version(),
                 dt,
                 cpu_per_sim_s: times[times.len() / 2] / duration,
                 omega_rel: rel_err(w, w_star, seg.speed, sc.froude_length()),
                 position,
-                steps: run.steps,
+                steps: result.steps,
+                kinematics: kinematics(&*engine).to_string(),
+                run,
             };
             eprintln!(
                 "{:28} dt {:.3e}  {:.3e} s/s  omega {:.2e}  position {:.2e} m",
@@ -157,19 +272,32 @@ fn main() {
     if quick {
         return;
     }
+    let rows = if merge { merged(old_rows, rows) } else { rows };
     let mut csv = String::from(
-        "engine,version,dt_s,cpu_s_per_simulated_s,omega_steady_rel_err,position_err_m,steps\n",
+        "engine,version,dt_s,cpu_s_per_simulated_s,omega_steady_rel_err,position_err_m,steps,kinematics,run\n",
     );
     for r in &rows {
         csv.push_str(&format!(
-            "{},\"{}\",{:.6e},{:.4e},{:.4e},{:.4e},{}\n",
-            r.engine, r.version, r.dt, r.cpu_per_sim_s, r.omega_rel, r.position, r.steps
+            "{},\"{}\",{:.6e},{:.4e},{:.4e},{:.4e},{},{},{}\n",
+            r.engine,
+            r.version,
+            r.dt,
+            r.cpu_per_sim_s,
+            r.omega_rel,
+            r.position,
+            r.steps,
+            r.kinematics,
+            r.run
         ));
     }
     let mut names: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();
     names.dedup();
+    let cheapest = rows
+        .iter()
+        .filter(|r| r.omega_rel <= TARGET)
+        .min_by(|a, b| a.cpu_per_sim_s.total_cmp(&b.cpu_per_sim_s));
     let mut summary = String::from(
-        "engine,cheapest_dt_at_1e-3_s,cheapest_cpu_s_per_simulated_s_at_1e-3,cost_exponent_b\n",
+        "engine,kinematics,run,cheapest_dt_at_1e-3_s,cheapest_cpu_s_per_simulated_s_at_1e-3,cpu_ratio_to_cheapest,cost_exponent_b\n",
     );
     for name in &names {
         let mine: Vec<&Row> = rows.iter().filter(|r| r.engine == *name).collect();
@@ -189,36 +317,70 @@ fn main() {
         );
         let b = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
             / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+        let first = mine[0];
         summary.push_str(&format!(
-            "{name},{},{},{b:.3}\n",
+            "{name},{},{},{},{},{},{b:.3}\n",
+            first.kinematics,
+            first.run,
             best.map_or("".into(), |r| format!("{:.6e}", r.dt)),
             best.map_or("".into(), |r| format!("{:.4e}", r.cpu_per_sim_s)),
+            best.zip(cheapest).map_or("".into(), |(r, c)| format!(
+                "{:.1}",
+                r.cpu_per_sim_s / c.cpu_per_sim_s
+            )),
         ));
     }
-    let out = root.join("results");
-    if let Some(best) = rows
-        .iter()
-        .filter(|r| r.omega_rel <= TARGET)
-        .min_by(|a, b| a.cpu_per_sim_s.total_cmp(&b.cpu_per_sim_s))
-    {
+    summary.push_str(
+        "# kinematics: model = the engine reads the model's contact kinematics (support velocities from the commanded \
+         contact velocity plus omega x (p_i - p_c), pusher re-pinned onto the contact point), engine = its own body velocities\n",
+    );
+    for line in &runs {
+        summary.push_str(line);
+        summary.push('\n');
+    }
+    if let Some(best) = cheapest {
         summary.push_str(&format!(
-            "# cheapest at {TARGET:e} relative steady-omega error: {} at dt = {:.4e} s, {:.4e} s CPU per simulated second\n",
-            best.engine, best.dt, best.cpu_per_sim_s
+            "# cheapest at {TARGET:e} relative steady-omega error: {} at dt = {:.4e} s, {:.4e} s CPU per simulated second (run {})\n",
+            best.engine, best.dt, best.cpu_per_sim_s, best.run
         ));
     }
-    pushval::output::write_atomic(&out.join("engine_work_precision.csv"), csv.as_bytes())
-        .expect("write csv");
-    pushval::output::write_atomic(
-        &out.join("engine_work_precision_summary.csv"),
-        summary.as_bytes(),
-    )
-    .expect("write summary");
+    pushval::output::write_atomic(&csv_path, csv.as_bytes()).expect("write csv");
+    pushval::output::write_atomic(&summary_path, summary.as_bytes()).expect("write summary");
     pushval::output::write_atomic(
         &out.join("engine_work_precision.svg"),
         figure(&rows, &names).as_bytes(),
     )
     .expect("write svg");
     print!("{summary}");
+}
+
+/// The committed rows with this run's in place of the same engines' (a new
+/// `NAME[mode]` right after `NAME`'s rows), in the committed order.
+fn merged(old: Vec<Row>, new: Vec<Row>) -> Vec<Row> {
+    let measured: Vec<String> = new.iter().map(|r| r.engine.clone()).collect();
+    let mut out: Vec<Row> = Vec::new();
+    let mut new = new;
+    for r in old {
+        if measured.contains(&r.engine) {
+            // Replaced: this run's rows of the engine go where its first was.
+            let mine: Vec<Row>;
+            (mine, new) = new.into_iter().partition(|n| n.engine == r.engine);
+            out.extend(mine);
+        } else {
+            out.push(r);
+        }
+    }
+    for r in new {
+        let base = r.engine.split('[').next().unwrap_or("").to_string();
+        let at = out
+            .iter()
+            .rposition(|o| {
+                o.engine == r.engine || o.engine.split('[').next() == Some(base.as_str())
+            })
+            .map_or(out.len(), |i| i + 1);
+        out.insert(at, r);
+    }
+    out
 }
 
 /// Log–log figure: steady-ω error (left) and position error (right)

@@ -408,19 +408,36 @@ fn path_figure(
     let last = |t: &Trajectory| t.samples.last().map(|s| (s.x, s.y)).unwrap_or_default();
     let (d, k, e) = (last(&r.dynamic), last(&r.kinematic), last(&r.engine));
     let v = sc.pushes[0].speed;
+    let duration = sc.problem().duration();
+    let kinematic_end = w.key(
+        &svg_name,
+        "kinematic_end_distance_m",
+        (d.0 - k.0).hypot(d.1 - k.1),
+    );
+    let path_length = w.key(&svg_name, "path_length_m", v * duration);
+    let engine_max = w.key(
+        &svg_name,
+        "rapier2d_max_distance_m",
+        max_position_diff(&r.dynamic, &r.engine),
+    );
+    let engine_end = w.key(
+        &svg_name,
+        "rapier2d_end_distance_m",
+        (d.0 - e.0).hypot(d.1 - e.1),
+    );
     Ok(Entry {
         figure: svg_name,
-        data: vec![csv_name],
+        data: vec![csv_name, super::KEY_FIGURES.to_string()],
         text: format!(
             "{title} (Fr = {:.3}): x(t), y(t) and the path of the centre of mass. After {} s the \
              kinematic model ends {:.3} m from the dynamic model (path length {:.1} m); \
              rapier2d stays within {:.1e} m of the dynamic model throughout (end point {:.1e} m).",
             sc.froude(v),
-            sc.problem().duration(),
-            (d.0 - k.0).hypot(d.1 - k.1),
-            v * sc.problem().duration(),
-            max_position_diff(&r.dynamic, &r.engine),
-            (d.0 - e.0).hypot(d.1 - e.1),
+            duration,
+            kinematic_end,
+            path_length,
+            engine_max,
+            engine_end,
         ),
     })
 }

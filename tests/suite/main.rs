@@ -13,6 +13,7 @@ mod kappa;
 mod outside;
 mod power;
 mod properties;
+mod readme;
 mod report;
 mod scenarios;
 mod stress;
