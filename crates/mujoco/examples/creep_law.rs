@@ -42,6 +42,9 @@ fn scene(cone: Cone, impratio: f64, dt: f64) -> CreepScene {
     }
 }
 
+/// A change of the default scene.
+type Variant = Box<dyn Fn(&mut CreepScene)>;
+
 const IMPRATIOS: [f64; 3] = [1.0, 10.0, 100.0];
 const CASES: [CreepCase; 2] = [CreepCase::Held, CreepCase::Sliding(SLIDING_SPEED)];
 
@@ -69,12 +72,27 @@ fn ladder() -> Vec<Cell> {
         }
     }
     // solref, solimp, feet at dt = 1e-3.
-    let variants: [(&str, Box<dyn Fn(&mut CreepScene)>); 8] = [
-        ("solref", Box::new(|s| s.settings.contact_solref = [0.005, 1.0])),
-        ("solref", Box::new(|s| s.settings.contact_solref = [0.05, 1.0])),
-        ("solref", Box::new(|s| s.settings.contact_solref = [0.02, 0.7])),
-        ("solref", Box::new(|s| s.settings.contact_solref = [0.02, 0.5])),
-        ("solref", Box::new(|s| s.settings.contact_solref = [0.02, 0.3])),
+    let variants: [(&str, Variant); 8] = [
+        (
+            "solref",
+            Box::new(|s| s.settings.contact_solref = [0.005, 1.0]),
+        ),
+        (
+            "solref",
+            Box::new(|s| s.settings.contact_solref = [0.05, 1.0]),
+        ),
+        (
+            "solref",
+            Box::new(|s| s.settings.contact_solref = [0.02, 0.7]),
+        ),
+        (
+            "solref",
+            Box::new(|s| s.settings.contact_solref = [0.02, 0.5]),
+        ),
+        (
+            "solref",
+            Box::new(|s| s.settings.contact_solref = [0.02, 0.3]),
+        ),
         (
             "solimp",
             Box::new(|s| s.settings.contact_solimp = [0.99, 0.99, 0.001, 0.5, 2.0]),
@@ -95,6 +113,16 @@ fn ladder() -> Vec<Cell> {
                         push(group, s, 0.0, load, case);
                     }
                 }
+            }
+        }
+    }
+    // No load: does the plate settle on its feet at all?
+    for cone in Cone::ALL {
+        for zeta in [1.0, 0.7, 0.5, 0.3] {
+            for imp in [1.0, 100.0] {
+                let mut s = scene(cone, imp, 1e-3);
+                s.settings.contact_solref = [0.02, zeta];
+                push("unloaded", s, 0.0, 0.0, CreepCase::Held);
             }
         }
     }
@@ -146,14 +174,12 @@ fn row(c: &Cell) -> Result<String, String> {
         )
     })?;
     let ([along, across], p) = c.scene.predicted(c.load, c.direction, m.tangents);
-    let rel = if p.regime == CreepRegime::Slides {
+    let rel = if p.regime == CreepRegime::Slides || c.load == 0.0 {
         f64::NAN
     } else {
         (m.creep - along).hypot(m.lateral - across) / along.hypot(across)
     };
-    let input = c
-        .scene
-        .creep_input(c.load, c.direction, m.tangents);
+    let input = c.scene.creep_input(c.load, c.direction, m.tangents);
     let e = |v: f64, d: usize| {
         if v.is_finite() {
             format!("{v:.d$e}")
@@ -202,7 +228,9 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
 fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() > 1 {
-        return Err(format!("expected at most one argument (OUT_DIR), got {args:?}"));
+        return Err(format!(
+            "expected at most one argument (OUT_DIR), got {args:?}"
+        ));
     }
     let out: PathBuf = match args.first() {
         Some(a) => PathBuf::from(a),
