@@ -236,6 +236,9 @@ fn run() -> Result<(), String> {
         Some(a) => PathBuf::from(a),
         None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/friction_models/mujoco"),
     };
+    let out = out
+        .canonicalize()
+        .map_err(|e| format!("OUT_DIR {}: {e}", out.display()))?;
     if !out.is_dir() {
         return Err(format!("OUT_DIR {} is not a directory", out.display()));
     }

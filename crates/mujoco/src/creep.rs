@@ -338,7 +338,8 @@ pub fn creep(input: &CreepInput) -> CreepPrediction {
     }
 }
 
-/// The regularised-friction slip scale of an elliptic contact,
+/// The regularised-friction slip scale of a contact, evaluated for the
+/// elliptic cone (its d, at the elliptic penetration, whatever `input.cone`),
 /// `ε = μ N R_t / B` (m/s): the steady creep under a load `λ μ N` is `λ ε`
 /// (pyramidal: `(1 + μ²) λ ε` up to `λ = 1/2` along a tangent axis).
 pub fn slip_scale(input: &CreepInput) -> f64 {
@@ -753,6 +754,47 @@ pub fn report_markdown(csv: &str) -> Result<String, String> {
         ds.settle_time,
         SLIDING_SPEED,
         ds.iterations
+    );
+
+    // The closed form.
+    let def = |cone: &str| {
+        find(&|r: &Row| {
+            cell(r, "group") == "ladder"
+                && base(r)
+                && cell(r, "cone") == cone
+                && cell(r, "impratio") == "1"
+                && cell(r, "dt") == "0.001"
+                && cell(r, "load_fraction") == "0.5"
+                && cell(r, "case") == "held"
+        })
+    };
+    let ell = def("elliptic");
+    let pyr = def("pyramidal");
+    let _ = writeln!(o, "\n## The closed form\n");
+    let _ = writeln!(
+        o,
+        "Derived in `crates/mujoco/src/creep.rs` from MuJoCo's regularised constraint problem. Inside the \
+         friction cone MuJoCo's solver returns the linear solution (A + R) f = a_ref − a₀, so the \
+         constraint acceleration is a = a_ref − R f. A steady creep has a = 0 on every contact row, hence \
+         **R f = a_ref**: the mass matrix A and the time step drop out. With MuJoCo's bookkeeping \
+         (impedance d from solimp at the penetration δ, B = 2/(d_max t_c) and K = 1/(d_max² t_c² ζ²) from \
+         solref with t_c ≥ 2 dt, R = (1 − d)/d · Â with Â the body's translational invweight0 = 1/m):\n\n\
+         * elliptic: friction rows R_t = R_n/impratio and a_ref = −B u, so for a contact loaded by F \
+         (λ μ N): **u* = F R_t / B = λ ε**, ε = μ N (1 − d) Â d_max t_c / (2 d impratio); δ from \
+         R_n N = K d δ;\n\
+         * pyramidal: edges n ± μ t_j with Â(1 + μ²) and R_py = 2 μ² (1 + μ²)(1 − d)/d Â / impratio, \
+         a_ref = −B(±μ u_j) + K d δ: **u_j = F_j R_py / (2 μ² B) = (1 + μ²) λ_j ε** while |F_j| ≤ μN/2 on \
+         both tangent axes (δ from K d δ = R_py N/4); beyond, the edge n + μ t₁ (for F₁ > 0 the one \
+         whose friction would push along the load) lifts off and \
+         **u₁ = R_py (3F₁/μ − N)/(2 B μ)**, i.e. (1 + μ²) ε (3λ − 1) along an axis (δ from \
+         K d δ = R_py (N − F₁/μ)/2), until |F₁| + |F₂| = μN.\n\n\
+         In the regularised-friction picture f = μN u / max(|u|, ε) this is the slip scale ε = μ N R_t / B. \
+         With equal loads N = m g / n it reads ε = μ g (1 − d) d_max t_c / (2 n d impratio): 1/impratio, \
+         ∝ t_c, ∝ (1 − d)/d, and ∝ 1/n, the number of contacts sharing the weight. Defaults (impratio 1, \
+         dt 0.001 s): elliptic d = {}, ε = {} m/s; pyramidal d = {} (its edges penetrate less).",
+        ell.map(|r| cell(r, "impedance")).unwrap_or("–"),
+        ell.map(|r| fmt_e(num(r, "slip_scale"), 4)).unwrap_or("–".into()),
+        pyr.map(|r| cell(r, "impedance")).unwrap_or("–"),
     );
 
     // Accuracy.
