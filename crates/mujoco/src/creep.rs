@@ -640,7 +640,8 @@ impl CreepMeasurement {
 /// `load_fraction · μ W` along world angle `direction` (rad) at the centre of
 /// mass (for [`CreepCase::Sliding`] the plate also gets that speed along the
 /// load), holds it for `hold_time` s and measures the slip over the last
-/// 40 %. Without the `mujoco` feature: [`ModelError::Integration`] with
+/// 40 %. Without the `mujoco` feature:
+/// [`ModelError::Integration`](pushval_model::ModelError::Integration) with
 /// [`crate::UNAVAILABLE`].
 pub fn measure(
     scene: &CreepScene,
