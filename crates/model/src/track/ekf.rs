@@ -43,9 +43,12 @@ pub struct EkfSettings {
     /// Standard normal quantile of the lack-of-fit test (4.75: a false alarm
     /// rate of about 1e-6 per window). Default 4.75.
     pub z: f64,
-    /// On lack of fit, re-open the free parameters to their prior std (the
-    /// estimate can then follow a change such as a new surface). Default true.
+    /// On lack of fit, re-open the free parameters to `reopen_scale` times
+    /// their prior std and the pose and ω to their start std (the estimate
+    /// can then follow a change such as a new surface). Default true.
     pub reopen: bool,
+    /// See `reopen`. Default 0.2.
+    pub reopen_scale: f64,
 }
 
 impl Default for EkfSettings {
@@ -62,6 +65,7 @@ impl Default for EkfSettings {
             window: 25,
             z: 4.75,
             reopen: true,
+            reopen_scale: 0.2,
         }
     }
 }
@@ -312,12 +316,14 @@ impl Ekf {
     fn reopen(&mut self) {
         let (p, _) = self.model.from_q(&self.q());
         let (_, jq) = self.model.to_q(&p);
-        let prior_q = prior_in_q(&jq, &self.free, &self.prior_var);
-        for a in 4..8 {
-            for c in 0..8 {
-                self.p[(a, c)] = 0.0;
-                self.p[(c, a)] = 0.0;
-            }
+        let scaled = self
+            .prior_var
+            .map(|v| v * self.settings.reopen_scale.powi(2));
+        let prior_q = prior_in_q(&jq, &self.free, &scaled);
+        self.p = Mat8::zeros();
+        let [sp, st, sw] = self.settings.initial_std;
+        for (i, v) in [sp * sp, sp * sp, st * st, sw * sw].into_iter().enumerate() {
+            self.p[(i, i)] = v;
         }
         for a in 0..4 {
             for b in 0..4 {
