@@ -581,11 +581,8 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
         )),
         Source::Stdin => Box::new(std::io::stdin().lock()),
     };
-    std::fs::create_dir_all(&req.out).with_context(|| format!("creating {}", req.out.display()))?;
-    let csv_path = req.out.join("track.csv");
-    let tmp = tempfile::NamedTempFile::new_in(&req.out)
-        .with_context(|| format!("creating a temporary file in {}", req.out.display()))?;
-    let mut csv = std::io::BufWriter::new(tmp);
+    // Everything is written at the end, so bad input leaves nothing behind.
+    let mut csv: Vec<u8> = Vec::new();
     let stdout = std::io::stdout();
     let mut lock = stdout.lock();
     let echo: Option<&mut dyn Write> = match req.trajectory {
@@ -604,12 +601,10 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
         echo,
     )?;
     drop(lock);
-    let tmp = csv
-        .into_inner()
-        .map_err(|e| anyhow::anyhow!("writing {}: {e}", csv_path.display()))?;
     let (json, not_converged) = summary(&sc, &params, &req.settings, &out);
-    tmp.persist(&csv_path)
-        .with_context(|| format!("renaming into {}", csv_path.display()))?;
+    std::fs::create_dir_all(&req.out).with_context(|| format!("creating {}", req.out.display()))?;
+    let csv_path = req.out.join("track.csv");
+    crate::output::write_atomic(&csv_path, &csv)?;
     let json_path = req.out.join("track.json");
     crate::output::write_atomic(&json_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     eprintln!("wrote {} and {}", csv_path.display(), json_path.display());

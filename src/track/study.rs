@@ -38,6 +38,8 @@ use crate::fit::{fisher_at, noise, Param, Parametrised, Settings};
 use crate::output::write_atomic;
 use crate::report::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
+/// The broad prior of [`Method::EkfBroadPrior`].
+pub const BROAD_PRIOR: [f64; 3] = [0.5, 0.25, 0.5];
 /// The truth's factor on μ.
 pub const MU_FACTOR: f64 = 1.1;
 /// The truth's factor on I_cm.
@@ -58,6 +60,12 @@ pub enum Method {
     Ekf,
     /// [`Rls`] with a window of about 0.2 s (at least 5 samples).
     Rls,
+    /// [`Ekf`] told the start state exactly (std 1e-9), as `pushval fit`'s
+    /// Fisher information assumes.
+    EkfKnownStart,
+    /// [`Ekf`] with a broad prior (μ ±50 %, centre of friction ±25 % of the
+    /// size, I_cm ±50 %).
+    EkfBroadPrior,
 }
 
 impl Method {
@@ -65,6 +73,8 @@ impl Method {
         match self {
             Method::Ekf => "ekf",
             Method::Rls => "rls",
+            Method::EkfKnownStart => "ekf_known_start",
+            Method::EkfBroadPrior => "ekf_broad_prior",
         }
     }
 }
@@ -79,6 +89,29 @@ fn estimator(sc: &Scenario, method: Method, rate: f64, sp: f64, st: f64) -> Box<
                 sigma_position: sp,
                 sigma_theta: st,
                 initial_std: [sp, st, 1e-2],
+                ..Default::default()
+            },
+            None,
+        )),
+        Method::EkfKnownStart => Box::new(Ekf::new(
+            md,
+            Free::default(),
+            EkfSettings {
+                sigma_position: sp,
+                sigma_theta: st,
+                initial_std: [1e-9; 3],
+                ..Default::default()
+            },
+            None,
+        )),
+        Method::EkfBroadPrior => Box::new(Ekf::new(
+            md,
+            Free::default(),
+            EkfSettings {
+                sigma_position: sp,
+                sigma_theta: st,
+                initial_std: [sp, st, 1e-2],
+                prior: BROAD_PRIOR,
                 ..Default::default()
             },
             None,
@@ -393,6 +426,82 @@ struct EffRow {
     std: f64,
     reported: f64,
     crb: f64,
+    crb_known: f64,
+}
+
+/// The Cramér–Rao bound of `[mu_scale, c_x, c_y, I_cm]` (c from the centre
+/// of mass) when the start is measured, not known: the whitened Jacobian of
+/// the trajectory (x, y, θ at every sample) with respect to the parameters
+/// and the start `[x0, y0, θ0, ω0]` (central differences), information
+/// `JᵀJ` plus the filter's priors (the start's std `[σ_p, σ_p, σ_θ, 0.01]`,
+/// the parameters' `prior` as in [`EkfSettings::prior`]), inverted. For the
+/// known-start filter this is a looser bound than it is told (it is told
+/// the start exactly): the table gives `pushval fit`'s known-start bound
+/// beside it.
+fn crb_measured_start(
+    pm: &Parametrised,
+    v: &[f64],
+    sp: f64,
+    st: f64,
+    prior: [f64; 3],
+) -> anyhow::Result<[f64; 4]> {
+    let base = pm.problem(v).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let traj = |dv: &[f64; 8]| -> Vec<Sample> {
+        let vals: Vec<f64> = (0..4).map(|i| v[i] + dv[i]).collect();
+        let mut p = pm.problem(&vals).expect("near the truth");
+        p.initial.position += Vec2::new(dv[4], dv[5]);
+        p.initial.theta += dv[6];
+        p.initial.omega += dv[7];
+        simulate(&p)
+    };
+    let scales = pm.scales();
+    let steps = [
+        1e-5 * scales[0],
+        1e-5 * scales[1],
+        1e-5 * scales[2],
+        1e-5 * scales[3],
+        1e-6,
+        1e-6,
+        1e-6,
+        1e-5,
+    ];
+    let k = base.sample_times().len();
+    let mut jac = nalgebra::DMatrix::<f64>::zeros(3 * k, 8);
+    for j in 0..8 {
+        let mut d = [0.0; 8];
+        d[j] = steps[j];
+        let a = traj(&d);
+        d[j] = -steps[j];
+        let b = traj(&d);
+        for i in 0..k {
+            jac[(3 * i, j)] = (a[i].x - b[i].x) / (2.0 * steps[j] * sp);
+            jac[(3 * i + 1, j)] = (a[i].y - b[i].y) / (2.0 * steps[j] * sp);
+            jac[(3 * i + 2, j)] = (a[i].theta - b[i].theta) / (2.0 * steps[j] * st);
+        }
+    }
+    let mut info = jac.transpose() * &jac;
+    // Parametrised order: c_x, c_y (scale: its size), I_cm, mu_scale.
+    let prior_std = [
+        prior[1] * scales[0],
+        prior[1] * scales[1],
+        prior[2] * v[2] / INERTIA_FACTOR,
+        prior[0],
+        sp,
+        sp,
+        st,
+        1e-2,
+    ];
+    for (j, s) in prior_std.iter().enumerate() {
+        info[(j, j)] += 1.0 / (s * s);
+    }
+    let d: Vec<f64> = (0..8).map(|j| info[(j, j)].sqrt()).collect();
+    let unit = nalgebra::DMatrix::from_fn(8, 8, |a, b| info[(a, b)] / (d[a] * d[b]));
+    let inv = unit
+        .cholesky()
+        .context("the information with a measured start is singular")?
+        .inverse();
+    let sd = |j: usize| inv[(j, j)].sqrt() / d[j];
+    Ok([sd(3), sd(0), sd(1), sd(2)])
 }
 
 fn efficiency(grid: &Grid) -> anyhow::Result<(Vec<EffRow>, String)> {
@@ -413,9 +522,21 @@ fn efficiency(grid: &Grid) -> anyhow::Result<(Vec<EffRow>, String)> {
                 .map_err(|e| anyhow::anyhow!("{name}: Fisher information: {e}"))?;
             // Parametrised order: c_x, c_y, I_cm, mu_scale → estimator order.
             let crb_p = fisher.std();
-            let crb = [crb_p[3], crb_p[0], crb_p[1], crb_p[2]];
+            let crb_known = [crb_p[3], crb_p[0], crb_p[1], crb_p[2]];
+            let crb_default = crb_measured_start(&pm, &v, sp, st, EkfSettings::default().prior)?;
+            let crb_broad = crb_measured_start(&pm, &v, sp, st, BROAD_PRIOR)?;
             let clean = simulate(&pm.problem(&v).expect("truth"));
-            for method in [Method::Ekf, Method::Rls] {
+            for method in [
+                Method::Ekf,
+                Method::EkfBroadPrior,
+                Method::EkfKnownStart,
+                Method::Rls,
+            ] {
+                let crb = if method == Method::EkfBroadPrior {
+                    crb_broad
+                } else {
+                    crb_default
+                };
                 let finals: Vec<([f64; 4], [f64; 4])> = (0..grid.seeds_efficiency)
                     .into_par_iter()
                     .map(|seed| {
@@ -451,17 +572,18 @@ fn efficiency(grid: &Grid) -> anyhow::Result<(Vec<EffRow>, String)> {
                         std,
                         reported,
                         crb: crb[k],
+                        crb_known: crb_known[k],
                     });
                 }
             }
         }
     }
     let mut csv = String::from(
-        "scenario,method,rate_hz,sigma_position_m,sigma_theta_rad,seeds,component,truth,mean,empirical_std,reported_std,crb_std,efficiency,bias_over_crb\n",
+        "scenario,method,rate_hz,sigma_position_m,sigma_theta_rad,seeds,component,truth,mean,empirical_std,reported_std,crb_std,efficiency,bias_over_crb,crb_std_known_start,efficiency_known_start\n",
     );
     for r in &out {
         csv += &format!(
-            "{},{},{},{sp},{st},{},{},{:.6e},{:.6e},{:.4e},{:.4e},{:.4e},{:.3},{:.2}\n",
+            "{},{},{},{sp},{st},{},{},{:.6e},{:.6e},{:.4e},{:.4e},{:.4e},{:.3},{:.2},{:.4e},{:.3}\n",
             r.scenario,
             r.method.name(),
             r.rate,
@@ -473,7 +595,9 @@ fn efficiency(grid: &Grid) -> anyhow::Result<(Vec<EffRow>, String)> {
             r.reported,
             r.crb,
             (r.crb / r.std).powi(2),
-            (r.mean - r.truth) / r.crb
+            (r.mean - r.truth) / r.crb,
+            r.crb_known,
+            (r.crb_known / r.std).powi(2)
         );
     }
     Ok((out, csv))

@@ -28,7 +28,7 @@ pub struct EkfSettings {
     pub sigma_force: Option<f64>,
     /// Prior std relative to each parameter's scale: `mu_scale` (scale 1),
     /// centre of friction (scale: [`TrackModel::size`]), `inertia_cm`
-    /// (scale: the problem's). Default `[0.5, 0.25, 0.5]`.
+    /// (scale: the problem's). Default `[0.2, 0.05, 0.2]`.
     pub prior: [f64; 3],
     /// Std of the start state: position (m), θ (rad), ω (rad/s). Default
     /// `[1e-3, 1e-3, 1e-2]`.
@@ -47,7 +47,7 @@ pub struct EkfSettings {
     /// their prior std and the pose and ω to their start std (the estimate
     /// can then follow a change such as a new surface). Default true.
     pub reopen: bool,
-    /// See `reopen`. Default 0.2.
+    /// See `reopen`. Default 1.
     pub reopen_scale: f64,
 }
 
@@ -58,14 +58,14 @@ impl Default for EkfSettings {
             sigma_theta: 1e-3,
             sigma_omega: None,
             sigma_force: Some(0.05),
-            prior: [0.5, 0.25, 0.5],
+            prior: [0.2, 0.05, 0.2],
             initial_std: [1e-3, 1e-3, 1e-2],
             omega_noise: 0.0,
             max_step: 2.5e-3,
             window: 25,
             z: 4.75,
             reopen: true,
-            reopen_scale: 0.2,
+            reopen_scale: 1.0,
         }
     }
 }
