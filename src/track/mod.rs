@@ -283,6 +283,9 @@ pub struct Outcome {
     pub episodes: Vec<(f64, f64)>,
     /// The test rejected at the last sample.
     pub lack_at_end: bool,
+    /// The estimate left the finite numbers at this time (the rest of the
+    /// input was not read).
+    pub diverged: Option<f64>,
 }
 
 /// Streams `reader` through the filter: one [`Row`] per sample, each
@@ -324,6 +327,7 @@ pub fn stream(
         rows: Vec::new(),
         episodes: Vec::new(),
         lack_at_end: false,
+        diverged: None,
     };
     let mut in_episode = false;
     loop {
@@ -389,12 +393,19 @@ pub fn stream(
             },
         };
         let t0 = thread_cpu_time();
-        let rep = ekf.update(&m).map_err(|e| match e {
-            TrackError::TimeOrder { .. } | TrackError::OutsideSchedule { .. } => {
-                anyhow::anyhow!("{src}: line {lineno}: column `t`: {e}")
+        let rep = match ekf.update(&m) {
+            Ok(r) => r,
+            Err(e @ (TrackError::TimeOrder { .. } | TrackError::OutsideSchedule { .. })) => {
+                bail!("{src}: line {lineno}: column `t`: {e}")
             }
-            _ => anyhow::anyhow!("{src}: line {lineno}: {e}"),
-        })?;
+            Err(TrackError::Diverged { t }) => {
+                // Not bad input: the model cannot follow the data.
+                eprintln!("lack of fit at t = {t} s ({src} line {lineno}): the estimate left the finite numbers; stopped");
+                out.diverged = Some(t);
+                break;
+            }
+            Err(e) => bail!("{src}: line {lineno}: {e}"),
+        };
         let update_time = thread_cpu_time() - t0;
         let est = ekf.estimate();
         let (res, rsd) = ekf.resultant();
@@ -542,6 +553,7 @@ pub fn summary(
         "update_time_p99_s": q(0.99),
         "lack_of_fit": out.episodes.iter().map(|(a, b)| json!({"t_first": a, "t_last": b})).collect::<Vec<_>>(),
         "lack_of_fit_at_end": out.lack_at_end,
+        "diverged_at": out.diverged.map_or(Value::Null, num),
         "converged": converged,
         "not_converged": not_converged,
         "settings": {
@@ -617,7 +629,7 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
         );
         code = ExitCode::from(1);
     }
-    if out.lack_at_end || out.episodes.len() > MAX_EPISODES {
+    if out.lack_at_end || out.diverged.is_some() || out.episodes.len() > MAX_EPISODES {
         eprintln!(
             "FAIL {}: the model does not explain the data ({} lack-of-fit episode(s){})",
             sc.name,

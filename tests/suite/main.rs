@@ -16,3 +16,4 @@ mod report;
 mod scenarios;
 mod stress;
 mod study;
+mod track;

@@ -334,12 +334,22 @@ impl Ekf {
         self.test.clear();
     }
 
-    /// `γ₀ > 0` and `ζ > 0` (μ and I_P positive): clamped at 1 % of their
-    /// values at the problem's parameters.
+    /// `γ₀ > 0` and `ζ > 0` (μ and I_P positive): clamped to [1 %, 100 ×]
+    /// their values at the problem's parameters, `I_cm` to at least 1 % of
+    /// the problem's; the centre of friction to within ten sizes of the
+    /// centre of mass.
     fn keep_in_domain(&mut self) {
         let (q0, _) = self.model.to_q(&self.model.nominal());
-        self.s[4] = self.s[4].max(1e-2 * q0[0]);
-        self.s[7] = self.s[7].max(1e-2 * q0[3]);
+        self.s[4] = self.s[4].clamp(1e-2 * q0[0], 1e2 * q0[0]);
+        // I_cm > 0: ζ = 1 / I_P below 1 / (m |p_c|² + 1 % of the file's I_cm).
+        let md = &self.model;
+        let nominal = md.nominal();
+        let zeta_max = 1.0 / (md.mass() * md.contact().norm_squared() + 1e-2 * nominal[INERTIA]);
+        self.s[7] = self.s[7].clamp(1e-2 * q0[3], zeta_max.min(1e2 * q0[3]));
+        let reach = 10.0 * self.model.size() * self.s[4];
+        for i in [5, 6] {
+            self.s[i] = self.s[i].clamp(-reach, reach);
+        }
     }
 }
 
