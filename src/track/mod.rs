@@ -36,8 +36,14 @@
 //!               "point": [0.125, 0.01], "point_std": [0.0, 0.001]},
 //!  "update_time_median_s": 1.1e-6, "update_time_p99_s": 2.0e-6,
 //!  "lack_of_fit": [{"t_first": 4.1, "t_last": 4.3}], "lack_of_fit_at_end": false,
-//!  "converged": true, "not_converged": [], "settings": {...}}
+//!  "diverged_at": null, "converged": true, "not_converged": [], "settings": {...}}
 //! ```
+//!
+//! `lack_of_fit`: the episodes in which the test rejected (first and last
+//! rejecting sample, s); `diverged_at`: the time the filter's state left the
+//! finite numbers (the rest of the input is then not read; exit 1);
+//! `not_converged`: the parameters whose final std exceeds the tolerances
+//! below; `settings`: the noise levels, priors and numerics used.
 //!
 //! `converged_at` (s): the first sample time after which the estimate stays
 //! within 1 % (`mu_scale`, `inertia_cm`) or 1 mm (each component of

@@ -53,6 +53,9 @@ pub const STEP: f64 = 0.2;
 /// When μ steps (s).
 pub const STEP_AT: f64 = 5.0;
 
+/// Per sample: time (s), estimate `[mu_scale, c_x, c_y, I_cm]` and its std.
+type History = Vec<(f64, [f64; 4], [f64; 4])>;
+
 /// One method of the comparison.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
@@ -233,7 +236,7 @@ fn truth_samples(sc: &Scenario, rate: f64) -> Vec<Sample> {
 }
 
 /// Runs `est` over `data`; returns `(t, value, std)` per sample.
-fn run(est: &mut dyn Estimator, data: &[Measurement]) -> Vec<(f64, [f64; 4], [f64; 4])> {
+fn run(est: &mut dyn Estimator, data: &[Measurement]) -> History {
     data.iter()
         .map(|m| {
             est.update(m).expect("the study's samples are valid");
@@ -660,7 +663,7 @@ struct StepRow {
     detect: Option<f64>,
     follow: Option<f64>,
     final_mu: f64,
-    hist: Vec<(f64, [f64; 4], [f64; 4])>,
+    hist: History,
 }
 
 fn step(grid: &Grid) -> anyhow::Result<(Vec<StepRow>, String)> {
@@ -999,7 +1002,7 @@ fn figure(
 
 /// The figure's run: the 1 m/s push at 100 Hz, 1 mm / 1 mrad, seed 1, and
 /// its friction points (file frame).
-fn figure_run(sc: &Scenario) -> (Vec<(f64, [f64; 4], [f64; 4])>, Vec<(f64, f64)>, [f64; 4]) {
+fn figure_run(sc: &Scenario) -> (History, Vec<(f64, f64)>, [f64; 4]) {
     let (_, _, tr) = truth(sc);
     let data = measurements(&noise::add_noise(&truth_samples(sc, 100.0), 1e-3, 1e-3, 1));
     let md = track_model(sc).expect("loads");

@@ -355,3 +355,46 @@ fn track_study_quick_writes_its_files() {
     assert!(engines.lines().any(|l| l.starts_with("rapier2d,")));
     assert!(engines.lines().any(|l| l.starts_with("dynamic,")));
 }
+
+/// Every number with three or more decimals in the README's `track`
+/// section (README.md once merged, else README-track-section.md) appears in
+/// one of `results/track_*.csv`: the README quotes the files, it does not
+/// round or invent.
+#[test]
+fn readme_track_numbers_come_from_the_results_files() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let marker = "### Online friction estimation: `pushval track`";
+    let section = match readme.find(marker) {
+        Some(i) => {
+            let rest = &readme[i + marker.len()..];
+            let end = rest
+                .find("\n## ")
+                .or_else(|| rest.find("\n### "))
+                .unwrap_or(rest.len());
+            rest[..end].to_string()
+        }
+        None => std::fs::read_to_string(root().join("README-track-section.md")).unwrap(),
+    };
+    let mut results = String::new();
+    for e in std::fs::read_dir(root().join("results")).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().to_string();
+        if name.starts_with("track_") && name.ends_with(".csv") {
+            results += &std::fs::read_to_string(&p).unwrap();
+        }
+    }
+    let mut checked = 0;
+    for token in section.split(|c: char| !(c.is_ascii_digit() || c == '.')) {
+        let token = token.trim_matches('.');
+        if let Some((_, frac)) = token.split_once('.') {
+            if frac.len() >= 3 {
+                assert!(
+                    results.contains(token),
+                    "README number {token} is in no results/track_*.csv"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 10, "only {checked} numbers checked");
+}

@@ -325,9 +325,9 @@ impl Ekf {
         for (i, v) in [sp * sp, sp * sp, st * st, sw * sw].into_iter().enumerate() {
             self.p[(i, i)] = v;
         }
-        for a in 0..4 {
-            for b in 0..4 {
-                self.p[(4 + a, 4 + b)] = prior_q[a][b];
+        for (a, row) in prior_q.iter().enumerate() {
+            for (b, v) in row.iter().enumerate() {
+                self.p[(4 + a, 4 + b)] = *v;
             }
         }
         self.reopened += 1;
