@@ -443,15 +443,30 @@ fn pusher_force_samples_sharpen_the_estimate() {
     }
     let (with, rejections) = run_ekf(&data, Free::default(), EkfSettings::default());
     assert_eq!(rejections, 0);
-    let pose_only: Vec<Measurement> = data.iter().map(|m| Measurement { force: None, ..*m }).collect();
+    let pose_only: Vec<Measurement> = data
+        .iter()
+        .map(|m| Measurement { force: None, ..*m })
+        .collect();
     let (without, _) = run_ekf(&pose_only, Free::default(), EkfSettings::default());
     let (e, e0) = (with.estimate(), without.estimate());
     let i_true = paper_plate().inertia_cm() * 0.95;
     assert!((e.value[0] / 1.1 - 1.0).abs() < 0.01, "{:?}", e.value);
     assert!((e.value[3] / i_true - 1.0).abs() < 0.02, "{:?}", e.value);
-    assert!(e.value[1].abs() < 1e-3 && e.value[2].abs() < 1e-3, "{:?}", e.value);
+    assert!(
+        e.value[1].abs() < 1e-3 && e.value[2].abs() < 1e-3,
+        "{:?}",
+        e.value
+    );
     for k in 0..4 {
-        assert!(e.std()[k] < e0.std()[k], "component {k}: {} vs {}", e.std()[k], e0.std()[k]);
-        assert!((e.value[k] - [1.1, 0.0, 0.0, i_true][k]).abs() < 4.0 * e.std()[k], "component {k}");
+        assert!(
+            e.std()[k] < e0.std()[k],
+            "component {k}: {} vs {}",
+            e.std()[k],
+            e0.std()[k]
+        );
+        assert!(
+            (e.value[k] - [1.1, 0.0, 0.0, i_true][k]).abs() < 4.0 * e.std()[k],
+            "component {k}"
+        );
     }
 }

@@ -4,7 +4,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{
     Estimate, Estimator, Free, LackOfFit, Measurement, TrackError, TrackModel, UpdateReport,
-    INERTIA,
+    INERTIA, MU,
 };
 use crate::{perp, rotate, Vec2};
 
@@ -94,6 +94,8 @@ pub struct Ekf {
     settings: EkfSettings,
     free: [bool; 4],
     prior_var: [f64; 4],
+    /// The start values of the parameters (the fixed ones keep them).
+    start: [f64; 4],
     s: Vec8,
     p: Mat8,
     time: f64,
@@ -154,6 +156,7 @@ impl Ekf {
             settings,
             free,
             prior_var,
+            start: p0,
             s,
             p,
             time: 0.0,
@@ -334,21 +337,29 @@ impl Ekf {
         self.test.clear();
     }
 
-    /// `γ₀ > 0` and `ζ > 0` (μ and I_P positive): clamped to [1 %, 100 ×]
-    /// their values at the problem's parameters, `I_cm` to at least 1 % of
-    /// the problem's; the centre of friction to within ten sizes of the
-    /// centre of mass.
+    /// Keeps the parameters in their domain and the fixed ones fixed, in
+    /// `p` (so that clamping one coordinate of `q` cannot move a fixed
+    /// parameter): `mu_scale` and `I_cm` within [1 %, 100 ×] of the
+    /// problem's values, the centre of friction within ten sizes of the
+    /// centre of mass; fixed parameters back to their start values.
     fn keep_in_domain(&mut self) {
-        let (q0, _) = self.model.to_q(&self.model.nominal());
-        self.s[4] = self.s[4].clamp(1e-2 * q0[0], 1e2 * q0[0]);
-        // I_cm > 0: ζ = 1 / I_P below 1 / (m |p_c|² + 1 % of the file's I_cm).
-        let md = &self.model;
-        let nominal = md.nominal();
-        let zeta_max = 1.0 / (md.mass() * md.contact().norm_squared() + 1e-2 * nominal[INERTIA]);
-        self.s[7] = self.s[7].clamp(1e-2 * q0[3], zeta_max.min(1e2 * q0[3]));
-        let reach = 10.0 * self.model.size() * self.s[4];
-        for i in [5, 6] {
-            self.s[i] = self.s[i].clamp(-reach, reach);
+        let (mut p, _) = self.model.from_q(&self.q());
+        let nominal = self.model.nominal();
+        let reach = 10.0 * self.model.size();
+        for j in 0..4 {
+            p[j] = if !self.free[j] {
+                self.start[j]
+            } else if j == MU || j == INERTIA {
+                let v = if p[j].is_finite() { p[j] } else { nominal[j] };
+                v.clamp(1e-2 * nominal[j], 1e2 * nominal[j])
+            } else {
+                let v = if p[j].is_finite() { p[j] } else { nominal[j] };
+                v.clamp(nominal[j] - reach, nominal[j] + reach)
+            };
+        }
+        let (q, _) = self.model.to_q(&p);
+        for (j, v) in q.iter().enumerate() {
+            self.s[4 + j] = *v;
         }
     }
 }
