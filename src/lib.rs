@@ -11,6 +11,7 @@ pub mod registry;
 pub mod report;
 pub mod stress;
 pub mod study;
+pub mod track;
 
 pub use harness::{run_scenario, Comparison, ModelRun, RunOptions, ScenarioReport, SegmentInfo};
 pub use registry::engines_table;

@@ -134,6 +134,54 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Estimate μ scale, the centre of friction and I_cm online, sample by
+    /// sample (`--trajectory -`: from standard input as rows arrive, each
+    /// estimate printed as it is made), and the resultant friction force;
+    /// write DIR/track.csv and DIR/track.json. Exit 1 when an estimate does
+    /// not converge or the model does not explain the data.
+    Track {
+        file: PathBuf,
+        /// The trajectory (t,x,y,theta,omega; model, fx, fy optional), or `-` for standard input.
+        #[arg(long, value_name = "CSV|-")]
+        trajectory: PathBuf,
+        /// What to estimate: mu_scale, center_of_friction, inertia_cm.
+        #[arg(
+            long,
+            value_name = "NAME[,NAME...]",
+            default_value = "mu_scale,center_of_friction,inertia_cm"
+        )]
+        params: String,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Which run of the CSV's `model` column (default: the only one).
+        #[arg(long, value_name = "NAME")]
+        model: Option<String>,
+        /// Noise level of x and y (m).
+        #[arg(long, default_value_t = 1e-3, value_name = "M")]
+        sigma_position: f64,
+        /// Noise level of theta (rad).
+        #[arg(long, default_value_t = 1e-3, value_name = "RAD")]
+        sigma_theta: f64,
+        /// Use the omega column as a measurement with this noise level (rad/s).
+        #[arg(long, value_name = "RAD/S")]
+        sigma_omega: Option<f64>,
+        /// Noise level of each pusher force component when the CSV has fx, fy (N).
+        #[arg(long, default_value_t = 0.05, value_name = "N")]
+        sigma_force: f64,
+    },
+    /// Measure online friction estimation (cost per update, convergence
+    /// against noise and sample rate, efficiency against the Cramér–Rao
+    /// bound, a μ step, every engine tracked); write OUT/track_*.csv,
+    /// OUT/track.svg and OUT/track.md.
+    TrackStudy {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        /// Reduced grids (for tests).
+        #[arg(long)]
+        quick: bool,
+    },
     /// Measure the gate's power: the smallest model error of each kind the
     /// default gate (and `compare`) catches; write OUT/gate_power.{csv,svg}.
     Power {
@@ -356,6 +404,32 @@ fn main() -> ExitCode {
             },
         }),
         Some(Command::FitStudy { out, quick }) => pushval::fit::study::cli(&out, quick),
+        Some(Command::Track {
+            file,
+            trajectory,
+            params,
+            out,
+            model,
+            sigma_position,
+            sigma_theta,
+            sigma_omega,
+            sigma_force,
+        }) => pushval::track::cli(&pushval::track::Request {
+            scenario: file,
+            trajectory: pushval::track::Source::parse(&trajectory),
+            params,
+            out,
+            model,
+            settings: pushval_model::track::EkfSettings {
+                sigma_position,
+                sigma_theta,
+                sigma_omega,
+                sigma_force: Some(sigma_force),
+                initial_std: [sigma_position, sigma_theta, 1e-2],
+                ..Default::default()
+            },
+        }),
+        Some(Command::TrackStudy { out, quick }) => pushval::track::study::cli(&out, quick),
         Some(Command::Engines) => {
             print!("{}", pushval::engines_table());
             Ok(ExitCode::SUCCESS)

@@ -18,3 +18,4 @@ mod report;
 mod scenarios;
 mod stress;
 mod study;
+mod track;

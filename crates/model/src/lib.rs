@@ -13,6 +13,8 @@
 //!   with ψ the root of the friction moment alone.
 //! * [`kappa`]: the scaling factor `κ = ω* / (v_c ψ)` between the two, exactly
 //!   and as a series in the Froude number.
+//! * [`track`]: online estimators of μ, the centre of friction and I_cm from
+//!   a stream of pose samples, and the resultant friction force.
 //! * [`limit_surface`]: the ellipsoidal limit-surface approximation used in
 //!   quasi-static planning (Goyal, Ruina & Papadopoulos; Lynch, Maekawa & Tanie).
 //!
@@ -35,6 +37,7 @@ pub mod limit_surface;
 mod problem;
 mod rotor;
 mod tail;
+pub mod track;
 mod trajectory;
 
 pub use arc::{arc_advance, sinc_versc};
