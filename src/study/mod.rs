@@ -21,7 +21,7 @@
 //!
 //! What a study varies is data, `studies/MODEL.toml` ([`spec`]); nothing
 //! here names an engine. `all` runs every model of this build and writes an
-//! index, `OUT/README.md`, from the folders' files.
+//! index, `OUT/README.md`, from the folders' files (`index` writes only it).
 //!
 //! A study is a fixed list of tasks (engine runs, fits), each keyed and
 //! reduced to a row of numbers; the files are written from the rows alone.
@@ -384,6 +384,19 @@ pub fn run_model(model: &str, dir: &Path, opts: &Options) -> anyhow::Result<Summ
 pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
     let all = models();
     spec::check_names(&opts.studies, &all)?;
+    let root = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
+    if name == "index" {
+        // Only the index, from the model folders as they are.
+        let mut w = Writer::new(&root)?;
+        readme::index(&root, &all, opts.quick, &mut w)?;
+        return Ok(Summary {
+            files: w.into_written(),
+            ..Summary::default()
+        });
+    }
     if name != "all" {
         if !all.iter().any(|m| m == name) {
             bail!("unknown model `{name}`; known: {}, all", all.join(", "));
