@@ -124,12 +124,11 @@ pub fn class_code(c: Option<LawClass>) -> [f64; 4] {
 
 /// The class name of a code (empty for none).
 pub fn class_name(code: f64) -> &'static str {
-    match code {
-        c if c == 0.0 => "turns",
-        c if c == 1.0 => "locked",
-        c if c == 2.0 => "semi_stable",
-        _ => "",
-    }
+    ["turns", "locked", "semi_stable"]
+        .into_iter()
+        .enumerate()
+        .find(|(i, _)| *i as f64 == code)
+        .map_or("", |(_, n)| n)
 }
 
 /// A model's study: its setups, steps and task list.
