@@ -141,7 +141,9 @@ fn variants() -> Vec<(String, Box<dyn pushval_engine::Engine>)> {
             let mut opts = pushval_engine::EngineOptions::default();
             opts.values
                 .insert("friction_velocity".into(), serde_json::json!("body"));
-            let e = entry.build(&opts).expect("body is a friction_velocity mode");
+            let e = entry
+                .build(&opts)
+                .expect("body is a friction_velocity mode");
             out.push((format!("{}[body]", entry.name), e));
         }
     }

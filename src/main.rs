@@ -76,24 +76,30 @@ enum Command {
         #[arg(long)]
         merge: bool,
     },
-    /// Regenerate results/friction_models/: where each engine's own friction
-    /// disagrees with Coulomb support friction, and the closed forms that
-    /// explain it.
+    /// One engine model's friction against Coulomb and against the engine's
+    /// own law in closed form: results/friction_models/MODEL/ (or --out DIR).
     Study {
-        /// coulomb_fits, idioms, rapier3d, box2d, mujoco (--features mujoco), avian (--features avian), physx (--features physx), or all.
+        /// A model of `pushval engines`, or all (every model of this build,
+        /// each into OUT/MODEL/, and OUT/README.md).
         name: String,
-        /// Output folder (created if missing).
-        #[arg(long, default_value = "results/friction_models")]
-        out: PathBuf,
+        /// Output folder (created if missing); default
+        /// results/friction_models/MODEL (for all: results/friction_models).
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// Reduced grids (for tests).
         #[arg(long)]
         quick: bool,
-        /// Compute only part K of N of each study's runs into OUT/parts/ (batch schedulers).
-        #[arg(long, value_name = "K/N", conflicts_with = "merge")]
+        /// Compute only part K of N of the tasks (K/N contiguous, hash:K/N by
+        /// each task's key) into parts/; without it, a Slurm array task
+        /// (SLURM_ARRAY_TASK_ID/COUNT) computes its own part.
+        #[arg(long, value_name = "[hash:]K/N", conflicts_with = "merge")]
         shard: Option<pushval::report::Shard>,
-        /// Build the outputs from the parts in OUT/parts/ instead of running the engines.
+        /// Build the outputs from the part files instead of running the engines.
         #[arg(long)]
         merge: bool,
+        /// Folder of the study files (MODEL.toml); default studies/.
+        #[arg(long, value_name = "DIR")]
+        studies: Option<PathBuf>,
     },
     /// List every engine model: crate, engine version, order, whether it can
     /// be gated and whether this build has it.
@@ -448,7 +454,17 @@ fn main() -> ExitCode {
             quick,
             shard,
             merge,
-        }) => pushval::study::cli(&name, out, quick, shard, merge),
+            studies,
+        }) => pushval::study::cli(
+            &name,
+            pushval::study::Options {
+                quick,
+                shard,
+                merge,
+                studies: studies.unwrap_or_else(pushval::study::spec::default_dir),
+                ..pushval::study::Options::new(out)
+            },
+        ),
     };
     match result {
         Ok(code) => code,

@@ -213,11 +213,13 @@ pub fn par_rows<T: Sync>(
 }
 
 /// The part files of the report's sweeps.
-fn sweep_parts(quick: bool) -> Parts<'static> {
+fn sweep_parts(quick: bool, total: usize) -> Parts<'static> {
+    let keys: Vec<String> = (0..total).map(|i| i.to_string()).collect();
     Parts {
         tag: "report sweep",
         stem: "sweep",
         grid: grid_name(quick),
+        hash: shard::grid_hash(&keys),
     }
 }
 
@@ -237,12 +239,21 @@ pub fn run(opts: &Options) -> anyhow::Result<Summary> {
     }
     let geoms = cells::geometries(&opts.scenarios)?;
     let tasks = cells::tasks(&geoms, opts.quick);
-    let parts = sweep_parts(opts.quick);
+    let parts = sweep_parts(opts.quick, tasks.len());
     let mut w = Writer::new(&opts.out)?;
-    if let Some(shard) = opts.shard {
+    let from_env = if opts.merge { None } else { Shard::from_env()? };
+    let env_shard = from_env.map(|s| Shard {
+        by_hash: false,
+        ..s
+    });
+    if let Some(shard) = opts.shard.or(env_shard) {
+        if shard.by_hash {
+            bail!("pushval report splits its sweeps by position only: --shard K/N, not hash:K/N");
+        }
         let range = shard_range(tasks.len(), shard);
         let rows = cells::compute(&geoms, &tasks, range.clone(), opts.quick, opts.progress);
-        let text = parts.text(tasks.len(), range.clone(), &rows, shard);
+        let idx: Vec<usize> = range.clone().collect();
+        let text = parts.text(tasks.len(), &idx, &rows, shard);
         w.file(&parts.file_name(shard), text.as_bytes())?;
         return Ok(Summary {
             files: w.written,

@@ -2,8 +2,13 @@
 //! the shard I/O of `pushval report` and `pushval study`.
 //!
 //! A computation that can be split is a fixed list of tasks (fixed by its
-//! grid, `--quick` or full), each reduced to a row of numbers. `--shard K/N`
-//! computes the K-th of N contiguous parts of the list and writes
+//! grid, `--quick` or full), each named by a key and reduced to a row of
+//! numbers. `--shard K/N` computes the K-th of N contiguous parts of the
+//! list; `--shard hash:K/N` the tasks whose key hashes to K (FNV-1a, mod N),
+//! so adding tasks moves no others between shards (as cargo-nextest's
+//! `hash:` partitions do). Without `--shard`, a Slurm array task
+//! (`SLURM_ARRAY_TASK_ID`, `SLURM_ARRAY_TASK_COUNT`, `SLURM_ARRAY_TASK_MIN`)
+//! picks its own part ([`Shard::from_env`]). Each part is written to
 //! `OUT/parts/NAME-K-of-N.csv`; `--merge` reads the N parts back into the
 //! rows of every task, from which the caller builds exactly the files a
 //! single run writes.
@@ -11,10 +16,13 @@
 //! # Format
 //!
 //! A part file is a header line
-//! `# pushval TAG part K/N grid=GRID tasks=T` (T the length of the whole
-//! list), then one line per task of the part, `index,value,...`, with the
-//! numbers in Rust's shortest round-trip form (so a merge reproduces the
-//! single run's numbers exactly; `NaN` and `inf` as Rust prints them).
+//! `# pushval TAG part K/N grid=GRID tasks=T split=range|hash hash=H version=V`
+//! (T the length of the whole list, H the FNV-1a hash of its keys, V the
+//! pushval version), then one line per task of the part, `index,value,...`,
+//! with the numbers in Rust's shortest round-trip form (so a merge
+//! reproduces the single run's numbers exactly; `NaN` and `inf` as Rust
+//! prints them). A merge refuses parts of another grid, hash, version or
+//! split, a task in two parts or in none, and names the missing shards.
 
 use std::ops::Range;
 use std::path::Path;
@@ -24,16 +32,85 @@ use anyhow::{bail, Context};
 
 use super::num;
 
-/// One part of N of a task list: `K/N` with 1 ≤ K ≤ N.
+/// One part of N of a task list: `K/N` (contiguous) or `hash:K/N` (by the
+/// hash of each task's key), with 1 ≤ K ≤ N.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Shard {
     pub k: usize,
     pub n: usize,
+    /// Tasks chosen by the hash of their key, not by position.
+    pub by_hash: bool,
+}
+
+impl Shard {
+    /// The part a Slurm array task computes: K = `SLURM_ARRAY_TASK_ID` −
+    /// `SLURM_ARRAY_TASK_MIN` + 1 (MIN 0 when unset), N =
+    /// `SLURM_ARRAY_TASK_COUNT`, by hash. None outside an array job.
+    pub fn from_env() -> anyhow::Result<Option<Shard>> {
+        let var = |name: &str| std::env::var(name).ok();
+        let (Some(id), Some(count)) = (var("SLURM_ARRAY_TASK_ID"), var("SLURM_ARRAY_TASK_COUNT"))
+        else {
+            return Ok(None);
+        };
+        let num = |name: &str, v: &str| {
+            v.trim()
+                .parse::<usize>()
+                .map_err(|_| anyhow::anyhow!("{name}={v}: not a task number"))
+        };
+        let min = var("SLURM_ARRAY_TASK_MIN").map_or(Ok(0), |m| num("SLURM_ARRAY_TASK_MIN", &m))?;
+        let (id, n) = (
+            num("SLURM_ARRAY_TASK_ID", &id)?,
+            num("SLURM_ARRAY_TASK_COUNT", &count)?,
+        );
+        if id < min || id - min >= n {
+            bail!("SLURM_ARRAY_TASK_ID={id} is outside the array's {n} tasks from {min} (SLURM_ARRAY_TASK_MIN)");
+        }
+        Ok(Some(Shard {
+            k: id - min + 1,
+            n,
+            by_hash: true,
+        }))
+    }
+
+    /// The indices of the tasks (named by `keys`) in this part.
+    pub fn indices(&self, keys: &[String]) -> Vec<usize> {
+        if self.by_hash {
+            (0..keys.len())
+                .filter(|&i| (fnv1a(&keys[i]) % self.n as u64) as usize == self.k - 1)
+                .collect()
+        } else {
+            shard_range(keys.len(), *self).collect()
+        }
+    }
+
+    fn split(&self) -> &'static str {
+        if self.by_hash {
+            "hash"
+        } else {
+            "range"
+        }
+    }
+}
+
+/// FNV-1a, 64 bits: a hash that is the same on every machine and version.
+pub fn fnv1a(s: &str) -> u64 {
+    s.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The hash of a task list: FNV-1a of its keys, one a line, in hex.
+pub fn grid_hash(keys: &[String]) -> String {
+    format!("{:016x}", fnv1a(&keys.join("\n")))
 }
 
 impl FromStr for Shard {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let (by_hash, s) = match s.strip_prefix("hash:") {
+            Some(rest) => (true, rest),
+            None => (false, s),
+        };
         let (k, n) = s
             .split_once('/')
             .ok_or_else(|| format!("expected K/N (e.g. 2/8), got '{s}'"))?;
@@ -42,12 +119,12 @@ impl FromStr for Shard {
         if n == 0 || k == 0 || k > n {
             return Err(format!("need 1 <= K <= N, got '{s}'"));
         }
-        Ok(Self { k, n })
+        Ok(Self { k, n, by_hash })
     }
 }
 
 /// What names a split computation in its part files.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Parts<'a> {
     /// What the header calls it, e.g. `report sweep` or `study idioms`.
     pub tag: &'a str,
@@ -55,6 +132,8 @@ pub struct Parts<'a> {
     pub stem: &'a str,
     /// The grid's name, `full` or `quick`: parts of different grids never merge.
     pub grid: &'a str,
+    /// The hash of the task list's keys ([`grid_hash`]).
+    pub hash: String,
 }
 
 /// The grid name of a run: `quick` or `full`.
@@ -79,20 +158,21 @@ impl Parts<'_> {
         format!("parts/{}-{}-of-{}.csv", self.stem, shard.k, shard.n)
     }
 
-    /// The part file of `rows`, the results of `tasks` `range` of a list of
-    /// `total` tasks (see the module's format).
-    pub fn text(
-        &self,
-        total: usize,
-        range: Range<usize>,
-        rows: &[Vec<f64>],
-        shard: Shard,
-    ) -> String {
+    /// The part file of `rows`, the results of the tasks `indices` of a
+    /// list of `total` tasks (see the module's format).
+    pub fn text(&self, total: usize, indices: &[usize], rows: &[Vec<f64>], shard: Shard) -> String {
         let mut s = format!(
-            "# pushval {} part {}/{} grid={} tasks={}\n",
-            self.tag, shard.k, shard.n, self.grid, total
+            "# pushval {} part {}/{} grid={} tasks={} split={} hash={} version={}\n",
+            self.tag,
+            shard.k,
+            shard.n,
+            self.grid,
+            total,
+            shard.split(),
+            self.hash,
+            env!("CARGO_PKG_VERSION")
         );
-        for (idx, row) in range.zip(rows) {
+        for (&idx, row) in indices.iter().zip(rows) {
             s.push_str(&idx.to_string());
             for v in row {
                 s.push(',');
@@ -133,7 +213,7 @@ impl Parts<'_> {
             );
         }
         let mut rows: Vec<Option<Vec<f64>>> = vec![None; total];
-        let mut seen: Vec<(usize, usize)> = Vec::new();
+        let mut seen: Vec<(usize, usize, bool)> = Vec::new();
         let head_prefix = format!("# pushval {} part ", self.tag);
         for f in &files {
             let text =
@@ -165,7 +245,28 @@ impl Parts<'_> {
                     total
                 );
             }
-            seen.push((kn.k, kn.n));
+            let field = |name: &str| {
+                rest.split_whitespace()
+                    .find_map(|w| w.strip_prefix(name))
+                    .unwrap_or("")
+                    .to_string()
+            };
+            let (split, hash, version) = (field("split="), field("hash="), field("version="));
+            if hash != self.hash {
+                bail!(
+                    "{}: computed for a task list with hash {hash}, this one has {}: the grid or the study changed; run the shards again",
+                    f.display(),
+                    self.hash
+                );
+            }
+            if version != env!("CARGO_PKG_VERSION") {
+                bail!(
+                    "{}: written by pushval {version}, this is {}",
+                    f.display(),
+                    env!("CARGO_PKG_VERSION")
+                );
+            }
+            seen.push((kn.k, kn.n, split == "hash"));
             for (ln, line) in lines.enumerate() {
                 let mut fields = line.split(',');
                 let idx: usize = fields
@@ -188,20 +289,22 @@ impl Parts<'_> {
                 *slot = Some(vals);
             }
         }
-        let n = seen[0].1;
-        if seen.iter().any(|&(_, m)| m != n) {
+        let (n, by_hash) = (seen[0].1, seen[0].2);
+        if seen.iter().any(|&(_, m, h)| m != n || h != by_hash) {
             bail!(
                 "{} holds parts of different splits ({:?}); remove the stale ones",
                 dir.display(),
                 seen
             );
         }
-        let missing: Vec<usize> = (1..=n)
+        let missing: Vec<String> = (1..=n)
             .filter(|k| !seen.iter().any(|s| s.0 == *k))
+            .map(|k| format!("{}{k}/{n}", if by_hash { "hash:" } else { "" }))
             .collect();
         if !missing.is_empty() {
             bail!(
-                "missing parts {missing:?} of {n} of {} in {}",
+                "missing shards {} of {} in {} (run them with --shard)",
+                missing.join(", "),
                 self.stem,
                 dir.display()
             );

@@ -1,141 +1,321 @@
-//! `pushval study NAME|all`: regenerates `results/friction_models/`, where
-//! each engine's own friction law disagrees with Coulomb support friction
-//! and what explains it, in closed form.
+//! `pushval study MODEL|all`: one study for every engine model the registry
+//! lists (outside engines included): where the engine's friction disagrees
+//! with Coulomb support friction, and whether the engine's own friction law
+//! in closed form ([`pushval_engine::FrictionLaw`], declared by the engine
+//! through [`Engine::law`]) explains it.
 //!
-//! One module per study, each writing its folder of the output:
+//! For a model, in `results/friction_models/MODEL/` (or `--out DIR`):
 //!
-//! * [`idioms`] (`OUT/`): the friction idioms of 2-D game engines, run in
-//!   rapier2d, against Coulomb; its README also gathers the other studies'
-//!   paper-plate numbers and findings, so `all` runs it last;
-//! * [`rapier3d`] (`OUT/rapier3d/`): rapier3d's own contact friction;
-//! * [`box2d`] (`OUT/box2d/`): Box2D's per-support Coulomb model and its
-//!   motor-joint idiom (through the registry's `Engine` trait, with the
-//!   idiom's closed form from `pushval_box2d::predict`);
-//! * `mujoco` (`OUT/mujoco/`): MuJoCo's friction cones; compiled only with
-//!   the root feature `mujoco` (without it `study mujoco` exits 2 naming the
-//!   feature and `study all` skips it, keeping `OUT/mujoco/` as it is);
-//! * `avian` (`OUT/avian/`): Avian's per-support Coulomb model (avian2d) and
-//!   its own contact friction in closed form (avian3d, through the crate's
-//!   simulators and `pushval_avian::predict`); compiled only with the root
-//!   feature `avian`, gated like `mujoco`;
-//! * `physx` (`OUT/physx/`): PhysX's friction types on the feet-on-floor
-//!   scene against their closed forms (`pushval_physx::predict`), and which
-//!   lock criterion PhysX follows; compiled only with the root feature
-//!   `physx`, gated like `mujoco`.
+//! * `paper_plate.csv`: the steady ω at v_c 0.2, 0.5, 1 m/s, φ = π/4 + 0.3,
+//!   against the Coulomb model's ω* and the law's;
+//! * `map.csv`: the same over a 20 × 20 (Fr, φ) grid (5 × 5 `--quick`), with
+//!   the law's class of each cell (`turns`, `locked`, `semi_stable`);
+//! * `dt_ladder.csv`: the steady ω at 0.5 m/s over a ladder of steps, its
+//!   observed order and the Richardson extrapolation at the declared order;
+//! * `creep.csv`, where the law locks at a table push: the same ladder
+//!   there, to show whether the engine's creep shrinks with the step;
+//! * `variants.csv` and `map_NAME.csv`: the tables (and maps) of the
+//!   study file's variants (other `[engine]` options or supports);
+//! * `coulomb_fit.csv`: the Coulomb model fitted to the engine ([`fit`]);
+//! * `README.md`, written from those files' data ([`readme`]).
 //!
-//! A study is a fixed list of tasks (engine runs and the closed forms that
-//! need their output), each reduced to a row of numbers ([`Study::eval`]);
-//! every file is then written from the rows alone ([`Study::write`]), so the
-//! READMEs state no number that is not computed from the data beside them.
-//! The tasks run in parallel (rayon) with a progress bar (none when `CI` is
-//! set), and split for a batch scheduler like `pushval report`'s sweeps:
-//! `--shard K/N` computes the K-th of N parts of each study's task list into
-//! `OUT/parts/STUDY-K-of-N.csv`, `--merge` rebuilds from the parts exactly
-//! the files a single run writes (see [`crate::report::shard`]).
+//! What a study varies is data, `studies/MODEL.toml` ([`spec`]); nothing
+//! here names an engine. `all` runs every model of this build and writes an
+//! index, `OUT/README.md`, from the folders' files (`index` writes only it).
 //!
-//! Every study runs the scene of [`plate`]; the figures are drawn by
-//! [`crate::report::plot`] (one heat map for every (Fr, φ) map).
-//!
-//! The engines run through their crates' own simulators, not the
-//! [`pushval_engine::Engine`] trait: every task reads what a trajectory does
-//! not carry (the engine's step history, per-foot loads and friction,
-//! contact manifolds, tail statistics). The registry still names and
-//! versions each engine in the READMEs.
+//! A study is a fixed list of tasks (engine runs, fits), each keyed and
+//! reduced to a row of numbers; the files are written from the rows alone.
+//! The tasks run in parallel (rayon) with a progress bar, and split over
+//! processes or machines: `--shard K/N`, `--shard hash:K/N`, or a Slurm
+//! array's variables; `--merge` rebuilds exactly the single run's files
+//! ([`crate::report::shard`]).
 
-#[cfg(feature = "avian")]
-pub mod avian;
-pub mod box2d;
-pub mod fits;
-pub mod idioms;
-#[cfg(feature = "mujoco")]
-pub mod mujoco;
-#[cfg(feature = "physx")]
-pub mod physx;
+pub mod fit;
 pub mod plate;
-pub mod rapier3d;
+pub mod readme;
+pub mod spec;
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
+use pushval_engine::{rel_err, tail_mean_omega, Engine, EngineOptions, LawClass};
 
-use crate::report::plot::{cell_edges, heat_map, Axis, Figure, MapCell, Panel, Scale};
-use crate::report::shard::{grid_name, shard_range, Parts, Shard};
+use crate::report::shard::{grid_hash, grid_name, Parts, Shard};
 use crate::report::{par_rows, Writer};
-
-/// The studies on the command line, in the order `all` runs them.
-pub const STUDIES: [&str; 7] = [
-    "rapier3d",
-    "mujoco",
-    "box2d",
-    "avian",
-    "physx",
-    "coulomb_fits",
-    "idioms",
-];
-
-/// The cargo feature that brings in the MuJoCo study.
-pub const MUJOCO_FEATURE: &str =
-    "the MuJoCo study needs the cargo feature `mujoco` (build with --features mujoco; scripts/setup-mujoco.sh provides libmujoco.so)";
-
-/// The cargo feature that brings in the Avian study.
-pub const AVIAN_FEATURE: &str =
-    "the Avian study needs the cargo feature `avian` (build with --features avian)";
-
-/// The cargo feature that brings in the PhysX study.
-pub const PHYSX_FEATURE: &str =
-    "the PhysX study needs the cargo feature `physx` (build with --features physx; needs clang++: apt-get install clang)";
+use plate::{frs, length, paper_plate, phis, speed_of, PHI_TABLE, TABLE_SPEEDS};
+use spec::Spec;
 
 /// What `pushval study` does.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// Output folder (created if missing); default `results/friction_models`.
-    pub out: PathBuf,
+    /// `--out`: the model's folder (for `all`, the parent of every model's).
+    pub out: Option<PathBuf>,
     /// Reduced grids (for tests).
     pub quick: bool,
-    /// Compute only this part of each study's tasks and write a part file.
+    /// Compute only this part of the tasks and write a part file.
     pub shard: Option<Shard>,
-    /// Build every output from the part files in `OUT/parts/`.
+    /// Build every output from the part files.
     pub merge: bool,
     /// Draw a progress bar (still only on a terminal and when `CI` is unset).
     pub progress: bool,
+    /// The folder of the study files.
+    pub studies: PathBuf,
 }
 
 impl Options {
-    pub fn new(out: impl Into<PathBuf>) -> Self {
+    pub fn new(out: Option<PathBuf>) -> Self {
         Self {
-            out: out.into(),
+            out,
             quick: false,
             shard: None,
             merge: false,
             progress: true,
+            studies: spec::default_dir(),
         }
     }
 }
 
-/// One study: a fixed task list, the numbers of each task, and the files
-/// built from them.
-pub trait Study: Sync {
-    /// A task: one engine run (with the closed forms that need its output).
-    type Task: Sync;
-    /// The study's name on the command line and in part files.
-    fn name(&self) -> &'static str;
-    /// Its folder under the output folder (`""`: the output folder).
-    fn dir(&self) -> &'static str;
-    /// The task list (fixed by the grid).
-    fn tasks(&self) -> Vec<Self::Task>;
-    /// How many numbers a task gives, where fixed (checked on merge).
-    fn width(&self, task: &Self::Task) -> Option<usize>;
-    /// Runs a task.
-    fn eval(&self, task: &Self::Task) -> Vec<f64>;
-    /// Writes every file of the study from the rows of all tasks; `out` is
-    /// the output folder (a study may read another's data there).
-    fn write(
-        &self,
-        tasks: &[Self::Task],
-        rows: &[Vec<f64>],
-        out: &Path,
-        w: &mut Writer,
-    ) -> anyhow::Result<()>;
+/// The default output folder of every study.
+pub const DEFAULT_OUT: &str = "results/friction_models";
+
+/// One setup of a study: the study's own options or a variant's.
+pub struct Setup {
+    /// `""` for the study's own setup, else the variant's name.
+    pub name: String,
+    pub engine: Box<dyn Engine>,
+    pub options: EngineOptions,
+    pub supports_half: Option<f64>,
+    /// Direction of its table (rad).
+    pub phi: f64,
+    /// Its step (s).
+    pub dt: f64,
+    pub map: bool,
+}
+
+/// One task: an engine run or a fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Task {
+    /// Setup `s` at `TABLE_SPEEDS[v]` in its table direction.
+    Table { s: usize, v: usize },
+    /// The step ladder: `ladder[k]` at 0.5 m/s, φ = π/4 + 0.3.
+    Ladder { k: usize },
+    /// The creep ladder: `ladder[k]` at `TABLE_SPEEDS[v]`.
+    Creep { v: usize, k: usize },
+    /// Setup `s`'s map at `frs[i]`, `phis[j]`.
+    Map { s: usize, i: usize, j: usize },
+    /// The Coulomb fit on schedule `k`.
+    Fit { k: usize },
+}
+
+/// Values of a run's row: ω of the engine, of Coulomb and of the law
+/// (rad/s), the law's class code ([`class_code`]) and its rest moments.
+pub const RUN_WIDTH: usize = 7;
+
+/// The code of a class in a row: 0 turns, 1 locked, 2 semi-stable; NaN none.
+pub fn class_code(c: Option<LawClass>) -> [f64; 4] {
+    match c {
+        None => [f64::NAN; 4],
+        Some(LawClass::Turns) => [0.0, f64::NAN, f64::NAN, f64::NAN],
+        Some(LawClass::Locked) => [1.0, f64::NAN, f64::NAN, f64::NAN],
+        Some(LawClass::SemiStable { moment, lock, hold }) => [2.0, moment, lock, hold],
+    }
+}
+
+/// The class name of a code (empty for none).
+pub fn class_name(code: f64) -> &'static str {
+    ["turns", "locked", "semi_stable"]
+        .into_iter()
+        .enumerate()
+        .find(|(i, _)| *i as f64 == code)
+        .map_or("", |(_, n)| n)
+}
+
+/// A model's study: its setups, steps and task list.
+pub struct Plan {
+    pub model: String,
+    pub spec: Spec,
+    pub setups: Vec<Setup>,
+    pub quick: bool,
+    /// Step of the tables and maps (s).
+    pub dt: f64,
+    pub ladder: Vec<f64>,
+    pub t_run: f64,
+    pub tail: f64,
+    /// Table speeds (indices) at which the law locks: the creep ladder's.
+    pub creep: Vec<usize>,
+    pub fit: bool,
+}
+
+fn build(model: &str, options: &EngineOptions) -> anyhow::Result<Box<dyn Engine>> {
+    let e = crate::registry::entry(model).ok_or_else(|| {
+        anyhow::anyhow!("unknown model `{model}`; known: {}", models().join(", "))
+    })?;
+    e.build(options)
+        .map_err(|o| anyhow::anyhow!("{model}: {o}"))
+}
+
+/// Every engine model of the registry, in its order.
+pub fn models() -> Vec<String> {
+    crate::registry::entries()
+        .iter()
+        .map(|e| e.name.to_string())
+        .collect()
+}
+
+impl Plan {
+    /// The plan of `model` from its study file in `studies`.
+    pub fn new(model: &str, studies: &Path, quick: bool) -> anyhow::Result<Self> {
+        let spec = Spec::load(studies, model)?;
+        let options = spec.options(&BTreeMap::new());
+        let engine = build(model, &options)?;
+        if let Err(why) = engine.availability() {
+            bail!("the model `{model}` is not in this build: {why}");
+        }
+        let dt = spec.dt.unwrap_or(engine.default_dt());
+        let mut setups = vec![Setup {
+            name: String::new(),
+            engine,
+            options,
+            supports_half: None,
+            phi: PHI_TABLE,
+            dt,
+            map: true,
+        }];
+        for v in &spec.variant {
+            let options = spec.options(&v.engine);
+            setups.push(Setup {
+                name: v.name.clone(),
+                engine: build(model, &options)?,
+                options,
+                supports_half: v.supports_half,
+                phi: v.phi.unwrap_or(PHI_TABLE),
+                dt: v.dt.unwrap_or(dt),
+                map: v.map,
+            });
+        }
+        let t_run = spec.t_run.unwrap_or(6.0);
+        let law_locks = |v: usize| {
+            let p = paper_plate(TABLE_SPEEDS[v], PHI_TABLE, t_run, None);
+            setups[0]
+                .engine
+                .law()
+                .and_then(|l| l.steady(&p, 0, dt))
+                .is_some_and(|s| s.class != LawClass::Turns)
+        };
+        let creep = (0..TABLE_SPEEDS.len()).filter(|&v| law_locks(v)).collect();
+        Ok(Self {
+            model: model.to_string(),
+            ladder: spec.ladder(dt, quick),
+            tail: spec.tail.unwrap_or(0.2),
+            fit: spec.fit.unwrap_or(true),
+            spec,
+            setups,
+            quick,
+            dt,
+            t_run,
+            creep,
+        })
+    }
+
+    /// The task list (fixed by the grid and the study file).
+    pub fn tasks(&self) -> Vec<Task> {
+        let mut t = Vec::new();
+        for s in 0..self.setups.len() {
+            t.extend((0..TABLE_SPEEDS.len()).map(|v| Task::Table { s, v }));
+        }
+        t.extend((0..self.ladder.len()).map(|k| Task::Ladder { k }));
+        for &v in &self.creep {
+            t.extend((0..self.ladder.len()).map(|k| Task::Creep { v, k }));
+        }
+        for (s, setup) in self.setups.iter().enumerate() {
+            if setup.map {
+                for i in 0..frs(self.quick).len() {
+                    t.extend((0..phis(self.quick).len()).map(|j| Task::Map { s, i, j }));
+                }
+            }
+        }
+        if self.fit {
+            let n = if self.quick { 1 } else { fit::SCHEDULES.len() };
+            t.extend((0..n).map(|k| Task::Fit { k }));
+        }
+        t
+    }
+
+    /// The task's key: what it computes, so its hash shard never moves.
+    pub fn key(&self, t: &Task) -> String {
+        let m = &self.model;
+        let (speed, phi, dt, s) = self.push(t);
+        match t {
+            Task::Fit { k } => format!("{m}/fit/{}/{}", fit::SCHEDULES[*k], self.dt),
+            _ => format!(
+                "{m}/{}/{}/v={speed}/phi={phi}/dt={dt}/t={}/tail={}",
+                self.setups[s].name,
+                match t {
+                    Task::Creep { .. } => "creep",
+                    Task::Ladder { .. } => "ladder",
+                    _ => "run",
+                },
+                self.t_run,
+                self.tail
+            ),
+        }
+    }
+
+    /// Speed (m/s), direction (rad), step (s) and setup of a run task.
+    fn push(&self, t: &Task) -> (f64, f64, f64, usize) {
+        match *t {
+            Task::Table { s, v } => (TABLE_SPEEDS[v], self.setups[s].phi, self.setups[s].dt, s),
+            Task::Ladder { k } => (0.5, PHI_TABLE, self.ladder[k], 0),
+            Task::Creep { v, k } => (TABLE_SPEEDS[v], PHI_TABLE, self.ladder[k], 0),
+            Task::Map { s, i, j } => {
+                let (fr, phi) = (frs(self.quick)[i], phis(self.quick)[j]);
+                (speed_of(fr), phi, self.setups[s].dt, s)
+            }
+            Task::Fit { .. } => (f64::NAN, f64::NAN, self.dt, 0),
+        }
+    }
+
+    /// Runs a task: a run's row is [`RUN_WIDTH`] values, a fit's
+    /// [`fit::WIDTH`] (NaN where the engine or the fit fails).
+    pub fn eval(&self, t: &Task) -> Vec<f64> {
+        if let Task::Fit { k } = *t {
+            return fit::fit_engine(self.setups[0].engine.as_ref(), k, self.dt)
+                .unwrap_or_else(|_| vec![f64::NAN; fit::WIDTH]);
+        }
+        let (speed, phi, dt, s) = self.push(t);
+        let setup = &self.setups[s];
+        let p = paper_plate(speed, phi, self.t_run, setup.supports_half);
+        let engine = setup
+            .engine
+            .run(&p, dt)
+            .ok()
+            .and_then(|r| tail_mean_omega(&p, &r.trajectory, self.tail)[0])
+            .unwrap_or(f64::NAN);
+        let coulomb = pushval_engine::coulomb_steady(&p, 0).unwrap_or(f64::NAN);
+        let law = setup.engine.law().and_then(|l| l.steady(&p, 0, dt));
+        let mut row = vec![engine, coulomb, law.map_or(f64::NAN, |l| l.omega)];
+        row.extend(class_code(law.map(|l| l.class)));
+        row
+    }
+
+    fn width(&self, t: &Task) -> usize {
+        match t {
+            Task::Fit { .. } => fit::WIDTH,
+            _ => RUN_WIDTH,
+        }
+    }
+}
+
+/// The engine against a reference ω: relative with the gate's floor
+/// (`rel_err`); against a lock (reference 0), |ω| over |ω*|, the size of
+/// what the lock removes.
+pub fn err(engine: f64, reference: f64, coulomb: f64, speed: f64) -> f64 {
+    if reference == 0.0 {
+        rel_err(engine, 0.0, speed, length()).min(engine.abs() / coulomb.abs())
+    } else {
+        rel_err(engine, reference, speed, length())
+    }
 }
 
 /// What a study run did.
@@ -149,38 +329,49 @@ pub struct Summary {
     pub notes: Vec<String>,
 }
 
-/// Runs one study: its shard, its merge, or the whole of it.
-pub fn run_study<S: Study>(study: &S, opts: &Options) -> anyhow::Result<Summary> {
-    let tasks = study.tasks();
-    let tag = format!("study {}", study.name());
+/// Runs the study of one model into `dir`: its shard, its merge, or all.
+pub fn run_model(model: &str, dir: &Path, opts: &Options) -> anyhow::Result<Summary> {
+    let plan = Plan::new(model, &opts.studies, opts.quick)?;
+    let tasks = plan.tasks();
+    let keys: Vec<String> = tasks.iter().map(|t| plan.key(t)).collect();
+    let tag = format!("study {model}");
     let parts = Parts {
         tag: &tag,
-        stem: study.name(),
+        stem: model,
         grid: grid_name(opts.quick),
+        hash: grid_hash(&keys),
     };
-    if let Some(shard) = opts.shard {
-        let range = shard_range(tasks.len(), shard);
-        let rows = par_rows(&tasks[range.clone()], opts.progress, study.name(), |t| {
-            study.eval(t)
-        });
-        let mut w = Writer::new(&opts.out)?;
-        let text = parts.text(tasks.len(), range.clone(), &rows, shard);
-        w.file(&parts.file_name(shard), text.as_bytes())?;
+    let shard = match opts.shard {
+        Some(s) => Some(s),
+        None if !opts.merge => Shard::from_env()?,
+        None => None,
+    };
+    if let Some(shard) = shard {
+        let idx = shard.indices(&keys);
+        let mine: Vec<Task> = idx.iter().map(|&i| tasks[i]).collect();
+        let rows = par_rows(&mine, opts.progress, model, |t| plan.eval(t));
+        let mut w = Writer::new(dir)?;
+        w.file(
+            &parts.file_name(shard),
+            parts.text(tasks.len(), &idx, &rows, shard).as_bytes(),
+        )?;
         return Ok(Summary {
             files: w.into_written(),
-            tasks: range.len(),
+            tasks: idx.len(),
             notes: Vec::new(),
         });
     }
     let (rows, computed) = if opts.merge {
-        let width = |i: usize| study.width(&tasks[i]);
-        (parts.merge(&opts.out, tasks.len(), width)?, 0)
+        (
+            parts.merge(dir, tasks.len(), |i| Some(plan.width(&tasks[i])))?,
+            0,
+        )
     } else {
-        let rows = par_rows(&tasks, opts.progress, study.name(), |t| study.eval(t));
+        let rows = par_rows(&tasks, opts.progress, model, |t| plan.eval(t));
         (rows, tasks.len())
     };
-    let mut w = Writer::new(&opts.out.join(study.dir()))?;
-    study.write(&tasks, &rows, &opts.out, &mut w)?;
+    let mut w = Writer::new(dir)?;
+    readme::write(&plan, &tasks, &rows, &mut w)?;
     Ok(Summary {
         files: w.into_written(),
         tasks: computed,
@@ -188,75 +379,66 @@ pub fn run_study<S: Study>(study: &S, opts: &Options) -> anyhow::Result<Summary>
     })
 }
 
-/// Runs the study `name` (one of [`STUDIES`]) or `all` of them.
+/// Runs the study of `name` (a model of `pushval engines`) or `all` of
+/// this build's models (and writes the index).
 pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
-    if name == "all" {
-        let mut all = Summary::default();
-        for s in STUDIES {
-            if s == "mujoco" && !cfg!(feature = "mujoco") {
-                all.notes.push(format!(
-                    "skipped the MuJoCo study, keeping {} as it is: {MUJOCO_FEATURE}",
-                    opts.out.join("mujoco").display()
-                ));
-                continue;
-            }
-            if s == "avian" && !cfg!(feature = "avian") {
-                all.notes.push(format!(
-                    "skipped the Avian study, keeping {} as it is: {AVIAN_FEATURE}",
-                    opts.out.join("avian").display()
-                ));
-                continue;
-            }
-            if s == "physx" && !cfg!(feature = "physx") {
-                all.notes.push(format!(
-                    "skipped the PhysX study, keeping {} as it is: {PHYSX_FEATURE}",
-                    opts.out.join("physx").display()
-                ));
-                continue;
-            }
-            let one = run(s, opts)?;
-            all.files.extend(one.files);
-            all.tasks += one.tasks;
-            all.notes.extend(one.notes);
+    let all = models();
+    spec::check_names(&opts.studies, &all)?;
+    let root = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
+    if name == "index" {
+        // Only the index, from the model folders as they are.
+        let mut w = Writer::new(&root)?;
+        readme::index(&root, &all, opts.quick, &mut w)?;
+        return Ok(Summary {
+            files: w.into_written(),
+            ..Summary::default()
+        });
+    }
+    if name != "all" {
+        if !all.iter().any(|m| m == name) {
+            bail!("unknown model `{name}`; known: {}, all", all.join(", "));
         }
-        return Ok(all);
+        let dir = opts
+            .out
+            .clone()
+            .unwrap_or_else(|| Path::new(DEFAULT_OUT).join(name));
+        return run_model(name, &dir, opts);
     }
-    match name {
-        "idioms" => run_study(&idioms::Idioms { quick: opts.quick }, opts),
-        "rapier3d" => run_study(&rapier3d::Rapier3d { quick: opts.quick }, opts),
-        "box2d" => run_study(&box2d::Box2d { quick: opts.quick }, opts),
-        "coulomb_fits" => run_study(&fits::Fits { quick: opts.quick }, opts),
-        #[cfg(feature = "mujoco")]
-        "mujoco" => run_study(&mujoco::Mujoco { quick: opts.quick }, opts),
-        #[cfg(not(feature = "mujoco"))]
-        "mujoco" => bail!("{MUJOCO_FEATURE}"),
-        #[cfg(feature = "avian")]
-        "avian" => run_study(&avian::Avian { quick: opts.quick }, opts),
-        #[cfg(not(feature = "avian"))]
-        "avian" => bail!("{AVIAN_FEATURE}"),
-        #[cfg(feature = "physx")]
-        "physx" => run_study(&physx::Physx { quick: opts.quick }, opts),
-        #[cfg(not(feature = "physx"))]
-        "physx" => bail!("{PHYSX_FEATURE}"),
-        _ => bail!("unknown study '{name}'; known: {}, all", STUDIES.join(", ")),
+    let root = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
+    let mut sum = Summary::default();
+    for m in &all {
+        let e = crate::registry::engine(m, &EngineOptions::default());
+        if let Err(why) = e.availability() {
+            sum.notes.push(format!(
+                "skipped {m}, keeping {} as it is: {why}",
+                root.join(m).display()
+            ));
+            continue;
+        }
+        let one = run_model(m, &root.join(m), opts)?;
+        sum.files.extend(one.files);
+        sum.tasks += one.tasks;
     }
+    if opts.shard.is_none() && (opts.merge || Shard::from_env()?.is_none()) {
+        let mut w = Writer::new(&root)?;
+        readme::index(&root, &all, opts.quick, &mut w)?;
+        sum.files.extend(w.into_written());
+    }
+    Ok(sum)
 }
 
 /// `pushval study`: runs and prints what it wrote and how long it took.
-pub fn cli(
-    name: &str,
-    out: PathBuf,
-    quick: bool,
-    shard: Option<Shard>,
-    merge: bool,
-) -> anyhow::Result<std::process::ExitCode> {
+pub fn cli(name: &str, opts: Options) -> anyhow::Result<std::process::ExitCode> {
     let start = std::time::Instant::now();
-    let opts = Options {
-        quick,
-        shard,
-        merge,
-        ..Options::new(out)
-    };
+    if opts.merge && opts.shard.is_some() {
+        bail!("--shard and --merge exclude each other");
+    }
     let summary = run(name, &opts)?;
     for f in &summary.files {
         println!("wrote {}", f.display());
@@ -273,137 +455,11 @@ pub fn cli(
     Ok(std::process::ExitCode::SUCCESS)
 }
 
-/// The colour scale of every (Fr, φ) disagreement map: log10 of the
-/// relative steady-ω error from 1e-6 (blue) to 1 (red).
-pub const ERROR_SCALE: Scale = Scale::Log10 { lo: -6.0, hi: 0.0 };
-
-/// One cell of a (Fr, φ) map: `rel_err` its relative steady-ω error,
-/// `flags` the letters of its status (empty when ok).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ErrorCell {
-    /// Index into the map's Froude numbers.
-    pub i: usize,
-    /// Index into the map's push directions.
-    pub j: usize,
-    pub rel_err: f64,
-    pub flags: String,
-}
-
-/// One panel of a (Fr, φ) map: the heat map of [`ERROR_SCALE`] over φ
-/// (x) and Fr (y, log), each cell marked with `log10` of its error to one
-/// decimal and its status letters.
-pub fn error_panel(title: &str, frs: &[f64], phis: &[f64], cells: &[ErrorCell]) -> Panel {
-    let (fe, pe) = (cell_edges(frs, true), cell_edges(phis, false));
-    let map: Vec<MapCell> = cells
-        .iter()
-        .map(|c| {
-            let digits = match format!("{:.1}", c.rel_err.log10()) {
-                z if z == "-0.0" => "0.0".to_string(),
-                d => d,
-            };
-            MapCell {
-                x: pe[c.j],
-                y: fe[c.i],
-                value: c.rel_err,
-                mark: format!("{digits}{}", c.flags),
-            }
-        })
-        .collect();
-    heat_map(
-        title,
-        Axis::lin("push direction φ (rad)").range(pe[0].0, pe[pe.len() - 1].1),
-        Axis::log("Froude number Fr = v_c²/(μ g L)").range(fe[0].0, fe[fe.len() - 1].1),
-        &map,
-        &ERROR_SCALE,
-    )
-}
-
-/// A figure of (Fr, φ) error panels on `cols` columns, with the scale's key
-/// and what each status letter means (`(letter, meaning)`).
-pub fn error_figure(panels: Vec<Panel>, cols: usize, letters: &[(&str, &str)]) -> Figure {
-    let rows = panels.len().div_ceil(cols.max(1)) as u32;
-    let notes: Vec<String> = std::iter::once("cell: log10 of the error".to_string())
-        .chain(letters.iter().map(|(l, m)| format!("{l}: {m}")))
-        .collect();
-    // Room for every cell's mark: about 38 px a column, 24 px a row.
-    let distinct = |v: Vec<f64>| {
-        let mut v = v;
-        v.sort_by(f64::total_cmp);
-        v.dedup();
-        v.len() as u32
-    };
-    let (nx, ny) = panels.iter().fold((0, 0), |(nx, ny), p| {
-        (
-            distinct(p.cells.iter().map(|c| c.x.0).collect()).max(nx),
-            distinct(p.cells.iter().map(|c| c.y.0).collect()).max(ny),
-        )
-    });
-    let (w, h) = ((140 + 38 * nx).max(430), (130 + 24 * ny).max(420));
-    Figure {
-        size: (w * cols as u32 + 230, (h * rows).max(560)),
-        cols,
-        panels,
-        key: Some(ERROR_SCALE.key("|ω − ω*|/|ω*|", &[], &notes)),
-    }
-}
-
-/// The line a quick run's README carries (empty for a full run).
-pub fn quick_note(quick: bool) -> &'static str {
-    if quick {
-        "**Quick run: reduced grids (for tests).**\n\n"
-    } else {
-        ""
-    }
-}
-
 /// A number for a data file, blank where it is NaN (undefined).
 pub fn opt(v: f64) -> String {
     if v.is_nan() {
         String::new()
     } else {
         format!("{v}")
-    }
-}
-
-/// `(min, max)` of the finite values (`(NaN, NaN)` when there are none).
-pub fn min_max(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) = values
-        .into_iter()
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        });
-    if lo > hi {
-        (f64::NAN, f64::NAN)
-    } else {
-        (lo, hi)
-    }
-}
-
-/// `"a–b"` for a range printed with `digits` decimals (one value when they
-/// round alike).
-pub fn range_text(lo: f64, hi: f64, digits: usize) -> String {
-    let (a, b) = (format!("{lo:.digits$}"), format!("{hi:.digits$}"));
-    if a == b {
-        a
-    } else {
-        format!("{a}–{b}")
-    }
-}
-
-/// The median of the values (the upper one of an even count), NaN when empty.
-pub fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
-/// A label for a time step: `1/60` for 1/60 s, else the shortest form.
-pub fn dt_label(dt: f64) -> String {
-    let inv = 1.0 / dt;
-    if (inv - inv.round()).abs() < 1e-9 && inv.round() > 1.0 && inv.round() < 1000.0 {
-        format!("1/{}", inv.round())
-    } else {
-        format!("{dt:e}")
     }
 }

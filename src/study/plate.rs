@@ -3,7 +3,7 @@
 
 use std::f64::consts::FRAC_PI_4;
 
-use pushval_model::{Body, Initial, Problem, Push, SegmentDynamics, Support, Switching, Vec2};
+use pushval_model::{Body, Initial, Problem, Push, Support, Switching, Vec2};
 
 /// Friction coefficient of every support (dimensionless).
 pub const MU: f64 = 0.5;
@@ -23,8 +23,8 @@ pub const FRS: [f64; 20] = [
     0.02, 0.0255, 0.0325, 0.0414, 0.0527, 0.0672, 0.0856, 0.109, 0.139, 0.177, 0.226, 0.288, 0.367,
     0.467, 0.595, 0.759, 0.967, 1.23, 1.57, 2.0,
 ];
-/// The quick grid's Froude numbers (tests).
-pub const FRS_QUICK: [f64; 2] = [0.1, 1.0];
+/// The quick grid's Froude numbers (tests): 5 log-spaced over the same range.
+pub const FRS_QUICK: [f64; 5] = [0.02, 0.0632, 0.2, 0.632, 2.0];
 /// Range of the maps' push directions (rad).
 pub const PHI_RANGE: (f64, f64) = (0.15, 1.42);
 
@@ -47,11 +47,23 @@ pub fn plate() -> Body {
 
 /// One push of the paper plate at `speed` (m/s) in direction `phi` (rad) for
 /// `duration` (s), from θ = 0 moving with the pusher (ω = 0), samples every
-/// 10 ms. Studies that start elsewhere or push more than once change
-/// `initial` or `pushes`.
-pub fn paper_plate(speed: f64, phi: f64, duration: f64) -> Problem {
+/// 10 ms; with `supports_half` (m), the supports moved to the corners of a
+/// square of that half side (same loads, contact and inertia).
+pub fn paper_plate(speed: f64, phi: f64, duration: f64, supports_half: Option<f64>) -> Problem {
+    let mut body = plate();
+    if let Some(h) = supports_half {
+        let s: Vec<Support> = body
+            .supports()
+            .map(|s| Support {
+                position: s.position * (h / HALF),
+                friction: s.friction,
+            })
+            .collect();
+        body = Body::new(body.mass(), body.inertia_cm(), body.contact(), &s)
+            .expect("the plate on moved supports is a valid body");
+    }
     Problem {
-        body: plate(),
+        body,
         limits: Default::default(),
         pushes: vec![Push {
             duration,
@@ -79,10 +91,10 @@ pub fn froude(speed: f64) -> f64 {
     speed * speed / (MU * G * length())
 }
 
-/// The maps' push directions (rad): 20 evenly spaced in [`PHI_RANGE`] (3
+/// The maps' push directions (rad): 20 evenly spaced in [`PHI_RANGE`] (5
 /// on the quick grid).
 pub fn phis(quick: bool) -> Vec<f64> {
-    let n = if quick { 3 } else { 20 };
+    let n = if quick { 5 } else { 20 };
     let (lo, hi) = PHI_RANGE;
     (0..n)
         .map(|k| lo + k as f64 * (hi - lo) / (n - 1) as f64)
@@ -96,17 +108,4 @@ pub fn frs(quick: bool) -> &'static [f64] {
     } else {
         &FRS
     }
-}
-
-/// The Coulomb model's steady ω (rad/s) for `push`: the stable root the
-/// flow reaches from ω = 0 (NaN where there is none).
-pub fn coulomb_star(body: &Body, push: &Push) -> f64 {
-    let seg = SegmentDynamics::new(body, push);
-    let roots = seg.steady_states();
-    seg.attractor(&roots, 0.0).map_or(f64::NAN, |s| s.omega)
-}
-
-/// `|a − b| / |b|`.
-pub fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
 }

@@ -128,7 +128,11 @@ fn shards_merged_equal_a_single_run_byte_for_byte() {
     report::run(&opts(single.path())).unwrap();
     for k in 1..=3 {
         let s = report::run(&Options {
-            shard: Some(Shard { k, n: 3 }),
+            shard: Some(Shard {
+                k,
+                n: 3,
+                by_hash: false,
+            }),
             ..opts(sharded.path())
         })
         .unwrap();

@@ -3,7 +3,10 @@
 //! feet with Avian's own contact friction). Without the `avian` feature they
 //! are listed but not available.
 
-use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_engine::{
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
+    OptionError, COULOMB,
+};
 use pushval_model::{ModelError, Problem};
 
 use crate::{Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator, AVAILABLE};
@@ -84,6 +87,9 @@ pub fn models() -> Vec<ModelEntry> {
                 if let Some(n) = substeps(o)? {
                     settings.substeps = n;
                 }
+                if let Some(h) = o.non_negative("cm_height")? {
+                    settings.cm_height = h;
+                }
                 Ok(Box::new(Avian3dModel { settings }))
             },
         },
@@ -129,6 +135,9 @@ impl Engine for Avian2dModel {
             "label": s.label(),
         })
     }
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        Some(avian2d_law())
+    }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let r = Avian2dSimulator::new(Avian2dSettings {
             dt,
@@ -172,7 +181,7 @@ impl Engine for Avian3dModel {
         self.settings.dt
     }
     fn option_keys(&self) -> &'static [&'static str] {
-        OPTION_KEYS
+        &["substeps", "cm_height"]
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = Avian3dSettings {
@@ -188,6 +197,9 @@ impl Engine for Avian3dModel {
             "settle_time": s.settle_time,
             "label": s.label(),
         })
+    }
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        Some(self)
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let r = Avian3dSimulator::new(Avian3dSettings {
@@ -209,4 +221,27 @@ impl Engine for Avian3dModel {
             trajectory: r.trajectory,
         })
     }
+}
+
+/// avian3d's contact friction in closed form (`crate::predict`): Coulomb
+/// at every foot with the loads of its soft contacts, coupled to the forces
+/// when the centre of mass is above the floor.
+impl FrictionLaw for Avian3dModel {
+    fn law_name(&self) -> &'static str {
+        "Coulomb along −u at every foot with the soft contacts' loads, load transfer above the floor (pushval_avian::predict)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let scene = crate::predict::PlateScene::new(problem, &self.settings).ok()?;
+        let (omega, _) = scene.steady(push, 0.0)?;
+        Some(LawSteady {
+            omega,
+            class: LawClass::Turns,
+        })
+    }
+}
+
+/// The 2-D model applies Coulomb's law at every support.
+pub(crate) fn avian2d_law() -> &'static dyn FrictionLaw {
+    &COULOMB
 }

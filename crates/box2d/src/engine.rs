@@ -2,7 +2,10 @@
 //! Coulomb forces, gateable) and `box2d_motor_joint` (Box2D's top-down
 //! friction idiom, informational).
 
-use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_engine::{
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
+    OptionError, COULOMB,
+};
 use pushval_model::{ModelError, Problem};
 
 use crate::{Box2dSettings, Box2dSimulator, Friction};
@@ -126,6 +129,12 @@ impl Engine for Box2dModel {
             "label": s.label(),
         })
     }
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        match self.settings.friction {
+            Friction::Coulomb => Some(&COULOMB),
+            Friction::MotorJoint => Some(self),
+        }
+    }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let r = Box2dSimulator::new(Box2dSettings {
             dt,
@@ -141,6 +150,26 @@ impl Engine for Box2dModel {
                 "steps": r.steps,
             }),
             trajectory: r.trajectory,
+        })
+    }
+}
+
+/// The motor joint's closed form (`crate::predict`): force capped at
+/// `Σ F_i`, torque at `Σ F_i |p_i|`, each on its own.
+impl FrictionLaw for Box2dModel {
+    fn law_name(&self) -> &'static str {
+        "motor joint to the ground: force and torque capped apart (pushval_box2d::predict)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let s = crate::predict::motor_joint_steady(&problem.body, push, 0.0)?;
+        Some(LawSteady {
+            omega: s.omega,
+            class: if s.locked {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
         })
     }
 }

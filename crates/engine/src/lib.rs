@@ -20,9 +20,11 @@ use std::time::Duration;
 
 use pushval_model::{ModelError, Problem, Trajectory};
 
+mod law;
 mod options;
 mod resample;
 
+pub use law::{coulomb_steady, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB};
 pub use options::{EngineOptions, OptionError, SceneFrame};
 pub use resample::{
     resample, sample, segment_reports, step_tail_omega, tail_mean_omega, trajectory_from_steps,
@@ -106,6 +108,12 @@ pub trait Engine: Send + Sync {
     fn settings(&self, dt: f64) -> serde_json::Value;
     /// Runs the problem at time step `dt` (s).
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError>;
+    /// The engine's own friction law in closed form, if it declares one
+    /// ([`FrictionLaw`]; [`COULOMB`] for an engine that applies Coulomb
+    /// friction at every support). None by default.
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        None
+    }
 }
 
 /// A constructor of an engine model from the scenario's `[engine]` table.

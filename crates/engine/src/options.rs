@@ -109,6 +109,20 @@ impl EngineOptions {
         }
     }
 
+    /// A finite number key that must be ≥ 0; None when absent.
+    pub fn non_negative(&self, key: &str) -> Result<Option<f64>, OptionError> {
+        let Some(v) = self.values.get(key) else {
+            return Ok(None);
+        };
+        match v.as_f64() {
+            Some(x) if x.is_finite() && x >= 0.0 => Ok(Some(x)),
+            _ => Err(Self::bad(
+                key,
+                format!("must be a finite number >= 0, got {v}"),
+            )),
+        }
+    }
+
     /// A finite number key that must be > 0; None when absent.
     pub fn positive(&self, key: &str) -> Result<Option<f64>, OptionError> {
         let Some(v) = self.values.get(key) else {

@@ -3,7 +3,9 @@
 //! contact friction. Without the `mujoco` feature they are listed but not
 //! available.
 
-use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_engine::{
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, ModelEntry, OptionError, COULOMB,
+};
 use pushval_model::{ModelError, Problem};
 
 use crate::{Cone, MujocoSettings, MujocoSimulator, AVAILABLE};
@@ -100,6 +102,14 @@ impl Engine for MujocoModel {
             "cone": s.cone.as_str(),
             "label": s.label(),
         })
+    }
+    /// The elliptic cone follows Coulomb's law (`crate::theory`); the
+    /// pyramidal cone's lock on its diagonal has no closed form of ω here.
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        match self.settings.cone {
+            Cone::Elliptic => Some(&COULOMB),
+            Cone::Pyramidal => None,
+        }
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let r = MujocoSimulator::new(MujocoSettings {

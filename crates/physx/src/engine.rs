@@ -3,10 +3,14 @@
 //! feet on a ground plane with each of PhysX's friction types. Without the
 //! `physx` feature they are listed but not available.
 
-use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_engine::{
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
+    OptionError,
+};
 use pushval_model::{ModelError, Problem};
 
-use crate::{FrictionType, PhysxSettings, PhysxSimulator, AVAILABLE};
+use crate::predict::{at_rest, lock_moments, rest_moments, steady_from_rest, AtRest};
+use crate::{FootContacts, FrictionType, PhysxSettings, PhysxSimulator, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the `physx`
 /// entry of the workspace's Cargo.toml; a test checks it against Cargo.lock).
@@ -33,6 +37,19 @@ fn build(friction: FrictionType, opts: &EngineOptions) -> Result<Box<dyn Engine>
     };
     if let Some(dt) = opts.dt {
         settings.dt = dt;
+    }
+    if let Some(c) = opts.choice("contacts", &["welded", "separate"])? {
+        settings.contacts = if c == "separate" {
+            FootContacts::Separate
+        } else {
+            FootContacts::Welded
+        };
+    }
+    if let Some(n) = opts.integer("position_iterations", 1)? {
+        settings.position_iterations = n.min(255) as u32;
+    }
+    if let Some(n) = opts.integer("velocity_iterations", 1)? {
+        settings.velocity_iterations = n.min(255) as u32;
     }
     Ok(Box::new(PhysxModel { settings }))
 }
@@ -98,6 +115,12 @@ impl Engine for PhysxModel {
     fn default_dt(&self) -> f64 {
         self.settings.dt
     }
+    fn option_keys(&self) -> &'static [&'static str] {
+        &["contacts", "position_iterations", "velocity_iterations"]
+    }
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        Some(self)
+    }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = PhysxSettings {
             dt,
@@ -133,6 +156,57 @@ impl Engine for PhysxModel {
                 "mu": r.mu,
             }),
             trajectory: r.trajectory,
+        })
+    }
+}
+
+/// PhysX's friction rows in closed form (`crate::predict`): the law of the
+/// friction type on welded or separate feet, the class of ω = 0 from the
+/// lock (`|M₀| ≤ H`) and hold (`|M₀| ≤ S`) criteria, and the steady ω a run
+/// from rest reaches. PhysX's contact order is taken as the supports' order
+/// (on the paper plate it gives feet 0 and 2 the `t0` rows, as PhysX does).
+impl FrictionLaw for PhysxModel {
+    fn law_name(&self) -> &'static str {
+        match (self.settings.contacts, self.settings.friction) {
+            (FootContacts::Welded, FrictionType::Patch) => {
+                "one welded patch: t0/t1 rows at two anchors, each capped at half of μΣN (pushval_physx::predict)"
+            }
+            (FootContacts::Welded, FrictionType::OneDirectional) => {
+                "one welded patch: one row per foot, t0 and t1 alternating, cap μN (pushval_physx::predict)"
+            }
+            (FootContacts::Separate, FrictionType::OneDirectional) => {
+                "a t0 row per foot along the centre of mass's velocity, cap μN (pushval_physx::predict)"
+            }
+            _ => "a t0 and a t1 row per foot, each capped at μN: a box (pushval_physx::predict)",
+        }
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let body = &problem.body;
+        let points: Vec<[f64; 2]> = body
+            .supports()
+            .map(|s| [s.position.x, s.position.y])
+            .collect();
+        let order: Vec<usize> = (0..points.len()).collect();
+        let law = self
+            .settings
+            .friction
+            .law(self.settings.contacts, &order, &points);
+        let class = match at_rest(body, push, law) {
+            AtRest::Locked => LawClass::Locked,
+            AtRest::Turns => LawClass::Turns,
+            AtRest::SemiStable => {
+                let (moment, lock) = lock_moments(body, push, law);
+                LawClass::SemiStable {
+                    moment,
+                    lock,
+                    hold: rest_moments(body, push, law).1,
+                }
+            }
+        };
+        Some(LawSteady {
+            omega: steady_from_rest(body, push, law).omega,
+            class,
         })
     }
 }

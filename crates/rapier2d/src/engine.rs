@@ -1,7 +1,10 @@
 //! The rapier2d models as pushval engine plug-ins: `rapier2d` (per-support
 //! Coulomb forces, gated by default) and the four 2-D friction idioms.
 
-use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_engine::{
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
+    OptionError, COULOMB,
+};
 use pushval_model::{ModelError, Problem};
 
 use crate::{EngineSettings, FrictionModel, FrictionVelocity, Precision, RapierSimulator};
@@ -197,6 +200,12 @@ impl Engine for Rapier2dModel {
             "label": s.label(),
         })
     }
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        match self.settings.friction_model {
+            FrictionModel::Coulomb => Some(&COULOMB),
+            _ => Some(self),
+        }
+    }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let r = RapierSimulator::new(EngineSettings {
             dt,
@@ -215,5 +224,50 @@ impl Engine for Rapier2dModel {
                 "steps": r.steps,
             }),
         })
+    }
+}
+
+/// Angles per turn of the box idiom's period mean.
+const BOX_ANGLES: usize = 360;
+
+/// The idioms' closed forms (`crate::idioms`): the moment balance with the
+/// idiom's support law substituted; for the box, the period mean over the
+/// object's angle, and a lock where the frozen root changes sign.
+impl FrictionLaw for Rapier2dModel {
+    fn law_name(&self) -> &'static str {
+        match self.settings.friction_model {
+            FrictionModel::ImpulseBox => {
+                "stopping impulse capped per world axis; mean ω over a turn, locked where ω*(θ) changes sign (pushval_rapier2d::idioms)"
+            }
+            FrictionModel::ImpulseDisk => {
+                "stopping impulse −K⁻¹u capped in length at μNΔt (pushval_rapier2d::idioms)"
+            }
+            _ => "Coulomb regularised below the slip speed (pushval_rapier2d::idioms)",
+        }
+    }
+    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+        let model = self.settings.friction_model;
+        let push = problem.pushes.get(segment)?;
+        let body = &problem.body;
+        if model.is_isotropic() {
+            let omega = crate::idioms::predicted_steady_omega(model, body, push, dt, 0.0, 0.0)?;
+            return Some(LawSteady {
+                omega,
+                class: LawClass::Turns,
+            });
+        }
+        match crate::idioms::predicted_mean_omega(model, body, push, dt, BOX_ANGLES) {
+            Some(omega) => Some(LawSteady {
+                omega,
+                class: LawClass::Turns,
+            }),
+            None => crate::idioms::lock_angles(model, body, push, dt, BOX_ANGLES)
+                .iter()
+                .any(|&(_, stable)| stable)
+                .then_some(LawSteady {
+                    omega: 0.0,
+                    class: LawClass::Locked,
+                }),
+        }
     }
 }

@@ -2,10 +2,14 @@
 //! `FrictionModel::Coulomb`) and `rapier3d_simplified` (its default,
 //! `Simplified`), the plate on ball feet on a ground plane.
 
-use pushval_engine::{Engine, EngineCrate, EngineOptions, EngineRun, ModelEntry, OptionError};
+use pushval_engine::{
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
+    OptionError,
+};
 use pushval_model::{ModelError, Problem};
 
-use crate::{ContactFriction, Rapier3dSettings, Rapier3dSimulator};
+use crate::predict::{predict_steady, simplified_locks, Law};
+use crate::{ContactFriction, FeetColliders, Rapier3dSettings, Rapier3dSimulator};
 
 /// The engine crate and version this adapter is built against (the
 /// `rapier3d-f64` entry of the workspace's Cargo.toml; a test checks it
@@ -29,6 +33,19 @@ fn build(friction: ContactFriction, opts: &EngineOptions) -> Result<Box<dyn Engi
     };
     if let Some(dt) = opts.dt {
         settings.dt = dt;
+    }
+    if let Some(f) = opts.choice("feet", &["compound", "separate"])? {
+        settings.feet = if f == "separate" {
+            FeetColliders::Separate
+        } else {
+            FeetColliders::Compound
+        };
+    }
+    if let Some(h) = opts.non_negative("cm_height")? {
+        settings.cm_height = h;
+    }
+    if let Some(h) = opts.non_negative("push_height")? {
+        settings.push_height = h;
     }
     Ok(Box::new(Rapier3dModel { settings }))
 }
@@ -77,6 +94,12 @@ impl Engine for Rapier3dModel {
     fn default_dt(&self) -> f64 {
         self.settings.dt
     }
+    fn option_keys(&self) -> &'static [&'static str] {
+        &["feet", "cm_height", "push_height"]
+    }
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        Some(self)
+    }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = Rapier3dSettings {
             dt,
@@ -86,6 +109,9 @@ impl Engine for Rapier3dModel {
             "engine": self.version(),
             "dt": s.dt,
             "friction_model": s.friction.as_str(),
+            "feet": s.feet.as_str(),
+            "cm_height": s.cm_height,
+            "push_height": s.push_height,
             "label": s.label(),
         })
     }
@@ -106,6 +132,54 @@ impl Engine for Rapier3dModel {
                 "max_lift": r.max_lift,
             }),
             trajectory: r.trajectory,
+        })
+    }
+}
+
+impl Rapier3dModel {
+    /// The closed form that predicts the engine: `Simplified` on one
+    /// manifold (compound feet) has the twist limit; otherwise every contact
+    /// slides along `−K⁻¹u` (rapier's per-contact solve).
+    pub fn predict_law(&self) -> Law {
+        if self.settings.friction == ContactFriction::Simplified
+            && self.settings.feet == FeetColliders::Compound
+        {
+            Law::SimplifiedOneManifold
+        } else {
+            Law::EffectiveMassDisk
+        }
+    }
+}
+
+/// rapier3d's contact friction in closed form (`crate::predict`), with the
+/// normal loads coupled to the forces by the tilting balance.
+impl FrictionLaw for Rapier3dModel {
+    fn law_name(&self) -> &'static str {
+        match self.predict_law() {
+            Law::SimplifiedOneManifold => {
+                "Simplified on one manifold: disk at the friction centre plus a twist limit, loads from the tilting balance (pushval_rapier3d::predict)"
+            }
+            _ => {
+                "per-contact impulse along −K⁻¹u capped at μN, loads from the tilting balance (pushval_rapier3d::predict)"
+            }
+        }
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let scene = self.settings.scene(problem).ok()?;
+        let law = self.predict_law();
+        let pred = predict_steady(&scene, push, law, true).ok()?;
+        let locked = law == Law::SimplifiedOneManifold && {
+            let body = scene.body(&pred.loads).ok()?;
+            simplified_locks(&scene.points, &pred.loads, scene.mu[0], &body, push)
+        };
+        Some(LawSteady {
+            omega: pred.omega,
+            class: if locked {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
         })
     }
 }

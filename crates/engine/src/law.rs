@@ -1,0 +1,112 @@
+//! An engine's own friction law in closed form: what steady ω it predicts
+//! for a push, and whether the law turns the object, locks its orientation
+//! or holds it only from one side.
+//!
+//! An engine whose friction is not Coulomb's at every support (a capped
+//! joint, per-axis rows, a twist limit, …) declares the law it follows
+//! through [`crate::Engine::law`]; `pushval study MODEL` compares the engine
+//! with it and with Coulomb. An engine that applies Coulomb's law returns
+//! [`COULOMB`], an engine with no closed form returns `None`.
+
+use pushval_model::{Problem, SegmentDynamics};
+
+/// What ω = 0 is under a law, for a run that starts there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LawClass {
+    /// The object turns: the law's steady ω is an ordinary root.
+    Turns,
+    /// The law holds ω = 0 from both sides (the orientation locks).
+    Locked,
+    /// ω = 0 holds from one side only: sticking friction can balance the
+    /// moment at rest (`|moment| ≤ hold`) but does not pull ω back to 0 from
+    /// the side the moment points to (`|moment| > lock`). Which a run shows
+    /// depends on the solver's disturbances, not on the law.
+    SemiStable {
+        /// The sliding rows' moment about the contact at ω = 0, M₀ (N m).
+        moment: f64,
+        /// The largest |M₀| that locks from both sides, H (N m).
+        lock: f64,
+        /// The largest |M₀| sticking rows can hold at rest, S ≥ H (N m).
+        hold: f64,
+    },
+}
+
+impl LawClass {
+    /// `"turns"`, `"locked"` or `"semi_stable"` (the `class` column of a
+    /// study's `map.csv`).
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            LawClass::Turns => "turns",
+            LawClass::Locked => "locked",
+            LawClass::SemiStable { .. } => "semi_stable",
+        }
+    }
+
+    /// The class named by [`LawClass::as_str`] (rest moments unknown: NaN).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "turns" => Some(LawClass::Turns),
+            "locked" => Some(LawClass::Locked),
+            "semi_stable" => Some(LawClass::SemiStable {
+                moment: f64::NAN,
+                lock: f64::NAN,
+                hold: f64::NAN,
+            }),
+            _ => None,
+        }
+    }
+}
+
+/// A law's steady state for one push segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LawSteady {
+    /// The steady ω the law predicts for a run that starts the segment at
+    /// ω = 0 (rad/s); 0 where it locks or holds. For a law that depends on
+    /// the object's angle, the mean ω over a turn.
+    pub omega: f64,
+    /// What ω = 0 is under the law.
+    pub class: LawClass,
+}
+
+/// An engine's friction law in closed form (no engine needed to evaluate).
+pub trait FrictionLaw: Send + Sync {
+    /// One line naming the law and where its closed form lives, e.g.
+    /// `"motor joint: force and torque capped apart (pushval_box2d::predict)"`.
+    fn law_name(&self) -> &'static str;
+    /// The steady state of segment `segment` of `problem` under the law, for
+    /// a run at time step `dt` (s; laws whose caps scale with the step read
+    /// it), or None where the law has no steady state there.
+    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady>;
+}
+
+/// Coulomb friction at every support: the analytic model's own law.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Coulomb;
+
+/// The law of an engine that applies Coulomb friction at every support.
+pub const COULOMB: Coulomb = Coulomb;
+
+impl FrictionLaw for Coulomb {
+    fn law_name(&self) -> &'static str {
+        "Coulomb at every support (the analytic model, pushval_model::SegmentDynamics)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        coulomb_steady(problem, segment).map(|omega| LawSteady {
+            omega,
+            class: if omega == 0.0 {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
+        })
+    }
+}
+
+/// The Coulomb model's steady ω (rad/s) of segment `segment`: the stable
+/// root the flow reaches from ω = 0. None where there is none.
+pub fn coulomb_steady(problem: &Problem, segment: usize) -> Option<f64> {
+    let push = problem.pushes.get(segment)?;
+    let seg = SegmentDynamics::new(&problem.body, push);
+    let roots = seg.steady_states();
+    seg.attractor(&roots, 0.0).map(|s| s.omega)
+}

@@ -1,0 +1,146 @@
+//! Which Coulomb parameters an engine behaves as (`coulomb_fit.csv`): the
+//! dynamic model fitted to the engine's trajectory by `pushval fit`'s
+//! machinery ([`crate::fit`], Levenberg–Marquardt), and whether the fit
+//! explains the engine.
+//!
+//! Two schedules of the paper plate, read from the shipped scenarios:
+//! `friction-engines.toml` (one push of 6 s at 0.5 m/s, φ = π/4 + 0.3) and
+//! `paper-square-v1.0.toml` (the paper's five 2 s segments at 1 m/s; not on
+//! the quick grid). `mu_scale` is always fitted; `center_of_friction` and
+//! `inertia_cm` where the schedule identifies them (the Fisher information
+//! at the file's values, [`crate::fit::fisher_at`]; one constant push leaves
+//! the centre of friction unidentifiable).
+//!
+//! The engine runs at its study step over 4; its own error is the
+//! Richardson estimate from a second run at twice that step,
+//! `e = rms |X(2Δt) − X(Δt)| / (2^p − 1)` (p its order). Verdict, with
+//! `T = max(10 e, 1e-6)` in position (m) and θ (rad): **explained** when the
+//! fit's residual rms is within T and within 1 mm / 1 mrad, **not_explained**
+//! when it exceeds T, **undecided** otherwise (the engine's own error is too
+//! large to tell).
+
+use pushval_engine::Engine;
+use pushval_model::{DynamicModel, Sample, Simulator};
+
+use crate::fit::{fisher_at, fit, Param, Parametrised, Settings};
+
+/// The scenario files of the schedules, single push first.
+pub const SCHEDULES: [&str; 2] = ["friction-engines.toml", "paper-square-v1.0.toml"];
+/// The fitted run's step is the study's over this.
+pub const STEP_DIVISOR: f64 = 4.0;
+/// Thresholds: this many times the engine's own error, at least 1e-6.
+pub const THRESHOLD_FACTOR: f64 = 10.0;
+/// Above this (m, rad) a threshold no longer decides.
+pub const THRESHOLD_CAP: f64 = 1e-3;
+/// The columns of `coulomb_fit.csv` after `schedule`.
+pub const COLUMNS: &str = "dt,mu_scale,mu_scale_std,cof_x,cof_y,inertia_cm,inertia_cm_std,start_position_rms,start_theta_rms,position_rms,theta_rms,engine_error_position,engine_error_theta,converged,fitted";
+/// Values in a fit's row (the columns above less `fitted`, plus the two
+/// flags: centre of friction fitted, I_cm fitted).
+pub const WIDTH: usize = 16;
+
+fn rms_difference(a: &[Sample], b: &[Sample]) -> [f64; 2] {
+    let n = a.len().min(b.len()).max(1) as f64;
+    let (mut p, mut t) = (0.0, 0.0);
+    for (s, r) in a.iter().zip(b) {
+        p += (s.x - r.x).powi(2) + (s.y - r.y).powi(2);
+        t += (s.theta - r.theta).powi(2);
+    }
+    [(p / n).sqrt(), (t / n).sqrt()]
+}
+
+/// The parameters schedule's scenario identifies (see the module doc).
+fn identified(sc: &pushval_scenario::Scenario, s: &Settings) -> anyhow::Result<Vec<Param>> {
+    let mut set = vec![Param::InertiaCm, Param::CenterOfFriction, Param::MuScale];
+    loop {
+        let model = Parametrised::new(sc, &set).map_err(anyhow::Error::msg)?;
+        let f = fisher_at(&model, &model.file_values(), s).map_err(anyhow::Error::msg)?;
+        let bad: Vec<Param> = model
+            .slots()
+            .iter()
+            .zip(&f.unidentifiable)
+            .filter(|(_, u)| **u)
+            .map(|((p, _), _)| *p)
+            .collect();
+        match set
+            .iter()
+            .position(|p| *p != Param::MuScale && bad.contains(p))
+        {
+            Some(i) => {
+                set.remove(i);
+            }
+            None => return Ok(set),
+        }
+    }
+}
+
+/// Fits schedule `k` to `engine` run at `study_dt / STEP_DIVISOR`: the row
+/// of [`COLUMNS`] (NaN where not fitted).
+pub fn fit_engine(engine: &dyn Engine, k: usize, study_dt: f64) -> anyhow::Result<Vec<f64>> {
+    let settings = Settings::default();
+    let sc = crate::registry::load(crate::report::default_scenario_dir().join(SCHEDULES[k]))?;
+    let problem = sc.problem();
+    let dt = study_dt / STEP_DIVISOR;
+    let run = |h: f64| {
+        engine
+            .run(&problem, h)
+            .map(|r| r.trajectory.samples)
+            .map_err(|e| anyhow::anyhow!("{} at dt = {h}: {e}", engine.name()))
+    };
+    let (data, coarse) = (run(dt)?, run(2.0 * dt)?);
+    crate::fit::check_grid(&sc, &data).map_err(anyhow::Error::msg)?;
+    let k_rich = 1.0 / (2f64.powf(engine.order()) - 1.0);
+    let engine_error = rms_difference(&coarse, &data).map(|d| k_rich * d);
+    let set = identified(&sc, &settings)?;
+    let model = Parametrised::new(&sc, &set).map_err(anyhow::Error::msg)?;
+    let start = model.file_values();
+    let problem0 = model
+        .problem(&start)
+        .map_err(|e| anyhow::anyhow!("{}", e.0))?;
+    let reference = DynamicModel::default().simulate(&problem0)?;
+    let start_rms = rms_difference(&reference.samples, &data);
+    let f = fit(&model, &data, &start, &settings).map_err(anyhow::Error::msg)?;
+    let get = |p: Param| {
+        f.get(p)
+            .unwrap_or((vec![f64::NAN; p.dim()], vec![f64::NAN; p.dim()]))
+    };
+    let (mu, mu_std) = get(Param::MuScale);
+    let (cof, _) = get(Param::CenterOfFriction);
+    let (ic, ic_std) = get(Param::InertiaCm);
+    let flag = |b: bool| if b { 1.0 } else { 0.0 };
+    Ok(vec![
+        dt,
+        mu[0],
+        mu_std[0],
+        cof[0],
+        cof[1],
+        ic[0],
+        ic_std[0],
+        start_rms[0],
+        start_rms[1],
+        f.position_rms,
+        f.theta_rms,
+        engine_error[0],
+        engine_error[1],
+        flag(f.converged),
+        flag(set.contains(&Param::CenterOfFriction)),
+        flag(set.contains(&Param::InertiaCm)),
+    ])
+}
+
+/// `[position, θ]` thresholds of a row: `max(10 e, 1e-6)`.
+pub fn thresholds(row: &[f64]) -> [f64; 2] {
+    [row[11], row[12]].map(|e| (THRESHOLD_FACTOR * e).max(1e-6))
+}
+
+/// The verdict of a row (see the module doc).
+pub fn verdict(row: &[f64]) -> &'static str {
+    let t = thresholds(row);
+    let rms = [row[9], row[10]];
+    if !(rms[0] <= t[0] && rms[1] <= t[1]) {
+        "not_explained"
+    } else if rms[0] <= THRESHOLD_CAP && rms[1] <= THRESHOLD_CAP {
+        "explained"
+    } else {
+        "undecided"
+    }
+}

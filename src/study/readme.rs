@@ -1,0 +1,435 @@
+//! A study's files from its rows, and its README from those files: every
+//! number of a README is read back from the CSV text written beside it.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::plate::{froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
+use super::{class_name, err, fit, opt, Plan, Task};
+use crate::report::Writer;
+
+/// One CSV's records, by column name.
+pub type Records = Vec<std::collections::BTreeMap<String, String>>;
+
+/// Parses CSV text with a header row (no quoting: the studies write none).
+pub fn parse(text: &str) -> Records {
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    lines
+        .map(|l| {
+            head.iter()
+                .zip(l.split(','))
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+/// The number in column `key` (NaN where blank or absent).
+pub fn num(r: &std::collections::BTreeMap<String, String>, key: &str) -> f64 {
+    r.get(key).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN)
+}
+
+/// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
+/// within 1e-2 of the law, turns, locked, semi_stable)`.
+pub fn map_stats(map: &Records) -> [usize; 7] {
+    let mut s = [0; 7];
+    for r in map {
+        let (we, wc, wl) = (
+            num(r, "omega_engine"),
+            num(r, "omega_coulomb"),
+            num(r, "omega_law"),
+        );
+        let speed = (num(r, "froude") / froude(1.0)).sqrt();
+        s[0] += 1;
+        s[1] += usize::from(err(we, wc, wc, speed) <= 1e-2);
+        if wl.is_finite() {
+            s[2] += 1;
+            s[3] += usize::from(err(we, wl, wc, speed) <= 1e-2);
+        }
+        match r.get("class").map(String::as_str) {
+            Some("turns") => s[4] += 1,
+            Some("locked") => s[5] += 1,
+            Some("semi_stable") => s[6] += 1,
+            _ => {}
+        }
+    }
+    s
+}
+
+fn pct(a: usize, b: usize) -> String {
+    if b == 0 {
+        "–".into()
+    } else {
+        format!("{a}/{b} ({:.0} %)", 100.0 * a as f64 / b as f64)
+    }
+}
+
+/// `f` to 4 significant digits, `–` where undefined.
+fn sig(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.4e}")
+    } else {
+        "–".into()
+    }
+}
+
+fn run_line(r: &[f64]) -> String {
+    format!("{},{},{}", opt(r[0]), opt(r[1]), opt(r[2]))
+}
+
+fn map_csv(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], setup: usize) -> String {
+    let mut s = String::from("froude,phi,omega_engine,omega_coulomb,omega_law,class\n");
+    for (t, r) in tasks.iter().zip(rows) {
+        if let Task::Map { s: k, i, j } = *t {
+            if k == setup {
+                let (fr, phi) = (frs(plan.quick)[i], phis(plan.quick)[j]);
+                let _ = writeln!(s, "{fr},{phi},{},{}", run_line(r), class_name(r[3]));
+            }
+        }
+    }
+    s
+}
+
+/// Writes every file of the study and its README.
+pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> anyhow::Result<()> {
+    let rows_of = |pick: &dyn Fn(&Task) -> bool| -> Vec<(Task, &Vec<f64>)> {
+        tasks
+            .iter()
+            .zip(rows)
+            .filter(|(t, _)| pick(t))
+            .map(|(t, r)| (*t, r))
+            .collect()
+    };
+    let mut paper = String::from("speed,omega_engine,omega_coulomb,omega_law\n");
+    for (t, r) in rows_of(&|t| matches!(t, Task::Table { s: 0, .. })) {
+        if let Task::Table { v, .. } = t {
+            let _ = writeln!(paper, "{},{}", TABLE_SPEEDS[v], run_line(r));
+        }
+    }
+    w.file("paper_plate.csv", paper.as_bytes())?;
+    let map = map_csv(plan, tasks, rows, 0);
+    w.file("map.csv", map.as_bytes())?;
+
+    // The step ladder: change from the next coarser step, the observed
+    // order from three steps, Richardson at the declared order.
+    let p = plan.setups[0].engine.order();
+    // The ladder's step ratio (2 for the default ladders).
+    let ratio = plan.ladder[0] / plan.ladder[1];
+    let ladder_text = |sel: &dyn Fn(&Task) -> bool, lead: &dyn Fn(&Task) -> String, head: &str| {
+        let mut s = format!("{head}dt,omega_engine,omega_coulomb,omega_law,class,change,observed_order,richardson\n");
+        let rs = rows_of(sel);
+        for (n, (t, r)) in rs.iter().enumerate() {
+            let same = |m: usize| n >= m && lead(&rs[n - m].0) == lead(t);
+            let change = if same(1) {
+                r[0] - rs[n - 1].1[0]
+            } else {
+                f64::NAN
+            };
+            let order = if same(2) {
+                ((rs[n - 1].1[0] - rs[n - 2].1[0]) / change).abs().ln() / ratio.ln()
+            } else {
+                f64::NAN
+            };
+            let dt = match *t {
+                Task::Ladder { k } | Task::Creep { k, .. } => plan.ladder[k],
+                _ => f64::NAN,
+            };
+            let rich = r[0] + change / (ratio.powf(p) - 1.0);
+            let _ = writeln!(
+                s,
+                "{}{dt},{},{},{},{},{}",
+                lead(t),
+                run_line(r),
+                class_name(r[3]),
+                opt(change),
+                opt(order),
+                opt(rich)
+            );
+        }
+        s
+    };
+    let ladder = ladder_text(
+        &|t| matches!(t, Task::Ladder { .. }),
+        &|_| String::new(),
+        "",
+    );
+    w.file("dt_ladder.csv", ladder.as_bytes())?;
+    let creep = (!plan.creep.is_empty()).then(|| {
+        ladder_text(
+            &|t| matches!(t, Task::Creep { .. }),
+            &|t| match t {
+                Task::Creep { v, .. } => format!("{},", TABLE_SPEEDS[*v]),
+                _ => String::new(),
+            },
+            "speed,",
+        )
+    });
+    if let Some(c) = &creep {
+        w.file("creep.csv", c.as_bytes())?;
+    }
+    let mut variants = String::from(
+        "variant,options,supports_half,phi,dt,speed,omega_engine,omega_coulomb,omega_law,class\n",
+    );
+    let mut variant_maps = Vec::new();
+    for (k, s) in plan.setups.iter().enumerate().skip(1) {
+        let options: Vec<String> = s
+            .options
+            .values
+            .iter()
+            .map(|(a, b)| format!("{a}={b}"))
+            .collect();
+        for (t, r) in rows_of(&|t| matches!(t, Task::Table { s, .. } if *s == k)) {
+            if let Task::Table { v, .. } = t {
+                let _ = writeln!(
+                    variants,
+                    "{},{},{},{},{},{},{},{}",
+                    s.name,
+                    options.join(" ").replace(',', ";"),
+                    s.supports_half.map_or(String::new(), |h| h.to_string()),
+                    s.phi,
+                    s.dt,
+                    TABLE_SPEEDS[v],
+                    run_line(r),
+                    class_name(r[3])
+                );
+            }
+        }
+        if s.map {
+            let text = map_csv(plan, tasks, rows, k);
+            w.file(&format!("map_{}.csv", s.name), text.as_bytes())?;
+            variant_maps.push((s.name.clone(), text));
+        }
+    }
+    if plan.setups.len() > 1 {
+        w.file("variants.csv", variants.as_bytes())?;
+    }
+    let mut fits = format!("schedule,{},verdict\n", fit::COLUMNS);
+    for (t, r) in rows_of(&|t| matches!(t, Task::Fit { .. })) {
+        if let Task::Fit { k } = t {
+            let vals: Vec<String> = r.iter().take(fit::WIDTH - 2).map(|v| opt(*v)).collect();
+            let fitted = match (r[14] == 1.0, r[15] == 1.0) {
+                (true, true) => "mu_scale center_of_friction inertia_cm",
+                (false, true) => "mu_scale inertia_cm",
+                (true, false) => "mu_scale center_of_friction",
+                _ => "mu_scale",
+            };
+            let verdict = if r[0].is_nan() {
+                "failed"
+            } else {
+                fit::verdict(r)
+            };
+            let _ = writeln!(
+                fits,
+                "{},{},{fitted},{verdict}",
+                fit::SCHEDULES[k],
+                vals.join(",")
+            );
+        }
+    }
+    if plan.fit {
+        w.file("coulomb_fit.csv", fits.as_bytes())?;
+    }
+    let text = readme(
+        plan,
+        &paper,
+        &map,
+        &ladder,
+        creep.as_deref(),
+        &variants,
+        &variant_maps,
+        &fits,
+    );
+    w.file("README.md", text.as_bytes())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn readme(
+    plan: &Plan,
+    paper: &str,
+    map: &str,
+    ladder: &str,
+    creep: Option<&str>,
+    variants: &str,
+    variant_maps: &[(String, String)],
+    fits: &str,
+) -> String {
+    let e = plan.setups[0].engine.as_ref();
+    let m = &plan.model;
+    let mut s = format!(
+        "# {m}: friction against Coulomb\n\n\
+         Generated by `pushval study {m}` ({}); do not edit by hand. Study file: `studies/{m}.toml`{}.\n\n",
+        e.version(),
+        if plan.spec.about.is_some() || !plan.spec.variant.is_empty() { "" } else { " (none: defaults)" }
+    );
+    if plan.quick {
+        s.push_str("**Quick run: reduced grids (for tests).**\n\n");
+    }
+    let law = e
+        .law()
+        .map_or("none declared".to_string(), |l| l.law_name().to_string());
+    let _ = write!(
+        s,
+        "Model: {}. Engine law in closed form: {law}. Scene: the seed paper's plate (0.25 m square, 1 kg, μ = 0.5 on four corner supports), \
+         pushed at a corner from ω = 0 for {} s; ω is the mean over the last {} % of the run, at Δt = {} s{}.\n\n",
+        e.description(),
+        plan.t_run,
+        100.0 * plan.tail,
+        plan.dt,
+        if plan.setups[0].options.values.is_empty() {
+            String::new()
+        } else {
+            format!(", `[engine]` {:?}", plan.setups[0].options.values)
+        }
+    );
+    if let Some(a) = &plan.spec.about {
+        s.push_str(a.trim());
+        s.push_str("\n\n");
+    }
+    let _ = write!(
+        s,
+        "## Paper plate (`paper_plate.csv`)\n\nφ = π/4 + 0.3 = {PHI_TABLE:.4} rad. Error against Coulomb: relative to ω*; against the law: relative, or |ω|/|ω*| where the law holds ω = 0.\n\n\
+         | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law |\n|---|---|---|---|---|---|\n"
+    );
+    for r in parse(paper) {
+        let (v, we, wc, wl) = (
+            num(&r, "speed"),
+            num(&r, "omega_engine"),
+            num(&r, "omega_coulomb"),
+            num(&r, "omega_law"),
+        );
+        let _ = writeln!(
+            s,
+            "| {v} | {} | {} | {} | {} | {} |",
+            sig(we),
+            sig(wc),
+            sig(wl),
+            sig(err(we, wc, wc, v)),
+            sig(err(we, wl, wc, v))
+        );
+    }
+    let mut map_section = |name: &str, file: &str, text: &str| {
+        let st = map_stats(&parse(text));
+        let _ = write!(
+            s,
+            "\n## (Fr, φ) map{name} (`{file}`)\n\n{} cells, Fr from {} to {} (log), φ from {:.2} to {:.2} rad. \
+             Within 1e-2 of Coulomb: {}. Within 1e-2 of the engine's law: {}. The law's class: turns {}, locked {}, semi_stable {}.\n",
+            st[0],
+            frs(plan.quick)[0],
+            frs(plan.quick)[frs(plan.quick).len() - 1],
+            phis(plan.quick)[0],
+            phis(plan.quick)[phis(plan.quick).len() - 1],
+            pct(st[1], st[0]),
+            pct(st[3], st[2]),
+            st[4],
+            st[5],
+            st[6]
+        );
+    };
+    map_section("", "map.csv", map);
+    for (n, t) in variant_maps {
+        map_section(&format!(", variant {n}"), &format!("map_{n}.csv"), t);
+    }
+    let ladder_table = |s: &mut String, text: &str| {
+        s.push_str("| v_c | Δt (s) | ω engine | change | observed order | Richardson |\n|---|---|---|---|---|---|\n");
+        for r in parse(text) {
+            let v = r.get("speed").cloned().unwrap_or_else(|| "0.5".into());
+            let _ = writeln!(
+                s,
+                "| {v} | {} | {} | {} | {} | {} |",
+                num(&r, "dt"),
+                sig(num(&r, "omega_engine")),
+                sig(num(&r, "change")),
+                if num(&r, "observed_order").is_finite() {
+                    format!("{:.2}", num(&r, "observed_order"))
+                } else {
+                    "–".into()
+                },
+                sig(num(&r, "richardson"))
+            );
+        }
+    };
+    let _ = write!(
+        s,
+        "\n## Step ladder (`dt_ladder.csv`)\n\nv_c = 0.5 m/s, φ = π/4 + 0.3. Declared order {}; Richardson at it.\n\n",
+        e.order()
+    );
+    ladder_table(&mut s, ladder);
+    if let Some(c) = creep {
+        s.push_str("\n## Creep where the law locks (`creep.csv`)\n\nThe law holds ω = 0 at these table pushes; the engine's |ω| over the step ladder:\n\n");
+        ladder_table(&mut s, c);
+    }
+    if plan.setups.len() > 1 {
+        s.push_str("\n## Variants (`variants.csv`)\n\n| variant | options | supports half side (m) | φ (rad) | Δt (s) | v_c | ω engine | ω* Coulomb | ω law | class |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        for r in parse(variants) {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                r["variant"],
+                r["options"],
+                r["supports_half"],
+                r["phi"],
+                r["dt"],
+                r["speed"],
+                sig(num(&r, "omega_engine")),
+                sig(num(&r, "omega_coulomb")),
+                sig(num(&r, "omega_law")),
+                r["class"]
+            );
+        }
+    }
+    if plan.fit {
+        s.push_str("\n## Coulomb fit (`coulomb_fit.csv`)\n\nThe dynamic model fitted to the engine's trajectory (`pushval fit`'s Levenberg–Marquardt); verdict against ten times the engine's own step error.\n\n\
+                    | schedule | fitted | μ scale | residual position (m) | residual θ (rad) | verdict |\n|---|---|---|---|---|---|\n");
+        for r in parse(fits) {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} |",
+                r["schedule"],
+                r["fitted"],
+                sig(num(&r, "mu_scale")),
+                sig(num(&r, "position_rms")),
+                sig(num(&r, "theta_rms")),
+                r["verdict"]
+            );
+        }
+    }
+    s
+}
+
+/// The index of every model's study, `OUT/README.md`, read from the
+/// models' folders (a model this build lacks keeps its folder and row).
+pub fn index(root: &Path, models: &[String], quick: bool, w: &mut Writer) -> anyhow::Result<()> {
+    let mut s = String::from(
+        "# Engine friction against Coulomb: every engine model\n\n\
+         Generated by `pushval study all`; do not edit by hand. One folder per model (`pushval study MODEL`), \
+         each with its README; this table reads their `paper_plate.csv` (v_c = 0.5 m/s, φ = π/4 + 0.3) and `map.csv`.\n\n",
+    );
+    if quick {
+        s.push_str("**Quick run: reduced grids (for tests).**\n\n");
+    }
+    s.push_str("| model | ω engine (rad/s) | ω* Coulomb | ω law | map within 1e-2 of Coulomb | of the law | locked / semi-stable cells |\n|---|---|---|---|---|---|---|\n");
+    for m in models {
+        let read = |f: &str| std::fs::read_to_string(root.join(m).join(f)).ok();
+        let (Some(paper), Some(map)) = (read("paper_plate.csv"), read("map.csv")) else {
+            continue;
+        };
+        let rows = parse(&paper);
+        let Some(r) = rows.iter().find(|r| num(r, "speed") == 0.5) else {
+            continue;
+        };
+        let st = map_stats(&parse(&map));
+        let _ = writeln!(
+            s,
+            "| [{m}]({m}/README.md) | {} | {} | {} | {} | {} | {} / {} |",
+            sig(num(r, "omega_engine")),
+            sig(num(r, "omega_coulomb")),
+            sig(num(r, "omega_law")),
+            pct(st[1], st[0]),
+            pct(st[3], st[2]),
+            st[5],
+            st[6]
+        );
+    }
+    w.file("README.md", s.as_bytes())
+}

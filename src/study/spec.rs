@@ -1,0 +1,185 @@
+//! What a study varies, as data: `studies/MODEL.toml` (optional; every key
+//! has a default, so a model without a file, an outside engine included,
+//! still gets the whole study).
+//!
+//! ```toml
+//! about = "what the study shows, one paragraph of the README"
+//! dt = 1e-3               # s: step of the table and the maps (default: the engine's)
+//! t_run = 6.0             # s: length of every run
+//! tail = 0.2              # share of a run (its end) over which ω is averaged
+//! ladder = [4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4]   # s: the step ladder (default: dt × 4 … 1/4)
+//! ladder_quick = [2e-3, 1e-3, 5e-4]           # s: the same for --quick (default: dt × 2 … 1/2)
+//! fit = true              # fit the Coulomb model to the engine (default true)
+//! engine = { substeps = 4 }                   # [engine] options of every run
+//!
+//! [[variant]]             # a further table (and map) with other options or supports
+//! name = "separate"
+//! engine = { contacts = "separate" }          # over the study's own options
+//! supports_half = 0.05    # m: supports on a square of this half side (default: the plate's corners)
+//! phi = 1.585             # rad: direction of its table (default π/4 + 0.3)
+//! dt = 0.0166667          # s: its step (default the study's)
+//! map = true              # also a (Fr, φ) map, map_NAME.csv (default false)
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use pushval_engine::EngineOptions;
+use serde::Deserialize;
+
+/// One study file.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Spec {
+    pub about: Option<String>,
+    pub dt: Option<f64>,
+    pub t_run: Option<f64>,
+    pub tail: Option<f64>,
+    pub ladder: Option<Vec<f64>>,
+    pub ladder_quick: Option<Vec<f64>>,
+    pub fit: Option<bool>,
+    #[serde(default)]
+    pub engine: BTreeMap<String, serde_json::Value>,
+    #[serde(default)]
+    pub variant: Vec<Variant>,
+}
+
+/// A further table (and map) of the study.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Variant {
+    pub name: String,
+    #[serde(default)]
+    pub engine: BTreeMap<String, serde_json::Value>,
+    pub supports_half: Option<f64>,
+    pub phi: Option<f64>,
+    pub dt: Option<f64>,
+    #[serde(default)]
+    pub map: bool,
+}
+
+/// The folder of the study files: `studies/` here, else the package's.
+pub fn default_dir() -> PathBuf {
+    let local = PathBuf::from("studies");
+    if local.is_dir() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("studies")
+    }
+}
+
+impl Spec {
+    /// `DIR/MODEL.toml`, or the defaults when there is none. Errors name the
+    /// file and the key.
+    pub fn load(dir: &Path, model: &str) -> anyhow::Result<Self> {
+        let path = dir.join(format!("{model}.toml"));
+        if !path.exists() {
+            return Ok(Self::default());
+        }
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
+        let de = toml::Deserializer::parse(&text)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let spec: Spec = serde_path_to_error::deserialize(de).map_err(|e| {
+            anyhow::anyhow!("{}: key `{}`: {}", path.display(), e.path(), e.inner())
+        })?;
+        spec.check()
+            .map_err(|(key, why)| anyhow::anyhow!("{}: key `{key}`: {why}", path.display()))?;
+        Ok(spec)
+    }
+
+    fn check(&self) -> Result<(), (String, String)> {
+        let pos = |key: &str, v: Option<f64>| match v {
+            Some(x) if !(x.is_finite() && x > 0.0) => Err((
+                key.to_string(),
+                format!("must be a finite number > 0, got {x}"),
+            )),
+            _ => Ok(()),
+        };
+        pos("dt", self.dt)?;
+        pos("t_run", self.t_run)?;
+        if let Some(t) = self.tail {
+            if !(t > 0.0 && t <= 1.0) {
+                return Err(("tail".into(), format!("must be in (0, 1], got {t}")));
+            }
+        }
+        for (key, l) in [
+            ("ladder", &self.ladder),
+            ("ladder_quick", &self.ladder_quick),
+        ] {
+            if let Some(l) = l {
+                if l.len() < 3 {
+                    return Err((key.into(), "needs at least 3 steps".into()));
+                }
+                for (i, &h) in l.iter().enumerate() {
+                    pos(&format!("{key}[{i}]"), Some(h))?;
+                }
+            }
+        }
+        for (i, v) in self.variant.iter().enumerate() {
+            if v.name.is_empty()
+                || !v
+                    .name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_')
+            {
+                return Err((
+                    format!("variant[{i}].name"),
+                    format!("must be letters, digits and _, got \"{}\"", v.name),
+                ));
+            }
+            pos(&format!("variant[{i}].supports_half"), v.supports_half)?;
+            pos(&format!("variant[{i}].dt"), v.dt)?;
+        }
+        Ok(())
+    }
+
+    /// The `[engine]` options of the study's runs, with `extra` over them.
+    pub fn options(&self, extra: &BTreeMap<String, serde_json::Value>) -> EngineOptions {
+        let mut values = self.engine.clone();
+        values.extend(extra.clone());
+        EngineOptions {
+            dt: None,
+            values,
+            ..Default::default()
+        }
+    }
+
+    /// The step ladder (s), coarse to fine.
+    pub fn ladder(&self, dt: f64, quick: bool) -> Vec<f64> {
+        let given = if quick {
+            &self.ladder_quick
+        } else {
+            &self.ladder
+        };
+        given.clone().unwrap_or_else(|| {
+            let f: &[f64] = if quick {
+                &[2.0, 1.0, 0.5]
+            } else {
+                &[4.0, 2.0, 1.0, 0.5, 0.25]
+            };
+            f.iter().map(|k| k * dt).collect()
+        })
+    }
+}
+
+/// Refuses a study file for a model the registry does not list.
+pub fn check_names(dir: &Path, models: &[String]) -> anyhow::Result<()> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+            if !models.iter().any(|m| m == stem) {
+                bail!(
+                    "{}: no engine model `{stem}`; a study file is named after a model of `pushval engines`",
+                    p.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
