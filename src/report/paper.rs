@@ -566,9 +566,18 @@ fn mass_figure(light: &Runs, heavy: &Runs, w: &mut Writer) -> anyhow::Result<Ent
     };
     w.file("mass.csv", csv.as_bytes())?;
     w.figure("mass.svg", &fig)?;
+    // Differences of two runs: no column of mass.csv holds them.
+    for (q, v) in [
+        ("max_domega_dynamic_rad_s", dw_model),
+        ("max_dposition_dynamic_m", dp_model),
+        ("max_domega_rapier2d_rad_s", dw_engine),
+        ("max_dposition_rapier2d_m", dp_engine),
+    ] {
+        w.key("mass.svg", q, v);
+    }
     Ok(Entry {
         figure: "mass.svg".into(),
-        data: vec!["mass.csv".into()],
+        data: vec!["mass.csv".into(), super::KEY_FIGURES.into()],
         text: format!(
             "The paper plate at 1 kg and at 10 kg (inertia and loads scale with the mass), \
              v_c = 1 m/s. Dynamic model: max |Δω| = {dw_model:.1e} rad/s, max |Δposition| = \
