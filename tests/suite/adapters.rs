@@ -180,3 +180,80 @@ fn pybullet_contact_follows_the_rows_disk_law_not_coulomb() {
         "engine vs Coulomb: max relative {d_coulomb}"
     );
 }
+
+/// Mean ω over the last 20 % of a run's samples.
+fn tail_omega(samples: &[(f64, f64, f64)]) -> f64 {
+    let from = samples.len() - samples.len() / 5;
+    samples[from..].iter().map(|s| s.2).sum::<f64>() / (samples.len() - from) as f64
+}
+
+/// MuJoCo 4 through the outside adapter, the scene of the compiled-in 3.17
+/// adapter: the elliptic cone is Coulomb's disk (steady ω within 3 % of the
+/// analytic model at 1 m/s: the soft contacts' creep), the pyramidal cone
+/// locks the plate's orientation (|ω| under 5 % of Coulomb's; the finding
+/// of results/friction_models/mujoco/).
+#[test]
+#[ignore = "needs .venv-adapters (scripts/setup-adapters.sh); CI runs it"]
+fn mujoco4_elliptic_is_near_coulomb_and_pyramidal_locks() {
+    venv_python();
+    let dir = tempfile::tempdir().unwrap();
+    let file = scenario(
+        dir.path(),
+        1.0,
+        6.0,
+        &["mujoco4_elliptic", "mujoco4_pyramidal"],
+    );
+    let runs = run(&file, &dir.path().join("out"));
+    let body = plate();
+    let push = Push {
+        duration: 6.0,
+        speed: 1.0,
+        phi: PHI,
+    };
+    let coulomb = SegmentDynamics::new(&body, &push)
+        .steady_states()
+        .into_iter()
+        .find(|s| s.is_stable())
+        .unwrap()
+        .omega;
+    let e = tail_omega(&runs["mujoco4_elliptic"]);
+    let p = tail_omega(&runs["mujoco4_pyramidal"]);
+    assert!(
+        (e - coulomb).abs() < 0.03 * coulomb.abs(),
+        "elliptic {e} vs {coulomb}"
+    );
+    assert!(p.abs() < 0.05 * coulomb.abs(), "pyramidal {p} vs {coulomb}");
+}
+
+/// MuJoCo 3.17 (compiled in) and 4.0 (outside) on one problem: the same
+/// trajectory to rounding (results/friction_models/mujoco_versions.csv).
+#[cfg(feature = "mujoco")]
+#[test]
+#[ignore = "needs .venv-adapters (scripts/setup-adapters.sh); CI runs it"]
+fn mujoco_3_17_and_4_0_agree() {
+    venv_python();
+    let dir = tempfile::tempdir().unwrap();
+    let file = scenario(
+        dir.path(),
+        0.5,
+        3.0,
+        &[
+            "mujoco_elliptic",
+            "mujoco4_elliptic",
+            "mujoco_pyramidal",
+            "mujoco4_pyramidal",
+        ],
+    );
+    let runs = run(&file, &dir.path().join("out"));
+    for cone in ["elliptic", "pyramidal"] {
+        let a = &runs[&format!("mujoco_{cone}")];
+        let b = &runs[&format!("mujoco4_{cone}")];
+        assert_eq!(a.len(), b.len());
+        let d = a
+            .iter()
+            .zip(b)
+            .map(|(p, q)| (p.1 - q.1).abs().max((p.2 - q.2).abs()))
+            .fold(0.0f64, f64::max);
+        assert!(d < 1e-8, "{cone}: max |Δθ|, |Δω| {d}");
+    }
+}
