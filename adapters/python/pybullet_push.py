@@ -19,6 +19,14 @@ In both, the pusher is a kinematic body moved each step at
 speed * R(theta) (cos phi, sin phi), joined to the plate's contact point by a
 point-to-point constraint. Bullet steps semi-implicitly (velocities, then
 positions): first order in dt.
+
+In contact mode the constraint must not hold the plate up: a point-to-point
+joint fixes all three coordinates, and a pusher at a fixed height carries
+part of the weight (the plate then hangs from the pusher and rests on its far
+foot: loads 0, 0, 0 and 5 N instead of 2.45 N each). So the pusher is a
+fixed-base body with one light link on a free vertical prismatic joint (its
+weight cancelled each step), and the joint's pivot sits at the feet's
+contact height, so the pushing force does not tip the plate either.
 """
 
 import json
@@ -61,8 +69,8 @@ def simulate(p, doc, mode):
     dt = float(doc["dt"])
     g = float(doc["gravity"])
     p.setPhysicsEngineParameter(fixedTimeStep=dt, numSubSteps=0, numSolverIterations=50, physicsClientId=client)
-    thick = 0.01
-    foot = 0.005
+    thick = 0.005
+    foot = 0.0025
     z0 = foot * 2 + thick / 2 if mode == "contact" else 0.0
     xs = [q[0] - cx for q in obj["polygon"]]
     ys = [q[1] - cy for q in obj["polygon"]]
@@ -94,9 +102,10 @@ def simulate(p, doc, mode):
         physicsClientId=client,
     )
     # The plate's inertia about z is the problem's; x and y large enough
-    # that it does not rock on its feet.
+    # that it does not rock on its feet (and that rocking adds little to a
+    # friction row's effective mass: (h/1)^2/(100 I_cm), h = 7.5 mm).
     p.changeDynamics(
-        body, -1, localInertiaDiagonal=[10 * i_cm, 10 * i_cm, i_cm],
+        body, -1, localInertiaDiagonal=[100 * i_cm, 100 * i_cm, i_cm],
         linearDamping=0, angularDamping=0, physicsClientId=client,
     )
     if mode == "contact":
@@ -115,9 +124,26 @@ def simulate(p, doc, mode):
             body, [ini["position"][0], ini["position"][1], p.getBasePositionAndOrientation(body, physicsClientId=client)[0][2]],
             p.getQuaternionFromEuler([0, 0, th0]), physicsClientId=client)
     # The pusher: a kinematic (mass 0) point moved each step, joined to the
-    # contact point.
-    pusher = p.createMultiBody(0, -1, basePosition=contact_world(body, rc, p, client), physicsClientId=client)
-    cid = p.createConstraint(body, -1, pusher, -1, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], 0], [0, 0, 0], physicsClientId=client)
+    # contact point. In contact mode the joint acts at the feet's contact
+    # height through a light link free to slide vertically (see the top).
+    zp = -(thick / 2 + 2 * foot) if mode == "contact" else 0.0
+    base = contact_world(body, rc, p, client)
+    base[2] += zp
+    slider_mass = 1e-3
+    if mode == "contact":
+        pusher = p.createMultiBody(
+            0, -1, basePosition=base,
+            linkMasses=[slider_mass], linkCollisionShapeIndices=[-1], linkVisualShapeIndices=[-1],
+            linkPositions=[[0, 0, 0]], linkOrientations=[[0, 0, 0, 1]],
+            linkInertialFramePositions=[[0, 0, 0]], linkInertialFrameOrientations=[[0, 0, 0, 1]],
+            linkParentIndices=[0], linkJointTypes=[p.JOINT_PRISMATIC], linkJointAxis=[[0, 0, 1]],
+            physicsClientId=client)
+        p.changeDynamics(pusher, 0, linearDamping=0, angularDamping=0, jointDamping=0, physicsClientId=client)
+        p.setJointMotorControl2(pusher, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=client)
+        cid = p.createConstraint(body, -1, pusher, 0, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], zp], [0, 0, 0], physicsClientId=client)
+    else:
+        pusher = p.createMultiBody(0, -1, basePosition=base, physicsClientId=client)
+        cid = p.createConstraint(body, -1, pusher, -1, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], 0], [0, 0, 0], physicsClientId=client)
     p.changeConstraint(cid, maxForce=1e6, erp=0.8, physicsClientId=client)
 
     pushes = doc["pushes"]
@@ -148,6 +174,8 @@ def simulate(p, doc, mode):
             pp = p.getBasePositionAndOrientation(pusher, physicsClientId=client)[0]
             target = [pp[0] + h * push["speed"] * math.cos(a), pp[1] + h * push["speed"] * math.sin(a), pp[2]]
             p.resetBasePositionAndOrientation(pusher, target, [0, 0, 0, 1], physicsClientId=client)
+            if mode == "contact":
+                p.applyExternalForce(pusher, 0, [0, 0, slider_mass * g], [0, 0, 0], p.LINK_FRAME, physicsClientId=client)
             p.stepSimulation(physicsClientId=client)
             pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
             v, w = p.getBaseVelocity(body, physicsClientId=client)

@@ -130,6 +130,7 @@ fn engine_meets_steady_target(#[files("scenarios/*.toml")] path: PathBuf) {
     let mut sc = load(&path);
     // rapier2d gated whatever the file gates (the Box2D scene gates Box2D).
     sc.gate = vec!["rapier2d".into()];
+    // The outside scenes run only their adapter and the analytic models.
     if !sc.models.iter().any(|m| m == "rapier2d") {
         sc.models.push("rapier2d".into());
     }
@@ -197,6 +198,7 @@ fn automatic_dt_is_the_largest_rung_that_meets_its_criterion(
     // rapier2d gated whatever the file gates (the Box2D scene gates Box2D,
     // at numbers sized for Box2D: auto here, as everywhere else).
     sc.gate = vec!["rapier2d".into()];
+    // The outside scenes run only their adapter and the analytic models.
     if !sc.models.iter().any(|m| m == "rapier2d") {
         sc.models.push("rapier2d".into());
     }

@@ -1,6 +1,7 @@
 //! pushval's integration tests, one module per topic. Physics tests run in
 //! the optimised test profile (see the README's test command).
 
+mod adapters;
 mod assumptions;
 mod bad_input;
 mod cli;

@@ -136,7 +136,7 @@ fn an_adapter_with_inertia_one_percent_off_fails_the_gate() {
         .unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(
-        text(&o).contains("FAIL outside-pure-python-heun / pure_python: position_max"),
+        text(&o).contains("FAIL outside-pure-python-heun / pure_python: "),
         "{}",
         text(&o)
     );
@@ -325,4 +325,105 @@ fn a_bad_engines_file_is_an_input_error() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
+}
+
+/// `pushval power` on an outside engine: the gate of the shipped
+/// second-order pure-Python scenario (auto tolerances under the 1e-3
+/// ceiling) catches an I_cm error of 1 % and a μ error of 1 % like the
+/// compiled-in engines (the adapter with I_cm 1 % off fails `validate`, see
+/// above); the engine runs once, as a process, and the errors are injected
+/// into the model.
+#[test]
+fn power_measures_the_gate_of_an_outside_engine() {
+    let sc = crate::common::load(&root().join("scenarios/outside-pure-python-heun.toml"));
+    let rows = pushval::power::measure(&[sc], &[], 8).unwrap();
+    let ours: Vec<_> = rows
+        .iter()
+        .filter(|r| r.engine == "pure_python_heun")
+        .collect();
+    assert!(!ours.is_empty(), "no rows for the outside engine: {rows:?}");
+    for kind in [
+        pushval::power::ErrorKind::InertiaCm,
+        pushval::power::ErrorKind::MuAll,
+    ] {
+        let r = ours.iter().find(|r| r.kind == kind).unwrap();
+        let caught = r.both().unwrap_or(f64::INFINITY);
+        assert!(caught <= 0.01, "{}: caught from {caught:e}", kind.name());
+        // The dt ladder chose the step: a rung 1/(60 · 2^k) s.
+        let k = (1.0 / (60.0 * r.dt)).log2();
+        assert!(
+            k >= 1.0 && (k - k.round()).abs() < 1e-9,
+            "the gate's dt {}",
+            r.dt
+        );
+    }
+}
+
+/// `pushval fit` on an outside engine's trajectory: the pure-Python adapter
+/// run with its inertia scaled by 1.05 (`--inertia-scale`), its trajectory
+/// written by `pushval run`, and the fit of μ scale and I_cm from the
+/// scenario's values recovers I_cm × 1.05 and μ × 1 (Heun at dt = 1e-3 is
+/// accurate to ~1e-6 m, far below the parameters' effect).
+#[test]
+fn fit_recovers_the_inertia_of_an_outside_engine() {
+    let dir = tempfile::tempdir().unwrap();
+    let engines = dir.path().join("engines.toml");
+    std::fs::write(
+        &engines,
+        format!(
+            "[engine.heavy_python]\ncommand = [\"python3\", {:?}, \"--scheme\", \"heun\", \"--inertia-scale\", \"1.05\"]\norder = 2\n",
+            adapter()
+        ),
+    )
+    .unwrap();
+    let text_sc = std::fs::read_to_string(root().join("scenarios/outside-pure-python-heun.toml"))
+        .unwrap()
+        .replace(
+            "models = [\"dynamic\", \"kinematic\", \"pure_python_heun\"]",
+            "models = [\"heavy_python\"]",
+        )
+        .replace("gate = [\"pure_python_heun\"]\n", "");
+    assert!(text_sc.contains("models = [\"heavy_python\"]"));
+    let sc = dir.path().join("heavy.toml");
+    std::fs::write(&sc, text_sc).unwrap();
+    let run_dir = dir.path().join("run");
+    let o = pushval()
+        .arg("run")
+        .arg(&sc)
+        .arg("--out")
+        .arg(&run_dir)
+        .arg("--engines")
+        .arg(&engines)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let out = dir.path().join("fit");
+    let o = pushval()
+        .arg("fit")
+        .arg(&sc)
+        .arg("--trajectory")
+        .arg(run_dir.join("trajectory.csv"))
+        .args([
+            "--model",
+            "heavy_python",
+            "--params",
+            "mu_scale,inertia_cm",
+            "--out",
+        ])
+        .arg(&out)
+        .arg("--engines")
+        .arg(&engines)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("fit.json")).unwrap()).unwrap();
+    let mu = j["parameters"]["mu_scale"]["value"].as_f64().unwrap();
+    let inertia = j["parameters"]["inertia_cm"]["value"].as_f64().unwrap();
+    let truth = 1.05 * 0.0625 / 6.0;
+    assert!((mu - 1.0).abs() < 2e-3, "mu_scale {mu}");
+    assert!(
+        (inertia / truth - 1.0).abs() < 5e-3,
+        "inertia_cm {inertia}, the adapter's {truth}"
+    );
 }

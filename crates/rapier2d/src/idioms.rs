@@ -20,6 +20,18 @@
 //!   `1/(1/m + (r × e)²/I)`, each impulse in `[−F Δt, F Δt]`): rapier's own
 //!   idiom (a joint to the ground with linear motors of `max_force = μ N`
 //!   on its two axes) and the pyramid friction of many solvers.
+//! * [`FrictionModel::ImpulseRowsDisk`]: the box's two per-axis rows (each
+//!   with its own scalar effective mass), but the *pair* capped in length at
+//!   `F Δt`: Bullet's multibody contact friction (PyBullet), whose solver
+//!   solves the two lateral friction rows of a contact one by one and then
+//!   scales the pair back onto the disk of radius `μ λ_n`. Sliding, its
+//!   force has Coulomb's magnitude `F` but points along
+//!   `−(m_x u_x, m_y u_y)`, `m_x = 1/(1/m + r_y²/I)`, `m_y = 1/(1/m + r_x²/I)`:
+//!   the direction of `u` bent towards the axis with the larger effective
+//!   mass. The rows are Bullet's fixed friction axes (`btPlaneSpace1` of the
+//!   contact normal: world x and y on a level floor), so the law depends on
+//!   θ with period π/2 for the square plate and is exactly Coulomb's where
+//!   every support has `r_x² = r_y²` (θ = 0 mod π/2 for corner supports).
 //! * [`FrictionModel::RegularisedLinear`] / [`FrictionModel::RegularisedTanh`]:
 //!   Coulomb below a slip speed `v_s` replaced by `−F u/v_s`, or
 //!   `−F tanh(|u|/v_s) u/|u|` everywhere (smooth simulators).
@@ -29,7 +41,7 @@
 //! nominal step; so the engine integrates (to second order in the default
 //! leapfrog mode) the analytic model with the law substituted, and
 //! [`predicted_steady_omega`] — the root of that modified moment balance —
-//! predicts its steady ω. The isotropic laws (all but the box) depend on the
+//! predicts its steady ω. The isotropic laws (all but the per-axis ones) depend on the
 //! object frame only, so ω̇ depends on ω alone; the box law depends on the
 //! object's angle θ as well ([`idiom_moment`] takes θ), and
 //! [`predicted_mean_omega`] gives the quasi-steady period mean
@@ -51,6 +63,9 @@ pub enum FrictionModel {
     ImpulseDisk,
     /// The stopping impulse per world axis, each component capped at `F Δt`.
     ImpulseBox,
+    /// The stopping impulse per world axis (diagonal effective masses), the
+    /// pair capped in length at `F Δt` (Bullet's multibody cone friction).
+    ImpulseRowsDisk,
     /// `−F u/v_s` below the slip speed `slip_speed` (m/s), Coulomb above.
     RegularisedLinear {
         /// The slip speed `v_s` (m/s).
@@ -64,22 +79,27 @@ pub enum FrictionModel {
 }
 
 impl FrictionModel {
-    /// `"coulomb"`, `"impulse_disk"`, `"impulse_box"`, `"regularised_linear"`
-    /// or `"regularised_tanh"`.
+    /// `"coulomb"`, `"impulse_disk"`, `"impulse_box"`, `"impulse_rows_disk"`,
+    /// `"regularised_linear"` or `"regularised_tanh"`.
     pub fn as_str(&self) -> &'static str {
         match self {
             FrictionModel::Coulomb => "coulomb",
             FrictionModel::ImpulseDisk => "impulse_disk",
             FrictionModel::ImpulseBox => "impulse_box",
+            FrictionModel::ImpulseRowsDisk => "impulse_rows_disk",
             FrictionModel::RegularisedLinear { .. } => "regularised_linear",
             FrictionModel::RegularisedTanh { .. } => "regularised_tanh",
         }
     }
 
-    /// Whether the law is the same in every frame (all but the box): then
-    /// the engine's steady ω does not depend on the object's angle.
+    /// Whether the law is the same in every frame (all but the per-axis
+    /// laws): then the engine's steady ω does not depend on the object's
+    /// angle.
     pub fn is_isotropic(&self) -> bool {
-        !matches!(self, FrictionModel::ImpulseBox)
+        !matches!(
+            self,
+            FrictionModel::ImpulseBox | FrictionModel::ImpulseRowsDisk
+        )
     }
 
     /// Checks the slip speed; errors name the field.
@@ -158,6 +178,19 @@ pub fn support_force(
                 (-my * u[1] / ctx.dt).clamp(-friction, friction),
             ]
         }
+        FrictionModel::ImpulseRowsDisk => {
+            let mx = 1.0 / (inv_m + r[1] * r[1] * inv_i);
+            let my = 1.0 / (inv_m + r[0] * r[0] * inv_i);
+            let fx = -mx * u[0] / ctx.dt;
+            let fy = -my * u[1] / ctx.dt;
+            let len = (fx * fx + fy * fy).sqrt();
+            if len > friction {
+                let s = friction / len;
+                [fx * s, fy * s]
+            } else {
+                [fx, fy]
+            }
+        }
         FrictionModel::RegularisedLinear { slip_speed } => {
             let k = -friction * (speed / slip_speed).min(1.0) / speed;
             [k * u[0], k * u[1]]
@@ -184,7 +217,9 @@ pub fn force_magnitude(
     let s = speed.abs();
     match model {
         FrictionModel::Coulomb => friction,
-        FrictionModel::ImpulseDisk | FrictionModel::ImpulseBox => friction.min(m_eff * s / dt),
+        FrictionModel::ImpulseDisk | FrictionModel::ImpulseBox | FrictionModel::ImpulseRowsDisk => {
+            friction.min(m_eff * s / dt)
+        }
         FrictionModel::RegularisedLinear { slip_speed } => friction * (s / slip_speed).min(1.0),
         FrictionModel::RegularisedTanh { slip_speed } => friction * (s / slip_speed).tanh(),
     }
@@ -192,7 +227,7 @@ pub fn force_magnitude(
 
 /// `I_P ω̇` (N m) of the analytic model with the support law of `model`
 /// substituted: `Σ (p_i − p_c) × f_i + m v_c ω (p_c · n_φ)`, at object angle
-/// `theta` (only the box law depends on it) and cap step `dt`.
+/// `theta` (only the per-axis laws depend on it) and cap step `dt`.
 pub fn idiom_moment(
     model: FrictionModel,
     body: &Body,
@@ -416,7 +451,7 @@ pub fn stop_gain(model: FrictionModel, body: &Body, dt: f64, theta: f64) -> Opti
                 let det = a * c - b * b;
                 [(c * e[0] - b * e[1]) / det, (a * e[1] - b * e[0]) / det]
             }
-            FrictionModel::ImpulseBox => [e[0] / a, e[1] / c],
+            FrictionModel::ImpulseBox | FrictionModel::ImpulseRowsDisk => [e[0] / a, e[1] / c],
             FrictionModel::RegularisedLinear { slip_speed } => {
                 let k = s.friction * dt / slip_speed;
                 [k * e[0], k * e[1]]

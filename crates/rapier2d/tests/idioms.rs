@@ -279,3 +279,69 @@ fn stopping_chatters_when_the_step_gain_passes_two() {
         }
     }
 }
+
+/// Bullet's multibody friction (per-axis rows, the pair scaled onto the
+/// disk): Coulomb's magnitude, bent direction. For the square plate on its
+/// corners every support has `r_x² = r_y²` at θ = 0 (mod π/2), so the rows'
+/// effective masses agree and the law is Coulomb's there; it is periodic
+/// in θ with period π/2 (the plate's symmetry) and differs most near π/4.
+#[test]
+fn impulse_rows_disk_is_coulomb_on_the_axes_and_bent_between() {
+    let ctx = LawContext {
+        mass: 1.0,
+        inertia_cm: 0.0625 / 6.0,
+        dt: 1e-3,
+    };
+    // Sliding: magnitude F whatever the direction.
+    for (u, r) in [([1.0, 0.2], [0.0, 0.177]), ([-0.3, 0.7], [0.1, -0.05])] {
+        let f = support_force(FrictionModel::ImpulseRowsDisk, u, r, 1.5, &ctx);
+        assert!((f[0].hypot(f[1]) - 1.5).abs() < 1e-12, "{f:?}");
+    }
+    // A support on the y axis (r_x = 0): the x row has effective mass
+    // 1/(1/m + r_y²/I) = 1/4 of the y row's here (r_y² / I = 3), so a slip
+    // at 45° gets a force at atan(4) from the x axis instead of 45°.
+    let r = [0.0, (3.0 * ctx.inertia_cm).sqrt()];
+    let f = support_force(FrictionModel::ImpulseRowsDisk, [1.0, 1.0], r, 1.0, &ctx);
+    assert!(((f[1] / f[0]).atan() - 4f64.atan()).abs() < 1e-12, "{f:?}");
+    // On the axes the law is Coulomb's: same steady ω as the analytic model.
+    let body = plate();
+    for v in [0.2, 1.0] {
+        let p = push(v, 1.0);
+        let ws = star(v);
+        for th in [0.0, FRAC_PI_2, -FRAC_PI_2] {
+            let w =
+                predicted_steady_omega(FrictionModel::ImpulseRowsDisk, &body, &p, 1e-3, th, 0.0)
+                    .unwrap();
+            assert!(
+                (w - ws).abs() < 1e-9 * ws.abs(),
+                "v {v} θ {th}: {w} vs {ws}"
+            );
+        }
+        // Period π/2, and far from Coulomb at π/4.
+        for th in [0.3, FRAC_PI_4, 1.1] {
+            let a =
+                predicted_steady_omega(FrictionModel::ImpulseRowsDisk, &body, &p, 1e-3, th, 0.0)
+                    .unwrap();
+            let b = predicted_steady_omega(
+                FrictionModel::ImpulseRowsDisk,
+                &body,
+                &p,
+                1e-3,
+                th + FRAC_PI_2,
+                0.0,
+            )
+            .unwrap();
+            assert!((a - b).abs() < 1e-9 * a.abs(), "θ {th}: {a} vs {b}");
+        }
+        let w45 = predicted_steady_omega(
+            FrictionModel::ImpulseRowsDisk,
+            &body,
+            &p,
+            1e-3,
+            FRAC_PI_4,
+            0.0,
+        )
+        .unwrap();
+        assert!((w45 - ws).abs() > 0.1 * ws.abs(), "v {v}: {w45} vs {ws}");
+    }
+}

@@ -1,0 +1,324 @@
+//! What the outside-engine protocol costs per run, against the engine's own
+//! stepping: the 10 s paper push (`scenarios/paper-square-v1.0.toml`, five
+//! 2 s segments) at dt = 1e-3 (10 000 steps, 10 001 rows) on the reference
+//! adapter `adapters/python/pure_python.py` (semi-implicit Euler).
+//!
+//! `cargo bench --bench outside_overhead` (add `-- --quick` for fewer
+//! repeats). Writes `results/outside_overhead.csv` (one row per quantity:
+//! median and min over the repeats, in seconds, and a note), then runs the
+//! in-process parts under criterion.
+//!
+//! Measured, each the median wall time of `runs` repeats:
+//!
+//! * `document`: building the pushval-problem/1 document and serialising it
+//!   (pushval's side of the input);
+//! * `parse_resample`: reading the adapter's CSV, checking it and resampling
+//!   it onto the problem's samples (pushval's side of the output);
+//! * `spawn_*`: starting the interpreter, writing the document to its
+//!   standard input and reading it back to end of file, nothing else
+//!   (`python3 -c "import sys; sys.stdin.buffer.read()"`), for the command
+//!   as `pushval.toml` names it (`python3` found on PATH: on this machine a
+//!   pyenv shim, a bash script that runs `pyenv exec`), for the interpreter
+//!   the shim resolves to, and for that interpreter with `-S` (no `site`
+//!   import: what the interpreter's own start costs without the `.pth` files
+//!   of its site-packages);
+//! * `adapter_stepping`: the adapter's own time stepping the problem, as it
+//!   reports it (`--timing`: `time.perf_counter` around its loop);
+//! * `adapter_process`: the whole process as pushval's runner sees it
+//!   (start to exit, the document in and the CSV out), with `python3` from
+//!   PATH and with the resolved interpreter;
+//! * `engine_run`: `Engine::run` of the outside engine (the process plus
+//!   pushval's document, parse and resample), with `python3` from PATH.
+//!
+//! The protocol's overhead per run is `engine_run − adapter_stepping`; the
+//! rows `overhead_*` give it and `overhead_share_*` its share of the run.
+//! (`spawn_venv`: the virtual environment of `scripts/setup-adapters.sh`,
+//! when it exists.)
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use criterion::Criterion;
+use pushval_engine::{trajectory_from_steps, Engine, EngineOptions};
+use pushval_model::Problem;
+use pushval_outside::{
+    csv, history_from_rows, problem_document, run_process, Config, OutsideEngine, Spec,
+};
+use pushval_scenario::Scenario;
+
+const DT: f64 = 1e-3;
+const TIMEOUT: Duration = Duration::from_secs(300);
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn median(mut v: Vec<f64>) -> (f64, f64) {
+    v.sort_by(f64::total_cmp);
+    (v[v.len() / 2], v[0])
+}
+
+fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, f64) {
+    let mut t = Vec::with_capacity(runs);
+    for _ in 0..runs {
+        let s = Instant::now();
+        std::hint::black_box(f());
+        t.push(s.elapsed().as_secs_f64());
+    }
+    median(t)
+}
+
+/// The `pure_python` engine of a `pushval.toml` whose command starts with
+/// `python`.
+fn spec(python: &str) -> Arc<Spec> {
+    let text = format!(
+        "[engine.pure_python]\ncommand = [{python:?}, \"adapters/python/pure_python.py\"]\norder = 1\n"
+    );
+    let cfg = Config::from_toml(&text, &root().join("pushval.toml")).expect("a valid engines file");
+    Arc::new(cfg.engines.into_iter().next().expect("one engine"))
+}
+
+/// The interpreter `python3` on PATH runs (through a shim or not).
+fn resolved_python() -> String {
+    let o = Command::new("python3")
+        .args(["-c", "import sys; print(sys.executable)"])
+        .output()
+        .expect("python3 on PATH");
+    String::from_utf8(o.stdout).unwrap().trim().to_string()
+}
+
+fn which(cmd: &str) -> String {
+    std::env::var_os("PATH")
+        .and_then(|paths| {
+            std::env::split_paths(&paths)
+                .map(|p| p.join(cmd))
+                .find(|p| p.is_file())
+        })
+        .map_or_else(
+            || format!("{cmd} (not on PATH)"),
+            |p| p.display().to_string(),
+        )
+}
+
+fn process(program: &str, args: &[&str], input: &[u8]) -> pushval_outside::ProcessOutput {
+    let args: Vec<String> = args.iter().map(|a| a.to_string()).collect();
+    let out = run_process(Path::new(program), &args, &root(), input, TIMEOUT)
+        .unwrap_or_else(|e| panic!("{program}: {}", e.what));
+    assert!(
+        out.status.success(),
+        "{program} {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// One row of the results file: quantity, median, min, unit, note.
+type Row = (String, f64, f64, &'static str, String);
+
+fn put(rows: &mut Vec<Row>, name: &str, (med, min): (f64, f64), note: String) {
+    eprintln!("{name:>32}: median {med:.4} s, min {min:.4} s");
+    rows.push((name.to_string(), med, min, "s", note));
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let runs = if quick { 3 } else { 11 };
+    let sc = Scenario::from_path(root().join("scenarios/paper-square-v1.0.toml")).unwrap();
+    let problem: Problem = sc.problem();
+    let options: EngineOptions = sc.engine.clone();
+    let py = resolved_python();
+    let input =
+        serde_json::to_vec(&problem_document("pure_python", &problem, &options, DT)).unwrap();
+    let adapter = "adapters/python/pure_python.py";
+
+    let mut rows: Vec<Row> = Vec::new();
+
+    // pushval's own work on each side of the process.
+    put(
+        &mut rows,
+        "document",
+        time(runs * 10, || {
+            serde_json::to_vec(&problem_document("pure_python", &problem, &options, DT)).unwrap()
+        }),
+        format!(
+            "problem_document + serde_json::to_vec ({} bytes)",
+            input.len()
+        ),
+    );
+    let sample = process(&py, &[adapter], &input);
+    let text = String::from_utf8(sample.stdout.clone()).unwrap();
+    let n_rows = text.lines().count() - 1;
+    put(
+        &mut rows,
+        "parse_resample",
+        time(runs * 10, || {
+            let recs = csv::read(&text, &[], &["t", "x", "y", "theta", "omega"]).unwrap();
+            let history = history_from_rows(&problem, &recs).unwrap();
+            trajectory_from_steps("pure_python", &problem, &history)
+        }),
+        format!(
+            "csv::read + history_from_rows + trajectory_from_steps ({n_rows} rows, {} bytes)",
+            text.len()
+        ),
+    );
+
+    // Starting the interpreter and the pipes, nothing else.
+    let echo = ["-c", "import sys; sys.stdin.buffer.read()"];
+    put(
+        &mut rows,
+        "spawn_python3_on_path",
+        time(runs, || process("python3", &echo, &input)),
+        format!(
+            "`python3` as pushval.toml names it, found at {}",
+            which("python3")
+        ),
+    );
+    put(
+        &mut rows,
+        "spawn_resolved_interpreter",
+        time(runs, || process(&py, &echo, &input)),
+        format!("{py} (what `python3` on PATH runs)"),
+    );
+    let echo_s = ["-S", "-c", "import sys; sys.stdin.buffer.read()"];
+    put(
+        &mut rows,
+        "spawn_resolved_no_site",
+        time(runs, || process(&py, &echo_s, &input)),
+        format!("{py} -S (no site import, no .pth files)"),
+    );
+    let venv = root().join(".venv-adapters/bin/python");
+    if venv.exists() {
+        let v = venv.display().to_string();
+        put(
+        &mut rows,
+            "spawn_venv",
+            time(runs, || process(&v, &echo, &input)),
+            ".venv-adapters/bin/python (scripts/setup-adapters.sh; the other adapters' interpreter)"
+                .into(),
+        );
+    } else {
+        eprintln!(
+            "outside_overhead: no .venv-adapters (scripts/setup-adapters.sh): row spawn_venv not measured"
+        );
+    }
+
+    // The adapter: its own stepping, the whole process.
+    let mut stepping = Vec::new();
+    let mut whole = Vec::new();
+    for _ in 0..runs {
+        let out = process(&py, &[adapter, "--timing"], &input);
+        whole.push(out.elapsed.as_secs_f64());
+        let err = String::from_utf8_lossy(&out.stderr);
+        let t: f64 = err
+            .split_whitespace()
+            .find_map(|w| w.strip_prefix("step_time_s=").and_then(|n| n.parse().ok()))
+            .unwrap_or_else(|| panic!("no stepping time in the adapter's stderr: {err}"));
+        stepping.push(t);
+    }
+    let stepping = median(stepping);
+    put(
+        &mut rows,
+        "adapter_stepping",
+        stepping,
+        format!(
+            "pure_python.py --timing: its step loop alone ({} steps)",
+            n_rows - 1
+        ),
+    );
+    put(
+        &mut rows,
+        "adapter_process_resolved",
+        median(whole),
+        format!("{py} {adapter}: start to exit, document in, CSV out"),
+    );
+    put(
+        &mut rows,
+        "adapter_process_python3_on_path",
+        time(runs, || process("python3", &[adapter], &input)),
+        "python3 (PATH) adapters/python/pure_python.py: start to exit".into(),
+    );
+
+    // Through the Engine trait, as the harness runs it.
+    let engine = OutsideEngine::new(spec("python3"), &options);
+    let run = time(runs, || engine.run(&problem, DT).unwrap());
+    put(
+        &mut rows,
+        "engine_run_python3_on_path",
+        run,
+        "OutsideEngine::run (command python3 from PATH): document, process, parse, resample".into(),
+    );
+    let engine_r = OutsideEngine::new(spec(&py), &options);
+    let run_r = time(runs, || engine_r.run(&problem, DT).unwrap());
+    put(
+        &mut rows,
+        "engine_run_resolved",
+        run_r,
+        format!("OutsideEngine::run (command {py})"),
+    );
+    // The adapter's own input and output (imports, json.load, writing the
+    // rows), by difference.
+    let med = |name: &str| {
+        rows.iter()
+            .find(|r| r.0 == name)
+            .map(|r| (r.1, r.2))
+            .unwrap()
+    };
+    let (proc_r, spawn_r) = (
+        med("adapter_process_resolved"),
+        med("spawn_resolved_interpreter"),
+    );
+    put(
+        &mut rows,
+        "adapter_io_resolved",
+        (proc_r.0 - spawn_r.0 - stepping.0, proc_r.1 - spawn_r.1 - stepping.1),
+        "adapter_process_resolved − spawn_resolved_interpreter − adapter_stepping: the adapter's imports, json.load and CSV writing".into(),
+    );
+    for (label, r) in [("python3_on_path", run), ("resolved", run_r)] {
+        let over = r.0 - stepping.0;
+        put(
+            &mut rows,
+            &format!("overhead_{label}"),
+            (over, r.1 - stepping.1),
+            format!("engine_run_{label} − adapter_stepping (median − median, min − min)"),
+        );
+        rows.push((
+            format!("overhead_share_{label}"),
+            over / r.0,
+            (r.1 - stepping.1) / r.1,
+            "fraction",
+            format!("overhead_{label} / engine_run_{label} (of the medians, of the mins)"),
+        ));
+    }
+
+    let mut csv_text = String::from("quantity,median,min,unit,note\n");
+    for (name, med, min, unit, note) in &rows {
+        csv_text.push_str(&format!(
+            "{name},{med:.6},{min:.6},{unit},\"{}\"\n",
+            note.replace('"', "'")
+        ));
+    }
+    let path = root().join("results/outside_overhead.csv");
+    let tmp = path.with_extension("csv.tmp");
+    std::fs::write(&tmp, csv_text).unwrap();
+    std::fs::rename(&tmp, &path).unwrap();
+    eprintln!("wrote {}", path.display());
+
+    // The in-process parts under criterion (its own statistics and report).
+    let mut c = Criterion::default()
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(if quick { 1 } else { 3 }))
+        .configure_from_args();
+    c.bench_function("outside/document", |b| {
+        b.iter(|| serde_json::to_vec(&problem_document("pure_python", &problem, &options, DT)))
+    });
+    c.bench_function("outside/parse_resample", |b| {
+        b.iter(|| {
+            let recs = csv::read(&text, &[], &["t", "x", "y", "theta", "omega"]).unwrap();
+            let history = history_from_rows(&problem, &recs).unwrap();
+            trajectory_from_steps("pure_python", &problem, &history)
+        })
+    });
+    c.final_summary();
+}
