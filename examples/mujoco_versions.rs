@@ -58,8 +58,8 @@ fn main() -> anyhow::Result<()> {
         let old = build(&format!("mujoco_{cone}"))?;
         let new = build(&format!("mujoco4_{cone}"))?;
         for &speed in &TABLE_SPEEDS {
-            let problem = plate::paper_plate(speed, PHI_TABLE, DURATION);
-            let coulomb = plate::coulomb_star(&problem.body, &problem.pushes[0]);
+            let problem = plate::paper_plate(speed, PHI_TABLE, DURATION, None);
+            let coulomb = coulomb_star(&problem.body, &problem.pushes[0]);
             eprintln!("mujoco_versions: {cone}, v_c = {speed} m/s");
             let a = old
                 .run(&problem, DT)
@@ -83,8 +83,8 @@ fn main() -> anyhow::Result<()> {
                 new.version(),
                 wb - wa,
                 (wb - wa) / wa.abs().max(1e-3 * speed / plate::length()),
-                plate::rel(wa, coulomb),
-                plate::rel(wb, coulomb),
+                rel(wa, coulomb),
+                rel(wb, coulomb),
                 sa.last().unwrap().theta,
                 sb.last().unwrap().theta,
             )?;
@@ -96,4 +96,16 @@ fn main() -> anyhow::Result<()> {
     std::fs::rename(&tmp, out).with_context(|| format!("renaming to {}", out.display()))?;
     eprintln!("{csv}");
     Ok(())
+}
+
+/// The Coulomb model's steady ω (rad/s) reached from ω = 0.
+fn coulomb_star(body: &pushval_model::Body, push: &pushval_model::Push) -> f64 {
+    let seg = pushval_model::SegmentDynamics::new(body, push);
+    let roots = seg.steady_states();
+    seg.attractor(&roots, 0.0).map_or(f64::NAN, |s| s.omega)
+}
+
+/// `|a − b| / |b|`.
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
 }
