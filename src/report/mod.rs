@@ -297,7 +297,14 @@ fn readme(entries: &[Entry], quick: bool) -> String {
          (the engine, f64, dt = 1 ms, {} friction velocity). Fr = v_c²/(μ̄ g L) with\n\
          L = |p_c − p_cm| the contact's distance from the centre of mass.\n",
     )
-    .replace("{}", pushval_rapier2d::FrictionVelocity::default().as_str());
+    .replace(
+        "{}",
+        // The engine's own record of its default mode, through the registry.
+        crate::registry::engine("rapier2d", &Default::default()).settings(1e-3)
+            ["friction_velocity"]
+            .as_str()
+            .unwrap_or("default"),
+    );
     if quick {
         s.push_str("\n**Quick run: reduced sweep grids (for tests).**\n");
     }
