@@ -118,6 +118,9 @@ pub struct Panel {
     pub y: Axis,
     pub series: Vec<Series>,
     pub cells: Vec<Cell>,
+    /// Rectangles drawn as outlines (2 px, in their `color`) over the cells:
+    /// a map's cells of some class.
+    pub outlines: Vec<Cell>,
     /// Texts drawn over the cells (a heat map's per-cell marks).
     pub marks: Vec<Mark>,
     pub legend: Legend,
@@ -133,6 +136,7 @@ impl Panel {
             y,
             series: Vec::new(),
             cells: Vec::new(),
+            outlines: Vec::new(),
             marks: Vec::new(),
             legend: Legend::UpperRight,
             equal_aspect: false,
@@ -488,6 +492,15 @@ where
                 p.cells
                     .iter()
                     .map(|c| Rectangle::new([(c.x.0, c.y.0), (c.x.1, c.y.1)], c.color.filled())),
+            )
+            .map_err(err)?;
+    }
+    if !p.outlines.is_empty() {
+        chart
+            .draw_series(
+                p.outlines.iter().map(|c| {
+                    Rectangle::new([(c.x.0, c.y.0), (c.x.1, c.y.1)], c.color.stroke_width(2))
+                }),
             )
             .map_err(err)?;
     }

@@ -9,7 +9,8 @@
 //! * `paper_plate.csv`: the steady ω at v_c 0.2, 0.5, 1 m/s, φ = π/4 + 0.3,
 //!   against the Coulomb model's ω* and the law's;
 //! * `map.csv`: the same over a 20 × 20 (Fr, φ) grid (5 × 5 `--quick`), with
-//!   the law's class of each cell (`turns`, `locked`, `semi_stable`);
+//!   the law's class of each cell (`turns`, `locked`, `semi_stable`), and
+//!   `map.svg` drawn from it alone ([`figure`]; `study index` redraws it);
 //! * `dt_ladder.csv`: the steady ω at 0.5 m/s over a ladder of steps, its
 //!   observed order and the Richardson extrapolation at the declared order;
 //! * `creep.csv`, where the law locks at a table push: the same ladder
@@ -30,6 +31,7 @@
 //! array's variables; `--merge` rebuilds exactly the single run's files
 //! ([`crate::report::shard`]).
 
+pub mod figure;
 pub mod fit;
 pub mod plate;
 pub mod readme;

@@ -110,6 +110,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     w.file("paper_plate.csv", paper.as_bytes())?;
     let map = map_csv(plan, tasks, rows, 0);
     w.file("map.csv", map.as_bytes())?;
+    w.figure("map.svg", &super::figure::map_figure(&plan.model, &map)?)?;
 
     // The step ladder: change from the next coarser step, the observed
     // order from three steps, Richardson at the declared order.
@@ -325,6 +326,9 @@ fn readme(
             st[5],
             st[6]
         );
+        if name.is_empty() {
+            s.push_str("\nFigure: [`map.svg`](map.svg), drawn from `map.csv`: the error against Coulomb and against the law by decade; the law's locked cells outlined.\n");
+        }
     };
     map_section("", "map.csv", map);
     for (n, t) in variant_maps {
@@ -418,6 +422,11 @@ pub fn index(root: &Path, models: &[String], quick: bool, w: &mut Writer) -> any
         let Some(r) = rows.iter().find(|r| num(r, "speed") == 0.5) else {
             continue;
         };
+        // The model's figure, redrawn from its map.csv (no engine run).
+        w.figure(
+            &format!("{m}/map.svg"),
+            &super::figure::map_figure(m, &map)?,
+        )?;
         let st = map_stats(&parse(&map));
         let _ = writeln!(
             s,

@@ -358,3 +358,85 @@ fn bad_names_and_study_files_exit_2() {
     assert!(err.contains("box2d.toml") && err.contains("t_run"), "{err}");
     assert!(!dir.path().join("README.md").exists(), "nothing written");
 }
+
+/// The `rect` elements of an SVG as (x, fill, stroke), after checking the
+/// text is well-formed XML whose root is `svg`; and the root's width (px).
+fn svg_rects(text: &str) -> (f64, Vec<(f64, String, String)>) {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_str(text);
+    let (mut width, mut rects, mut root) = (f64::NAN, Vec::new(), None);
+    loop {
+        match reader.read_event().expect("map.svg is well-formed XML") {
+            Event::Start(e) | Event::Empty(e) => {
+                let name = String::from_utf8_lossy(e.name().as_ref()).to_string();
+                let attr = |k: &str| {
+                    e.attributes()
+                        .flatten()
+                        .find(|a| a.key.as_ref() == k.as_bytes())
+                        .map(|a| String::from_utf8_lossy(&a.value).to_string())
+                        .unwrap_or_default()
+                };
+                if root.is_none() {
+                    width = attr("width").parse().unwrap_or(f64::NAN);
+                    root = Some(name.clone());
+                }
+                if name == "rect" {
+                    rects.push((attr("x").parse().unwrap(), attr("fill"), attr("stroke")));
+                }
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    assert_eq!(root.as_deref(), Some("svg"), "the root element is svg");
+    (width, rects)
+}
+
+#[test]
+fn map_svg_has_one_cell_per_map_row() {
+    // map.svg: the Coulomb panel (left half of the plot area, the key is the
+    // right-most 230 px) fills one cell per map.csv row; the law panel one
+    // per row with an omega_law; locked or semi-stable cells are outlined.
+    for m in ["rapier2d", "rapier2d_impulse_box", "box2d_motor_joint"] {
+        if !available(m) {
+            continue;
+        }
+        let dir = quick_dir().join(m);
+        let rows = map(m);
+        let text = std::fs::read_to_string(dir.join("map.svg")).unwrap();
+        let (width, rects) = svg_rects(&text);
+        let main = width - 230.0;
+        let filled = |lo: f64, hi: f64| {
+            rects
+                .iter()
+                .filter(|(x, fill, stroke)| {
+                    *x >= lo && *x < hi && stroke == "none" && fill != "#FFFFFF"
+                })
+                .count()
+        };
+        let law = rows
+            .iter()
+            .filter(|r| val(r, "omega_law").is_finite())
+            .count();
+        assert_eq!(filled(0.0, main / 2.0), rows.len(), "{m}: Coulomb panel");
+        assert_eq!(filled(main / 2.0, main), law, "{m}: law panel");
+        let marked = rows
+            .iter()
+            .filter(|r| r["class"] != "turns" && !r["class"].is_empty())
+            .count();
+        let outlines = rects
+            .iter()
+            .filter(|(x, fill, _)| *x < main && fill == "none")
+            .count();
+        // Two panels, plus each panel's plot-area frame at most.
+        assert!(
+            (2 * marked..=2 * marked + 2).contains(&outlines),
+            "{m}: {outlines} outlines for {marked} locked or semi-stable cells"
+        );
+        let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+        assert!(
+            readme.contains("[`map.svg`](map.svg)"),
+            "{m}: README links map.svg"
+        );
+    }
+}

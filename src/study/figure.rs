@@ -1,0 +1,130 @@
+//! `map.svg`: a model's (Fr, φ) map drawn from its `map.csv` text alone
+//! (so `pushval study index` redraws it without running the engine). Two
+//! panels: the engine's error against Coulomb and against its own law, one
+//! coloured cell per row, by decade of the error; cells where the law locks
+//! are outlined black, semi-stable ones purple.
+
+use plotters::style::RGBColor;
+
+use super::err;
+use super::plate::froude;
+use super::readme::{num, parse};
+use crate::report::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, PURPLE};
+
+/// The error classes' lower bounds (dimensionless): class k is
+/// `BOUNDS[k-1] ≤ error < BOUNDS[k]`.
+pub const BOUNDS: [f64; 4] = [1e-4, 1e-3, 1e-2, 1e-1];
+
+const COLORS: [RGBColor; 5] = [
+    RGBColor(26, 152, 80),
+    RGBColor(166, 217, 106),
+    RGBColor(255, 237, 160),
+    RGBColor(253, 174, 97),
+    RGBColor(215, 48, 39),
+];
+
+/// The class of an error: the number of bounds it reaches (NaN stays NaN,
+/// drawn grey).
+fn class(e: f64) -> f64 {
+    if e.is_nan() {
+        f64::NAN
+    } else {
+        BOUNDS.iter().filter(|&&b| e >= b).count() as f64
+    }
+}
+
+/// Sorted distinct values.
+fn grid(mut v: Vec<f64>) -> Vec<f64> {
+    v.retain(|x| x.is_finite());
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+/// The figure of `map.csv`'s text (columns froude, phi, omega_engine,
+/// omega_coulomb, omega_law, class). Errors as in the README: relative with
+/// the gate's floor, or |ω|/|ω*| where the reference is a lock.
+pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
+    let rows = parse(csv);
+    anyhow::ensure!(!rows.is_empty(), "map.csv of {model} has no rows");
+    let frs = grid(rows.iter().map(|r| num(r, "froude")).collect());
+    let phis = grid(rows.iter().map(|r| num(r, "phi")).collect());
+    let (fe, pe) = (cell_edges(&frs, true), cell_edges(&phis, false));
+    let at = |v: f64, g: &[f64], e: &[(f64, f64)]| g.iter().position(|&x| x == v).map(|i| e[i]);
+    let (mut coulomb, mut law, mut outlines) = (Vec::new(), Vec::new(), Vec::new());
+    for r in &rows {
+        let (Some(x), Some(y)) = (
+            at(num(r, "froude"), &frs, &fe),
+            at(num(r, "phi"), &phis, &pe),
+        ) else {
+            anyhow::bail!("map.csv of {model}: a row without froude or phi");
+        };
+        let (we, wc, wl) = (
+            num(r, "omega_engine"),
+            num(r, "omega_coulomb"),
+            num(r, "omega_law"),
+        );
+        let speed = (num(r, "froude") / froude(1.0)).sqrt();
+        let cell = |value| MapCell {
+            x,
+            y,
+            value,
+            mark: String::new(),
+        };
+        coulomb.push(cell(class(err(we, wc, wc, speed))));
+        if wl.is_finite() {
+            law.push(cell(class(err(we, wl, wc, speed))));
+        }
+        let color = match r.get("class").map(String::as_str) {
+            Some("locked") => Some(DARK),
+            Some("semi_stable") => Some(PURPLE),
+            _ => None,
+        };
+        if let Some(color) = color {
+            outlines.push(Cell { x, y, color });
+        }
+    }
+    let scale = Scale::Classes(COLORS.to_vec());
+    let (xr, yr) = ((fe[0].0, fe[fe.len() - 1].1), (pe[0].0, pe[pe.len() - 1].1));
+    let axes = || {
+        (
+            Axis::log("Froude number Fr = v_c² / (μ̄ g L)").range(xr.0, xr.1),
+            Axis::lin("push direction φ (rad)").range(yr.0, yr.1),
+        )
+    };
+    let (x, y) = axes();
+    let mut left = heat_map(
+        format!("{model}: error against Coulomb"),
+        x,
+        y,
+        &coulomb,
+        &scale,
+    );
+    let (x, y) = axes();
+    let title = if law.is_empty() {
+        format!("{model}: no law declared")
+    } else {
+        format!("{model}: error against its law")
+    };
+    let mut right = heat_map(title, x, y, &law, &scale);
+    left.outlines.clone_from(&outlines);
+    right.outlines = outlines;
+    let labels = [
+        "< 1e-4",
+        "1e-4 – 1e-3",
+        "1e-3 – 1e-2",
+        "1e-2 – 1e-1",
+        "≥ 1e-1",
+    ];
+    let notes = [
+        "black edge: law locks".to_string(),
+        "purple edge: semi-stable".to_string(),
+        "grey: undefined".to_string(),
+    ];
+    Ok(Figure {
+        size: (1500, 640),
+        cols: 2,
+        panels: vec![left, right],
+        key: Some(scale.key("error", &labels, &notes)),
+    })
+}
