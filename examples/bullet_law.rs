@@ -69,7 +69,7 @@ fn main() -> anyhow::Result<()> {
         let problem = plate::paper_plate(speed, PHI_TABLE, DURATION, None);
         let body = &problem.body;
         let push = &problem.pushes[0];
-        let coulomb = coulomb_star(body, push);
+        let coulomb = pushval_engine::coulomb_steady(&problem, 0).unwrap_or(f64::NAN);
         eprintln!("bullet_law: pybullet_contact at v_c = {speed} m/s");
         let run = engine
             .run(&problem, DT)
@@ -166,13 +166,6 @@ fn main() -> anyhow::Result<()> {
     write(&out.join("bullet_contact_summary.csv"), &summary)?;
     eprintln!("{summary}");
     Ok(())
-}
-
-/// The Coulomb model's steady ω (rad/s) reached from ω = 0.
-fn coulomb_star(body: &pushval_model::Body, push: &pushval_model::Push) -> f64 {
-    let seg = pushval_model::SegmentDynamics::new(body, push);
-    let roots = seg.steady_states();
-    seg.attractor(&roots, 0.0).map_or(f64::NAN, |s| s.omega)
 }
 
 /// `|a − b| / |b|`.

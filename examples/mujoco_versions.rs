@@ -59,7 +59,7 @@ fn main() -> anyhow::Result<()> {
         let new = build(&format!("mujoco4_{cone}"))?;
         for &speed in &TABLE_SPEEDS {
             let problem = plate::paper_plate(speed, PHI_TABLE, DURATION, None);
-            let coulomb = coulomb_star(&problem.body, &problem.pushes[0]);
+            let coulomb = pushval_engine::coulomb_steady(&problem, 0).unwrap_or(f64::NAN);
             eprintln!("mujoco_versions: {cone}, v_c = {speed} m/s");
             let a = old
                 .run(&problem, DT)
@@ -96,13 +96,6 @@ fn main() -> anyhow::Result<()> {
     std::fs::rename(&tmp, out).with_context(|| format!("renaming to {}", out.display()))?;
     eprintln!("{csv}");
     Ok(())
-}
-
-/// The Coulomb model's steady ω (rad/s) reached from ω = 0.
-fn coulomb_star(body: &pushval_model::Body, push: &pushval_model::Push) -> f64 {
-    let seg = pushval_model::SegmentDynamics::new(body, push);
-    let roots = seg.steady_states();
-    seg.attractor(&roots, 0.0).map_or(f64::NAN, |s| s.omega)
 }
 
 /// `|a − b| / |b|`.

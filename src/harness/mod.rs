@@ -157,10 +157,19 @@ pub struct Convergence {
 impl Convergence {
     /// Median observed order over the settled segments.
     pub fn order(&self) -> Option<f64> {
+        self.order_resolved(0.0)
+    }
+
+    /// Median observed order over the settled segments whose
+    /// `|ω(2h) − ω(h)|` (relative, [`Convergence::diff_rel`]) is at least
+    /// `floor`.
+    pub fn order_resolved(&self, floor: f64) -> Option<f64> {
         let mut o: Vec<f64> = self
             .orders
             .iter()
-            .map(|p| p.1)
+            .enumerate()
+            .filter(|(i, _)| self.diff_rel.get(*i).is_none_or(|d| d.1 >= floor))
+            .map(|(_, p)| p.1)
             .filter(|p| p.is_finite())
             .collect();
         o.sort_by(f64::total_cmp);

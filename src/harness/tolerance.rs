@@ -240,15 +240,7 @@ pub fn order_problem(res: &Resolved, conv: &super::Convergence) -> Option<String
     // Only segments whose ω(2h) − ω(h) is resolved: below the auto target
     // the auto tolerance sits on its floor whatever the order, and the
     // ratio of two differences at the tail mean's noise level is no order.
-    let mut o: Vec<f64> = conv
-        .orders
-        .iter()
-        .zip(&conv.diff_rel)
-        .filter(|(p, d)| p.1.is_finite() && d.1 >= AUTO_TARGET.omega_steady_rel)
-        .map(|(p, _)| p.1)
-        .collect();
-    o.sort_by(f64::total_cmp);
-    let observed = *o.get(o.len() / 2)?;
+    let observed = conv.order_resolved(AUTO_TARGET.omega_steady_rel)?;
     let declared = conv.expected_order;
     (!((observed - declared).abs() <= ORDER_BAND)).then(|| {
         format!(

@@ -321,10 +321,6 @@ pub fn stream(
     let origin = sc.center_of_mass;
     let head = header(params);
     writeln!(csv, "{head}")?;
-    if let Some(e) = echo.as_mut() {
-        writeln!(e, "{head}")?;
-        e.flush()?;
-    }
     let mut buf = String::new();
     let mut lineno = 0usize;
     let mut cols: Option<Columns> = None;
@@ -352,6 +348,11 @@ pub fn stream(
         }
         let Some(c) = &cols else {
             cols = Some(Columns::parse(text, src)?);
+            // The input's header is good: the estimate's header goes out.
+            if let Some(e) = echo.as_mut() {
+                writeln!(e, "{head}")?;
+                e.flush()?;
+            }
             continue;
         };
         let f: Vec<&str> = text.split(',').map(str::trim).collect();
