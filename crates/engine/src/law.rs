@@ -77,6 +77,14 @@ pub trait FrictionLaw: Send + Sync {
     /// a run at time step `dt` (s; laws whose caps scale with the step read
     /// it), or None where the law has no steady state there.
     fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady>;
+    /// The normal load of each support (N, in the problem's support order)
+    /// the law predicts in the steady state of segment `segment`, for laws
+    /// under which the push moves load between the supports (a raised
+    /// centre of mass or pusher, sticking rows that hold a rest moment).
+    /// None by default: the problem's own loads.
+    fn loads(&self, _problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        None
+    }
 }
 
 /// Coulomb friction at every support: the analytic model's own law.

@@ -43,8 +43,22 @@ pub struct EngineRun {
     /// Wall-clock time of the run (set-up, stepping and sampling).
     pub wall_time: Duration,
     /// Engine-specific diagnostics for the outputs (joint drift, tilt, loads,
-    /// …); an object, possibly empty.
+    /// …); an object, possibly empty. One key is shared: an engine whose
+    /// supports carry measured normal loads writes `"loads"`, an array with
+    /// each support's load (N, in the problem's support order) averaged over
+    /// the last fifth of the run ([`tail_loads`] reads it).
     pub diagnostics: serde_json::Value,
+}
+
+/// The measured support loads of a run (N): its diagnostics' `"loads"`
+/// array, or None where the engine reports none.
+pub fn tail_loads(run: &EngineRun) -> Option<Vec<f64>> {
+    run.diagnostics
+        .get("loads")?
+        .as_array()?
+        .iter()
+        .map(|v| v.as_f64())
+        .collect()
 }
 
 /// The crate that provides an engine, as locked in `Cargo.lock`.
