@@ -17,6 +17,11 @@
 //!   there, to show whether the engine's creep shrinks with the step;
 //! * `variants.csv` and `map_NAME.csv`: the tables (and maps) of the
 //!   study file's variants (other `[engine]` options or supports);
+//! * `sweep_NAME.csv`: one quantity of the runs (speed, φ, the start θ, the
+//!   step or an `[engine]` option) over the study file's list, with the
+//!   supports' loads as the engine measures them and as the law predicts;
+//! * `rest_moments.csv`, where the law holds a map cell from one side: the
+//!   rest moments M₀, H and S of every map cell;
 //! * `coulomb_fit.csv`: the Coulomb model fitted to the engine ([`fit`]);
 //! * `README.md`, written from those files' data ([`readme`]).
 //!
@@ -41,7 +46,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
-use pushval_engine::{rel_err, tail_mean_omega, Engine, EngineOptions, LawClass};
+use pushval_engine::{rel_err, tail_loads, tail_mean_omega, Engine, EngineOptions, LawClass};
+use pushval_model::Problem;
 
 use crate::report::shard::{grid_hash, grid_name, Parts, Shard};
 use crate::report::{par_rows, Writer};
@@ -108,11 +114,49 @@ pub enum Task {
     Map { s: usize, i: usize, j: usize },
     /// The Coulomb fit on schedule `k`.
     Fit { k: usize },
+    /// Sweep `w` at its `values[i]` and `speeds[v]`.
+    Sweep { w: usize, i: usize, v: usize },
 }
 
+/// Supports whose loads a row carries (the plate's four).
+pub const LOADS: usize = 4;
+
 /// Values of a run's row: ω of the engine, of Coulomb and of the law
-/// (rad/s), the law's class code ([`class_code`]) and its rest moments.
-pub const RUN_WIDTH: usize = 7;
+/// (rad/s), the law's class code ([`class_code`]) and its rest moments,
+/// then [`LOADS`] support loads measured by the engine and as many
+/// predicted by the law (N; NaN where unknown).
+pub const RUN_WIDTH: usize = 7 + 2 * LOADS;
+
+/// A sweep of the study file, ready to run.
+pub struct SweepPlan {
+    pub spec: spec::Sweep,
+    /// One engine per value for an `[engine]` key sweep, else one.
+    pub engines: Vec<Box<dyn Engine>>,
+    /// Pusher speeds (m/s).
+    pub speeds: Vec<f64>,
+    pub phi: f64,
+    pub dt: f64,
+    pub t_run: f64,
+    pub tail: f64,
+}
+
+impl SweepPlan {
+    /// Speed (m/s), direction (rad), step (s), start θ (rad) and engine of
+    /// value `i` at speed `v`.
+    fn push(&self, i: usize, v: usize) -> (f64, f64, f64, f64, &dyn Engine) {
+        let x = self.spec.values[i];
+        let mut p = (self.speeds[v], self.phi, self.dt, 0.0);
+        match self.spec.over.as_str() {
+            "speed" => p.0 = x,
+            "phi" => p.1 = x,
+            "dt" => p.2 = x,
+            "theta0" => p.3 = x,
+            _ => {}
+        }
+        let e = &self.engines[if self.engines.len() > 1 { i } else { 0 }];
+        (p.0, p.1, p.2, p.3, e.as_ref())
+    }
+}
 
 /// The code of a class in a row: 0 turns, 1 locked, 2 semi-stable; NaN none.
 pub fn class_code(c: Option<LawClass>) -> [f64; 4] {
@@ -147,6 +191,7 @@ pub struct Plan {
     /// Table speeds (indices) at which the law locks: the creep ladder's.
     pub creep: Vec<usize>,
     pub fit: bool,
+    pub sweeps: Vec<SweepPlan>,
 }
 
 fn build(model: &str, options: &EngineOptions) -> anyhow::Result<Box<dyn Engine>> {
@@ -206,10 +251,43 @@ impl Plan {
                 .is_some_and(|s| s.class != LawClass::Turns)
         };
         let creep = (0..TABLE_SPEEDS.len()).filter(|&v| law_locks(v)).collect();
+        let tail = spec.tail.unwrap_or(0.2);
+        let mut sweeps = Vec::new();
+        for (n, w) in spec.sweep.iter().enumerate() {
+            let engines = match w.key() {
+                Some(key) => {
+                    if !setups[0].engine.accepts_option(key) {
+                        bail!(
+                            "{}: key `sweep[{n}].over`: the model `{model}` reads no [engine] key `{key}` (it reads: {})",
+                            studies.join(format!("{model}.toml")).display(),
+                            setups[0].engine.option_keys().join(", ")
+                        );
+                    }
+                    let mut e = Vec::new();
+                    for x in &w.values {
+                        let mut o = w.engine.clone();
+                        o.insert(key.to_string(), (*x).into());
+                        e.push(build(model, &spec.options(&o))?);
+                    }
+                    e
+                }
+                None => vec![build(model, &spec.options(&w.engine))?],
+            };
+            sweeps.push(SweepPlan {
+                engines,
+                speeds: w.speeds.clone().unwrap_or(vec![0.5]),
+                phi: w.phi.unwrap_or(PHI_TABLE),
+                dt: w.dt.unwrap_or(dt),
+                t_run: w.t_run.unwrap_or(t_run),
+                tail: w.tail.unwrap_or(tail),
+                spec: w.clone(),
+            });
+        }
         Ok(Self {
             model: model.to_string(),
             ladder: spec.ladder(dt, quick),
-            tail: spec.tail.unwrap_or(0.2),
+            tail,
+            sweeps,
             fit: spec.fit.unwrap_or(true),
             spec,
             setups,
@@ -241,12 +319,31 @@ impl Plan {
             let n = if self.quick { 1 } else { fit::SCHEDULES.len() };
             t.extend((0..n).map(|k| Task::Fit { k }));
         }
+        for (w, sw) in self.sweeps.iter().enumerate() {
+            // A speed sweep sets the speed itself: one column of speeds.
+            let nv = if sw.spec.over == "speed" {
+                1
+            } else {
+                sw.speeds.len()
+            };
+            for i in 0..sw.spec.values.len() {
+                t.extend((0..nv).map(|v| Task::Sweep { w, i, v }));
+            }
+        }
         t
     }
 
     /// The task's key: what it computes, so its hash shard never moves.
     pub fn key(&self, t: &Task) -> String {
         let m = &self.model;
+        if let Task::Sweep { w, i, v } = *t {
+            let sw = &self.sweeps[w];
+            let (speed, phi, dt, theta0, _) = sw.push(i, v);
+            return format!(
+                "{m}/sweep/{}/{}={}/{:?}/v={speed}/phi={phi}/dt={dt}/theta0={theta0}/t={}/tail={}",
+                sw.spec.name, sw.spec.over, sw.spec.values[i], sw.spec.engine, sw.t_run, sw.tail
+            );
+        }
         let (speed, phi, dt, s) = self.push(t);
         match t {
             Task::Fit { k } => format!("{m}/fit/{}/{}", fit::SCHEDULES[*k], self.dt),
@@ -274,7 +371,7 @@ impl Plan {
                 let (fr, phi) = (frs(self.quick)[i], phis(self.quick)[j]);
                 (speed_of(fr), phi, self.setups[s].dt, s)
             }
-            Task::Fit { .. } => (f64::NAN, f64::NAN, self.dt, 0),
+            Task::Fit { .. } | Task::Sweep { .. } => (f64::NAN, f64::NAN, self.dt, 0),
         }
     }
 
@@ -285,20 +382,17 @@ impl Plan {
             return fit::fit_engine(self.setups[0].engine.as_ref(), k, self.dt)
                 .unwrap_or_else(|_| vec![f64::NAN; fit::WIDTH]);
         }
+        if let Task::Sweep { w, i, v } = *t {
+            let sw = &self.sweeps[w];
+            let (speed, phi, dt, theta0, engine) = sw.push(i, v);
+            let mut p = paper_plate(speed, phi, sw.t_run, None);
+            p.initial.theta = theta0;
+            return run_row(engine, &p, dt, sw.tail);
+        }
         let (speed, phi, dt, s) = self.push(t);
         let setup = &self.setups[s];
         let p = paper_plate(speed, phi, self.t_run, setup.supports_half);
-        let engine = setup
-            .engine
-            .run(&p, dt)
-            .ok()
-            .and_then(|r| tail_mean_omega(&p, &r.trajectory, self.tail)[0])
-            .unwrap_or(f64::NAN);
-        let coulomb = pushval_engine::coulomb_steady(&p, 0).unwrap_or(f64::NAN);
-        let law = setup.engine.law().and_then(|l| l.steady(&p, 0, dt));
-        let mut row = vec![engine, coulomb, law.map_or(f64::NAN, |l| l.omega)];
-        row.extend(class_code(law.map(|l| l.class)));
-        row
+        run_row(setup.engine.as_ref(), &p, dt, self.tail)
     }
 
     fn width(&self, t: &Task) -> usize {
@@ -307,6 +401,29 @@ impl Plan {
             _ => RUN_WIDTH,
         }
     }
+}
+
+/// A run's row ([`RUN_WIDTH`] values): the engine's tail-mean ω and loads,
+/// Coulomb's ω*, the law's ω, class and loads.
+fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
+    let run = engine.run(p, dt).ok();
+    let omega = run
+        .as_ref()
+        .and_then(|r| tail_mean_omega(p, &r.trajectory, tail)[0])
+        .unwrap_or(f64::NAN);
+    let coulomb = pushval_engine::coulomb_steady(p, 0).unwrap_or(f64::NAN);
+    let law = engine.law();
+    let steady = law.and_then(|l| l.steady(p, 0, dt));
+    let mut row = vec![omega, coulomb, steady.map_or(f64::NAN, |l| l.omega)];
+    row.extend(class_code(steady.map(|l| l.class)));
+    for loads in [
+        run.as_ref().and_then(tail_loads),
+        law.and_then(|l| l.loads(p, 0, dt)),
+    ] {
+        let loads = loads.unwrap_or_default();
+        row.extend((0..LOADS).map(|k| loads.get(k).copied().unwrap_or(f64::NAN)));
+    }
+    row
 }
 
 /// The engine against a reference ω: relative with the gate's floor

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::plate::{froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
-use super::{class_name, err, fit, opt, Plan, Task};
+use super::{class_name, err, fit, opt, Plan, Task, LOADS, RUN_WIDTH};
 use crate::report::Writer;
 
 /// One CSV's records, by column name.
@@ -231,7 +231,9 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     if plan.fit {
         w.file("coulomb_fit.csv", fits.as_bytes())?;
     }
-    let text = readme(
+    let mut more = sweeps(plan, tasks, rows, w)?;
+    more.push_str(&rest_moments(plan, tasks, rows, w)?);
+    let mut text = readme(
         plan,
         &paper,
         &map,
@@ -241,7 +243,149 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
         &variant_maps,
         &fits,
     );
+    text.push_str(&more);
     w.file("README.md", text.as_bytes())
+}
+
+/// Loads of a row, `n` engine then `n` law columns (blank where unknown).
+fn loads_cells(r: &[f64]) -> String {
+    r[7..RUN_WIDTH]
+        .iter()
+        .map(|v| opt(*v))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// `sweep_NAME.csv` of every sweep, and their README sections.
+fn sweeps(
+    plan: &Plan,
+    tasks: &[Task],
+    rows: &[Vec<f64>],
+    w: &mut Writer,
+) -> anyhow::Result<String> {
+    let mut md = String::new();
+    for (n, sw) in plan.sweeps.iter().enumerate() {
+        let sel: Vec<_> = tasks
+            .iter()
+            .zip(rows)
+            .filter(|(t, _)| matches!(t, Task::Sweep { w, .. } if *w == n))
+            .collect();
+        let has_loads = sel
+            .iter()
+            .any(|(_, r)| r[7..RUN_WIDTH].iter().any(|v| v.is_finite()));
+        let mut csv = String::from("value,speed,phi,dt,theta0,omega_engine,omega_coulomb,omega_law,class,err_vs_coulomb,err_vs_law");
+        if has_loads {
+            for who in ["engine", "law"] {
+                for k in 1..=LOADS {
+                    let _ = write!(csv, ",load_{who}_{k}");
+                }
+            }
+        }
+        csv.push('\n');
+        let name = &sw.spec.name;
+        let _ = write!(
+            md,
+            "\n## Sweep {name} (`sweep_{name}.csv`)\n\n`{}` over {:?}{}; {} s runs, ω the mean over the last {} %{}.\n\n\
+             | {} | v_c (m/s) | ω engine | ω* Coulomb | ω law | class | vs Coulomb | vs law |{}\n|---|---|---|---|---|---|---|---|{}\n",
+            sw.spec.over,
+            sw.spec.values,
+            if sw.spec.engine.is_empty() { String::new() } else { format!(", `[engine]` {:?}", sw.spec.engine) },
+            sw.t_run,
+            100.0 * sw.tail,
+            if has_loads { "; loads in N, supports in the problem's order" } else { "" },
+            sw.spec.over,
+            if has_loads { " loads engine | loads law |" } else { "" },
+            if has_loads { "---|---|" } else { "" },
+        );
+        for (t, r) in sel {
+            let Task::Sweep { i, v, .. } = *t else {
+                continue;
+            };
+            let (speed, phi, dt, theta0, _) = sw.push(i, v);
+            let (ec, el) = (err(r[0], r[1], r[1], speed), err(r[0], r[2], r[1], speed));
+            let _ = write!(
+                csv,
+                "{},{speed},{phi},{dt},{theta0},{},{},{},{}",
+                sw.spec.values[i],
+                run_line(r),
+                class_name(r[3]),
+                opt(ec),
+                opt(el)
+            );
+            let _ = write!(
+                md,
+                "| {} | {speed} | {} | {} | {} | {} | {} | {} |",
+                sw.spec.values[i],
+                sig(r[0]),
+                sig(r[1]),
+                sig(r[2]),
+                class_name(r[3]),
+                sig(ec),
+                sig(el)
+            );
+            if has_loads {
+                let _ = write!(csv, ",{}", loads_cells(r));
+                let fmt = |x: &[f64]| {
+                    x.iter()
+                        .map(|v| {
+                            if v.is_finite() {
+                                format!("{v:.3}")
+                            } else {
+                                "–".into()
+                            }
+                        })
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                };
+                let _ = write!(
+                    md,
+                    " {} | {} |",
+                    fmt(&r[7..7 + LOADS]),
+                    fmt(&r[7 + LOADS..RUN_WIDTH])
+                );
+            }
+            csv.push('\n');
+            md.push('\n');
+        }
+        w.file(&format!("sweep_{name}.csv"), csv.as_bytes())?;
+    }
+    Ok(md)
+}
+
+/// `rest_moments.csv`, where the law holds some map cell from one side:
+/// M₀, H and S (N m) of every cell of every map.
+fn rest_moments(
+    plan: &Plan,
+    tasks: &[Task],
+    rows: &[Vec<f64>],
+    w: &mut Writer,
+) -> anyhow::Result<String> {
+    let mut csv = String::from("variant,froude,phi,class,moment,lock,hold\n");
+    let mut semi = 0usize;
+    for (t, r) in tasks.iter().zip(rows) {
+        if let Task::Map { s, i, j } = *t {
+            let _ = writeln!(
+                csv,
+                "{},{},{},{},{},{},{}",
+                plan.setups[s].name,
+                frs(plan.quick)[i],
+                phis(plan.quick)[j],
+                class_name(r[3]),
+                opt(r[4]),
+                opt(r[5]),
+                opt(r[6])
+            );
+            semi += usize::from(r[4].is_finite());
+        }
+    }
+    if semi == 0 {
+        return Ok(String::new());
+    }
+    w.file("rest_moments.csv", csv.as_bytes())?;
+    Ok(format!(
+        "\n## Rest moments (`rest_moments.csv`)\n\nWhere the law holds ω = 0 from one side only (H < |M₀| ≤ S) it gives the sliding rows' moment at ω = 0, M₀, the largest |M₀| they lock, H, \
+         and the largest that sticking rows hold, S (N m): {semi} map cells, every map of the study.\n"
+    ))
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -19,6 +19,14 @@
 //! phi = 1.585             # rad: direction of its table (default π/4 + 0.3)
 //! dt = 0.0166667          # s: its step (default the study's)
 //! map = true              # also a (Fr, φ) map, map_NAME.csv (default false)
+//!
+//! [[sweep]]               # one quantity over a list: sweep_NAME.csv
+//! name = "cm_height"
+//! over = "engine.cm_height"  # speed (m/s), phi (rad), theta0 (rad: the start), dt (s) or engine.KEY
+//! values = [0.0, 0.02, 0.05]
+//! speeds = [0.2, 0.5, 1.0]   # m/s: every value at every speed (default [0.5])
+//! engine = { feet = "separate" }  # over the study's options, for every run of the sweep
+//! phi = 1.0854            # rad, dt (s), t_run (s), tail: as the study's by default
 //! ```
 
 use std::collections::BTreeMap;
@@ -43,6 +51,32 @@ pub struct Spec {
     pub engine: BTreeMap<String, serde_json::Value>,
     #[serde(default)]
     pub variant: Vec<Variant>,
+    #[serde(default)]
+    pub sweep: Vec<Sweep>,
+}
+
+/// One quantity of the runs over a list of values.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sweep {
+    pub name: String,
+    /// `speed`, `phi`, `theta0`, `dt` or `engine.KEY`.
+    pub over: String,
+    pub values: Vec<f64>,
+    pub speeds: Option<Vec<f64>>,
+    #[serde(default)]
+    pub engine: BTreeMap<String, serde_json::Value>,
+    pub phi: Option<f64>,
+    pub dt: Option<f64>,
+    pub t_run: Option<f64>,
+    pub tail: Option<f64>,
+}
+
+impl Sweep {
+    /// The `[engine]` key the sweep varies, if it varies one.
+    pub fn key(&self) -> Option<&str> {
+        self.over.strip_prefix("engine.")
+    }
 }
 
 /// A further table (and map) of the study.
@@ -118,19 +152,52 @@ impl Spec {
             }
         }
         for (i, v) in self.variant.iter().enumerate() {
-            if v.name.is_empty()
-                || !v
-                    .name
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_')
-            {
-                return Err((
-                    format!("variant[{i}].name"),
-                    format!("must be letters, digits and _, got \"{}\"", v.name),
-                ));
-            }
+            name_ok(&format!("variant[{i}].name"), &v.name)?;
             pos(&format!("variant[{i}].supports_half"), v.supports_half)?;
             pos(&format!("variant[{i}].dt"), v.dt)?;
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for (i, w) in self.sweep.iter().enumerate() {
+            let at = |k: &str| format!("sweep[{i}].{k}");
+            name_ok(&at("name"), &w.name)?;
+            if !names.insert(&w.name) {
+                return Err((at("name"), format!("\"{}\" is used twice", w.name)));
+            }
+            if !matches!(w.over.as_str(), "speed" | "phi" | "theta0" | "dt")
+                && w.key().is_none_or(|k| k.is_empty())
+            {
+                return Err((
+                    at("over"),
+                    format!(
+                        "must be speed, phi, theta0, dt or engine.KEY, got \"{}\"",
+                        w.over
+                    ),
+                ));
+            }
+            if w.values.is_empty() {
+                return Err((at("values"), "needs at least one value".into()));
+            }
+            for (k, &v) in w.values.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err((
+                        format!("{}[{k}]", at("values")),
+                        format!("must be finite, got {v}"),
+                    ));
+                }
+                if matches!(w.over.as_str(), "speed" | "dt") {
+                    pos(&format!("{}[{k}]", at("values")), Some(v))?;
+                }
+            }
+            for (k, &v) in w.speeds.iter().flatten().enumerate() {
+                pos(&format!("{}[{k}]", at("speeds")), Some(v))?;
+            }
+            pos(&at("dt"), w.dt)?;
+            pos(&at("t_run"), w.t_run)?;
+            if let Some(t) = w.tail {
+                if !(t > 0.0 && t <= 1.0) {
+                    return Err((at("tail"), format!("must be in (0, 1], got {t}")));
+                }
+            }
         }
         Ok(())
     }
@@ -162,6 +229,17 @@ impl Spec {
             f.iter().map(|k| k * dt).collect()
         })
     }
+}
+
+/// A variant's or sweep's name names a file: letters, digits and `_`.
+fn name_ok(key: &str, name: &str) -> Result<(), (String, String)> {
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err((
+            key.to_string(),
+            format!("must be letters, digits and _, got \"{name}\""),
+        ));
+    }
+    Ok(())
 }
 
 /// Refuses a study file for a model the registry does not list.

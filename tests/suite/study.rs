@@ -440,3 +440,115 @@ fn map_svg_has_one_cell_per_map_row() {
         );
     }
 }
+
+/// A sweep file of the quick `study all`.
+fn sweep(model: &str, name: &str) -> Rows {
+    read_csv(&quick_dir().join(model).join(format!("sweep_{name}.csv")))
+}
+
+#[test]
+fn regularised_idioms_tend_to_coulomb_as_the_slip_speed_shrinks() {
+    use pushval_rapier2d::idioms::predicted_steady_omega;
+    use pushval_rapier2d::FrictionModel;
+    // The limit v_s → 0 is Coulomb's law: below the supports' slip speeds
+    // (the slowest slides at about 0.03 m/s at v_c = 0.2) the engine is the
+    // Coulomb model to its step error (measured ≤ 6.7e-8); at v_s = 0.3 m/s
+    // tanh is far from it (measured 5.8e-3 to 0.22); both are on the closed form
+    // recomputed here (measured ≤ 6.6e-8). The linear idiom is Coulomb's
+    // wherever every support slides faster than v_s.
+    for (model, law) in [
+        ("rapier2d_regularised_linear", 0),
+        ("rapier2d_regularised_tanh", 1),
+    ] {
+        let rows = sweep(model, "slip_speed");
+        assert_eq!(rows.len(), 15, "{model}: 5 slip speeds × 3 speeds");
+        for r in rows {
+            let (vs, v) = (val(&r, "value"), val(&r, "speed"));
+            let p = problem(v, val(&r, "phi"), 6.0, None);
+            let w = val(&r, "omega_engine");
+            let m = if law == 0 {
+                FrictionModel::RegularisedLinear { slip_speed: vs }
+            } else {
+                FrictionModel::RegularisedTanh { slip_speed: vs }
+            };
+            let pred = predicted_steady_omega(m, &p.body, &p.pushes[0], 1e-3, 0.0, 0.0).unwrap();
+            assert!(
+                rel_err(w, pred, v, length()) < 5e-7,
+                "{model} {r:?} vs {pred}"
+            );
+            let off = rel_err(w, coulomb(&p), v, length());
+            if vs <= 0.01 {
+                assert!(off < 5e-7, "{model} {r:?}");
+            }
+            // tanh is below Coulomb at every slip speed; the linear idiom
+            // only where a support slides slower than v_s.
+            if vs == 0.3 && law == 1 {
+                assert!(off > 5e-3 && w.abs() < coulomb(&p).abs(), "{model} {r:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_box_idiom_locks_from_every_start_and_the_disk_ignores_the_start() {
+    // Rotating the start leaves an isotropic law's run unchanged (measured
+    // spread 1.1e-15 rad/s); the box's per-axis rows lock the plate at 0.5
+    // m/s from every start over its quarter-turn period (measured |ω| ≤
+    // 8.9e-5 against |ω*| = 0.47).
+    let disk = sweep("rapier2d_impulse_disk", "theta0");
+    assert_eq!(disk.len(), 8);
+    let w0 = val(&disk[0], "omega_engine");
+    for r in &disk {
+        assert!((val(r, "omega_engine") - w0).abs() < 1e-12, "{r:?}");
+    }
+    let boxed = sweep("rapier2d_impulse_box", "theta0");
+    assert_eq!(boxed.len(), 8);
+    for r in &boxed {
+        let p = problem(0.5, val(r, "phi"), 8.0, None);
+        assert!(
+            val(r, "omega_engine").abs() < 1e-3 * coulomb(&p).abs(),
+            "{r:?}"
+        );
+    }
+}
+
+#[test]
+fn bad_sweeps_exit_2_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    for (text, key) in [
+        (
+            "[[sweep]]\nname = \"a\"\nover = \"mass\"\nvalues = [1.0]\n",
+            "sweep[0].over",
+        ),
+        (
+            "[[sweep]]\nname = \"a\"\nover = \"engine.no_such_key\"\nvalues = [1.0]\n",
+            "sweep[0].over",
+        ),
+        (
+            "[[sweep]]\nname = \"a\"\nover = \"dt\"\nvalues = [1e-3, -1e-3]\n",
+            "sweep[0].values[1]",
+        ),
+        (
+            "[[sweep]]\nname = \"a\"\nover = \"phi\"\nvalues = [1.0]\n[[sweep]]\nname = \"a\"\nover = \"speed\"\nvalues = [1.0]\n",
+            "sweep[1].name",
+        ),
+    ] {
+        let studies = tempfile::tempdir().unwrap();
+        std::fs::write(studies.path().join("rapier2d.toml"), text).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_pushval"))
+            .current_dir(root())
+            .args(["study", "rapier2d", "--quick", "--studies"])
+            .arg(studies.path())
+            .arg("--out")
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{text}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("rapier2d.toml") && err.contains(key),
+            "{text}: {err}"
+        );
+        assert!(!dir.path().join("README.md").exists(), "nothing written");
+    }
+}

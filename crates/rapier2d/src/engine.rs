@@ -43,6 +43,13 @@ impl Rapier2dModel {
 
 /// The `[engine]` keys the rapier2d models read, besides `dt`.
 const OPTION_KEYS: &[&str] = &["solver_iterations", "precision", "friction_velocity"];
+/// The regularised idioms' keys: the common ones and `slip_speed` (m/s).
+const REGULARISED_KEYS: &[&str] = &[
+    "solver_iterations",
+    "precision",
+    "friction_velocity",
+    "slip_speed",
+];
 
 /// The settings the `[engine]` table asks for, over the adapter's defaults.
 pub fn settings_from(opts: &EngineOptions) -> Result<EngineSettings, OptionError> {
@@ -76,6 +83,15 @@ fn build(
     friction_model: FrictionModel,
     opts: &EngineOptions,
 ) -> Result<Box<dyn Engine>, OptionError> {
+    let friction_model = match (friction_model, opts.positive("slip_speed")?) {
+        (FrictionModel::RegularisedLinear { .. }, Some(v)) => {
+            FrictionModel::RegularisedLinear { slip_speed: v }
+        }
+        (FrictionModel::RegularisedTanh { .. }, Some(v)) => {
+            FrictionModel::RegularisedTanh { slip_speed: v }
+        }
+        (m, _) => m,
+    };
     let settings = EngineSettings {
         friction_model,
         ..settings_from(opts)?
@@ -125,7 +141,7 @@ pub fn models() -> Vec<ModelEntry> {
             build: |o| {
                 build(
                     "rapier2d_regularised_linear",
-                    "Coulomb regularised linearly below 0.01 m/s",
+                    "Coulomb regularised linearly below the slip speed ([engine] slip_speed, default 0.01 m/s)",
                     FrictionModel::RegularisedLinear {
                         slip_speed: IDIOM_SLIP_SPEED,
                     },
@@ -138,7 +154,7 @@ pub fn models() -> Vec<ModelEntry> {
             build: |o| {
                 build(
                     "rapier2d_regularised_tanh",
-                    "Coulomb regularised by tanh(|u| / 0.01 m/s)",
+                    "Coulomb regularised by tanh(|u| / v_s) ([engine] slip_speed v_s, default 0.01 m/s)",
                     FrictionModel::RegularisedTanh {
                         slip_speed: IDIOM_SLIP_SPEED,
                     },
@@ -180,7 +196,14 @@ impl Engine for Rapier2dModel {
         self.settings.dt
     }
     fn option_keys(&self) -> &'static [&'static str] {
-        OPTION_KEYS
+        if matches!(
+            self.settings.friction_model,
+            FrictionModel::RegularisedLinear { .. } | FrictionModel::RegularisedTanh { .. }
+        ) {
+            REGULARISED_KEYS
+        } else {
+            OPTION_KEYS
+        }
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = EngineSettings {
@@ -195,6 +218,11 @@ impl Engine for Rapier2dModel {
             "precision": s.precision.as_str(),
             "friction_velocity": s.friction_velocity.as_str(),
             "friction_model": s.friction_model.as_str(),
+            "slip_speed": match s.friction_model {
+                FrictionModel::RegularisedLinear { slip_speed }
+                | FrictionModel::RegularisedTanh { slip_speed } => Some(slip_speed),
+                _ => None,
+            },
             "switch_step_fraction": s.switch_step_fraction,
             "colliders": s.colliders,
             "label": s.label(),
