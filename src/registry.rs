@@ -14,7 +14,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 
-use pushval_engine::{Build, Engine, EngineOptions, ModelEntry, OptionError};
+use pushval_engine::{Build, Engine, EngineOptions, FrictionLaw, ModelEntry, OptionError};
 pub use pushval_outside::{csv, problem_document, DEFAULT_DT as OUTSIDE_DEFAULT_DT};
 use pushval_outside::{Config, OutsideEngine, Spec};
 use pushval_scenario::{Scenario, ScenarioError, ANALYTIC_MODELS};
@@ -29,6 +29,24 @@ pub const ENGINE_CRATES: &[fn() -> Vec<ModelEntry>] = &[
     pushval_avian::models,
     pushval_jolt::models,
 ];
+
+/// The friction laws an outside engine may declare (`law = "NAME"` in
+/// `pushval.toml`): Coulomb's, and the rapier2d idioms' closed forms.
+pub fn laws() -> Vec<(&'static str, Arc<dyn FrictionLaw>)> {
+    let mut out: Vec<(&'static str, Arc<dyn FrictionLaw>)> =
+        vec![("coulomb", Arc::new(pushval_engine::COULOMB))];
+    out.extend(
+        pushval_rapier2d::laws()
+            .into_iter()
+            .map(|(n, l)| (n, Arc::from(l))),
+    );
+    out
+}
+
+/// The law called `name`, if [`laws`] has it.
+fn law(name: &str) -> Option<Arc<dyn FrictionLaw>> {
+    laws().into_iter().find(|(n, _)| *n == name).map(|(_, l)| l)
+}
 
 /// The file outside engines are declared in when `--engines` names none:
 /// `pushval.toml` in the current directory.
@@ -65,6 +83,14 @@ pub fn use_engines_file(file: Option<&Path>) -> Result<(), pushval_outside::Conf
                     file: c.file.clone(),
                     key: format!("engine.{}", spec.name),
                     problem: "this name is already a built-in model; choose another".into(),
+                });
+            }
+            if let Some(l) = spec.law.as_deref().filter(|l| law(l).is_none()) {
+                let known: Vec<&str> = laws().iter().map(|(n, _)| *n).collect();
+                return Err(pushval_outside::ConfigError {
+                    file: c.file.clone(),
+                    key: format!("engine.{}.law", spec.name),
+                    problem: format!("unknown law \"{l}\"; known: {}", known.join(", ")),
                 });
             }
         }
@@ -118,7 +144,10 @@ impl Entry {
     pub fn build(&self, options: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
         match &self.build {
             Builder::Crate(b) => b(options),
-            Builder::Outside(spec) => Ok(Box::new(OutsideEngine::new(spec.clone(), options))),
+            Builder::Outside(spec) => Ok(Box::new(
+                OutsideEngine::new(spec.clone(), options)
+                    .with_law(spec.law.as_deref().and_then(law)),
+            )),
         }
     }
     /// The model with default options (for listings).

@@ -318,6 +318,20 @@ fn a_bad_engines_file_is_an_input_error() {
         t.contains("engines.toml: engine.pure_python.shell: unknown key"),
         "{t}"
     );
+    let f = engines_file(dir.path(), &["python3"], "law = \"stribeck\"\n");
+    let o = pushval()
+        .arg("engines")
+        .arg("--engines")
+        .arg(&f)
+        .output()
+        .unwrap();
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(
+        t.contains("engine.pure_python.law: unknown law \"stribeck\"")
+            && t.contains("impulse_rows_disk"),
+        "{t}"
+    );
     let o = pushval()
         .arg("engines")
         .arg("--engines")

@@ -10,7 +10,7 @@ pub const DEFAULT_DT: f64 = 1e-3;
 pub const DEFAULT_TIMEOUT_S: f64 = 120.0;
 
 /// The keys an `[engine.NAME]` table may hold.
-const KEYS: &[&str] = &["command", "order", "dt", "timeout_s", "version"];
+const KEYS: &[&str] = &["command", "order", "dt", "timeout_s", "version", "law"];
 
 /// One outside engine as `pushval.toml` declares it.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,6 +33,10 @@ pub struct Spec {
     /// What `pushval engines` and `summary.json` show as the engine's
     /// version; None when the file gives none.
     pub version: Option<String>,
+    /// The friction law in closed form the engine follows, by name (one of
+    /// the laws pushval knows: `pushval engines` lists them); None when the
+    /// file names none. The registry checks the name.
+    pub law: Option<String>,
 }
 
 impl Spec {
@@ -253,7 +257,13 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
         Some(toml::Value::String(s)) => Some(s.clone()),
         Some(v) => return Err(err("version", format!("must be a string, got {v}"))),
     };
+    let law = match t.get("law") {
+        None => None,
+        Some(toml::Value::String(s)) => Some(s.clone()),
+        Some(v) => return Err(err("law", format!("must be a string, got {v}"))),
+    };
     Ok(Spec {
+        law,
         name: name.to_string(),
         command,
         dir: dir.to_path_buf(),

@@ -4,7 +4,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use pushval_engine::{
-    trajectory_from_steps, Engine, EngineCrate, EngineOptions, EngineRun, StepRecord,
+    trajectory_from_steps, Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, StepRecord,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -18,12 +18,23 @@ const STDERR_LINES: usize = 8;
 
 /// An outside engine with a scenario's `[engine]` options: one process per
 /// run (see the crate docs).
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct OutsideEngine {
     spec: Arc<Spec>,
+    law: Option<Arc<dyn FrictionLaw>>,
     options: EngineOptions,
     adapter: String,
     description: String,
+}
+
+impl std::fmt::Debug for OutsideEngine {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OutsideEngine")
+            .field("spec", &self.spec)
+            .field("options", &self.options)
+            .field("law", &self.law.as_ref().map(|l| l.law_name()))
+            .finish()
+    }
 }
 
 impl OutsideEngine {
@@ -44,7 +55,15 @@ impl OutsideEngine {
             ),
             options: options.clone(),
             spec,
+            law: None,
         }
+    }
+
+    /// The engine with the friction law its declaration names (the
+    /// registry resolves `law = "NAME"`).
+    pub fn with_law(mut self, law: Option<Arc<dyn FrictionLaw>>) -> Self {
+        self.law = law;
+        self
     }
 
     /// Its declaration.
@@ -109,6 +128,9 @@ impl Engine for OutsideEngine {
             "order": self.spec.order,
             "timeout_s": self.spec.timeout_s,
         })
+    }
+    fn law(&self) -> Option<&dyn FrictionLaw> {
+        self.law.as_deref()
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let start = Instant::now();

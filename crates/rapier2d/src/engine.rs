@@ -255,6 +255,42 @@ impl Engine for Rapier2dModel {
     }
 }
 
+/// The idioms' laws by name, for engines outside pushval that declare one
+/// (`law = "NAME"` in `pushval.toml`): each evaluates the closed form of
+/// [`crate::idioms`] with the idiom's default slip speed.
+pub fn laws() -> Vec<(&'static str, Box<dyn FrictionLaw>)> {
+    [
+        ("impulse_disk", FrictionModel::ImpulseDisk),
+        ("impulse_box", FrictionModel::ImpulseBox),
+        ("impulse_rows_disk", FrictionModel::ImpulseRowsDisk),
+        (
+            "regularised_linear",
+            FrictionModel::RegularisedLinear {
+                slip_speed: IDIOM_SLIP_SPEED,
+            },
+        ),
+        (
+            "regularised_tanh",
+            FrictionModel::RegularisedTanh {
+                slip_speed: IDIOM_SLIP_SPEED,
+            },
+        ),
+    ]
+    .into_iter()
+    .map(|(name, friction_model)| {
+        let law: Box<dyn FrictionLaw> = Box::new(Rapier2dModel::new(
+            name,
+            "a friction law of crate::idioms",
+            EngineSettings {
+                friction_model,
+                ..EngineSettings::default()
+            },
+        ));
+        (name, law)
+    })
+    .collect()
+}
+
 /// Angles per turn of the box idiom's period mean.
 const BOX_ANGLES: usize = 360;
 
@@ -269,6 +305,12 @@ impl FrictionLaw for Rapier2dModel {
             }
             FrictionModel::ImpulseDisk => {
                 "stopping impulse −K⁻¹u capped in length at μNΔt (pushval_rapier2d::idioms)"
+            }
+            FrictionModel::ImpulseRowsDisk => {
+                "stopping impulse solved per world axis, the pair scaled onto the disk μNΔt; mean ω over a turn (pushval_rapier2d::idioms)"
+            }
+            FrictionModel::Coulomb => {
+                "Coulomb at every support (the analytic model, pushval_model::SegmentDynamics)"
             }
             _ => "Coulomb regularised below the slip speed (pushval_rapier2d::idioms)",
         }

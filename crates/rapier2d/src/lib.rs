@@ -37,7 +37,7 @@ mod f32_engine;
 mod f64_engine;
 pub mod idioms;
 
-pub use engine::{models, Rapier2dModel, ENGINE_CRATE};
+pub use engine::{laws, models, Rapier2dModel, ENGINE_CRATE};
 pub use idioms::FrictionModel;
 pub use pushval_engine::{tail_mean_omega, StepRecord};
 
