@@ -47,7 +47,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use pushval_engine::{rel_err, tail_loads, tail_mean_omega, Engine, EngineOptions, LawClass};
-use pushval_model::Problem;
+use pushval_model::{Problem, Push};
 
 use crate::report::shard::{grid_hash, grid_name, Parts, Shard};
 use crate::report::{par_rows, Writer};
@@ -342,7 +342,7 @@ impl Plan {
             return format!(
                 "{m}/sweep/{}/{}={}/{:?}/v={speed}/phi={phi}/dt={dt}/theta0={theta0}/t={}/tail={}",
                 sw.spec.name, sw.spec.over, sw.spec.values[i], sw.spec.engine, sw.t_run, sw.tail
-            );
+            ) + &sw.spec.stop.map_or(String::new(), |s| format!("/stop={s}"));
         }
         let (speed, phi, dt, s) = self.push(t);
         match t {
@@ -387,6 +387,13 @@ impl Plan {
             let (speed, phi, dt, theta0, engine) = sw.push(i, v);
             let mut p = paper_plate(speed, phi, sw.t_run, None);
             p.initial.theta = theta0;
+            if let Some(duration) = sw.spec.stop {
+                p.pushes.push(Push {
+                    duration,
+                    speed: 0.0,
+                    phi,
+                });
+            }
             return run_row(engine, &p, dt, sw.tail);
         }
         let (speed, phi, dt, s) = self.push(t);
@@ -407,18 +414,34 @@ impl Plan {
 /// Coulomb's ω*, the law's ω, class and loads.
 fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
     let run = engine.run(p, dt).ok();
+    // The last segment: the push, or the rest after a stop, where ω is the
+    // mean |ω| over the tail (a signed mean hides a chattering stop).
+    let seg = p.pushes.len() - 1;
     let omega = run
         .as_ref()
-        .and_then(|r| tail_mean_omega(p, &r.trajectory, tail)[0])
+        .and_then(|r| {
+            if seg == 0 {
+                return tail_mean_omega(p, &r.trajectory, tail)[0];
+            }
+            let t1 = p.segment_times()[seg].1;
+            let w: Vec<f64> = r
+                .trajectory
+                .samples
+                .iter()
+                .filter(|s| s.t >= t1 - tail * p.pushes[seg].duration)
+                .map(|s| s.omega.abs())
+                .collect();
+            Some(w.iter().sum::<f64>() / w.len() as f64)
+        })
         .unwrap_or(f64::NAN);
-    let coulomb = pushval_engine::coulomb_steady(p, 0).unwrap_or(f64::NAN);
+    let coulomb = pushval_engine::coulomb_steady(p, seg).unwrap_or(f64::NAN);
     let law = engine.law();
-    let steady = law.and_then(|l| l.steady(p, 0, dt));
+    let steady = law.and_then(|l| l.steady(p, seg, dt));
     let mut row = vec![omega, coulomb, steady.map_or(f64::NAN, |l| l.omega)];
     row.extend(class_code(steady.map(|l| l.class)));
     for loads in [
         run.as_ref().and_then(tail_loads),
-        law.and_then(|l| l.loads(p, 0, dt)),
+        law.and_then(|l| l.loads(p, seg, dt)),
     ] {
         let loads = loads.unwrap_or_default();
         row.extend((0..LOADS).map(|k| loads.get(k).copied().unwrap_or(f64::NAN)));

@@ -289,7 +289,8 @@ fn sweeps(
              | {} | v_c (m/s) | ω engine | ω* Coulomb | ω law | class | vs Coulomb | vs law |{}\n|---|---|---|---|---|---|---|---|{}\n",
             sw.spec.over,
             sw.spec.values,
-            if sw.spec.engine.is_empty() { String::new() } else { format!(", `[engine]` {:?}", sw.spec.engine) },
+            if sw.spec.engine.is_empty() { String::new() } else { format!(", `[engine]` {:?}", sw.spec.engine) }
+                + &sw.spec.stop.map_or(String::new(), |s| format!(", then the pusher at rest for {s} s: ω engine is the mean |ω| over the rest's tail, the models' ω at rest")),
             sw.t_run,
             100.0 * sw.tail,
             if has_loads { "; loads in N, supports in the problem's order" } else { "" },
@@ -302,13 +303,21 @@ fn sweeps(
                 continue;
             };
             let (speed, phi, dt, theta0, _) = sw.push(i, v);
-            let (ec, el) = (err(r[0], r[1], r[1], speed), err(r[0], r[2], r[1], speed));
+            // After a stop ω is a mean |ω| at rest, against no turning rate.
+            let (ec, el, class) = match sw.spec.stop {
+                Some(_) => (f64::NAN, f64::NAN, ""),
+                None => (
+                    err(r[0], r[1], r[1], speed),
+                    err(r[0], r[2], r[1], speed),
+                    class_name(r[3]),
+                ),
+            };
             let _ = write!(
                 csv,
                 "{},{speed},{phi},{dt},{theta0},{},{},{},{}",
                 sw.spec.values[i],
                 run_line(r),
-                class_name(r[3]),
+                class,
                 opt(ec),
                 opt(el)
             );
@@ -319,7 +328,7 @@ fn sweeps(
                 sig(r[0]),
                 sig(r[1]),
                 sig(r[2]),
-                class_name(r[3]),
+                class,
                 sig(ec),
                 sig(el)
             );

@@ -27,6 +27,8 @@
 //! speeds = [0.2, 0.5, 1.0]   # m/s: every value at every speed (default [0.5])
 //! engine = { feet = "separate" }  # over the study's options, for every run of the sweep
 //! phi = 1.0854            # rad, dt (s), t_run (s), tail: as the study's by default
+//! stop = 1.0              # s: the pusher then rests this long; ω is the mean |ω| over the
+//!                         # rest's tail (0 for a clean stop, not for a chattering one)
 //! ```
 
 use std::collections::BTreeMap;
@@ -70,6 +72,7 @@ pub struct Sweep {
     pub dt: Option<f64>,
     pub t_run: Option<f64>,
     pub tail: Option<f64>,
+    pub stop: Option<f64>,
 }
 
 impl Sweep {
@@ -193,6 +196,7 @@ impl Spec {
             }
             pos(&at("dt"), w.dt)?;
             pos(&at("t_run"), w.t_run)?;
+            pos(&at("stop"), w.stop)?;
             if let Some(t) = w.tail {
                 if !(t > 0.0 && t <= 1.0) {
                     return Err((at("tail"), format!("must be in (0, 1], got {t}")));

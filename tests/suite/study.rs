@@ -552,3 +552,32 @@ fn bad_sweeps_exit_2_naming_the_key() {
         assert!(!dir.path().join("README.md").exists(), "nothing written");
     }
 }
+
+#[test]
+fn a_regularised_stop_is_clean_exactly_when_the_step_gain_is_below_2() {
+    // At rest the explicit step maps ω to (1 − γ) ω with
+    // γ = Δt Σ F_i |p_i − p_c|² / (v_s I_P) (the linear law's slope at
+    // u = 0), so the stop is clean for γ < 2 and chatters for γ > 2:
+    // γ = 0.74 at 1 ms, 12.3 at 1/60 s on the plate with v_s = 0.01 m/s.
+    // Measured mean |ω| at rest: 2.2e-13 and 0.167 rad/s.
+    let p = problem(0.5, 1.0, 1.0, None);
+    let (b, pc) = (&p.body, p.body.contact());
+    let sum: f64 = b
+        .supports()
+        .map(|s| s.friction * (s.position - pc).norm_squared())
+        .sum();
+    let ip = b.inertia_contact();
+    for model in ["rapier2d_regularised_linear", "rapier2d_regularised_tanh"] {
+        let rows = sweep(model, "stop");
+        assert_eq!(rows.len(), 2);
+        for r in rows {
+            let gamma = val(&r, "dt") * sum / (0.01 * ip);
+            let w = val(&r, "omega_engine");
+            if gamma < 2.0 {
+                assert!(w < 1e-9, "{model} γ {gamma}: {r:?}");
+            } else {
+                assert!(w > 1e-2, "{model} γ {gamma}: {r:?}");
+            }
+        }
+    }
+}
