@@ -217,6 +217,7 @@ impl Engine for Avian3dModel {
                 "max_tilt": r.max_tilt,
                 "rest_loads": r.rest_loads,
                 "mu": r.mu,
+                "loads": r.loads,
             }),
             trajectory: r.trajectory,
         })
@@ -238,6 +239,15 @@ impl FrictionLaw for Avian3dModel {
             omega,
             class: LawClass::Turns,
         })
+    }
+    /// The feet's loads (N) at the steady state: the rest loads of the soft
+    /// contacts (`m g` shared as springs ∝ effective mass: statics for three
+    /// feet) moved by the couple `−h_cm Σ f_i` of the friction
+    /// ([`crate::predict::PlateScene::steady`]).
+    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        let push = problem.pushes.get(segment)?;
+        let scene = crate::predict::PlateScene::new(problem, &self.settings).ok()?;
+        scene.steady(push, 0.0).map(|(_, loads)| loads)
     }
 }
 

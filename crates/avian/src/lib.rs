@@ -303,6 +303,9 @@ pub struct Avian3dRun {
     /// Per segment, the time-weighted mean normal force of each foot over
     /// the segment's last 20 % (N).
     pub segment_tail_loads: Vec<Vec<f64>>,
+    /// The time-weighted mean normal force of each foot over the last fifth
+    /// of the run (N), in support order: the engine diagnostics' `"loads"`.
+    pub loads: Vec<f64>,
     /// Largest tilt of the object (rad): angle between its vertical axis and
     /// the world's.
     pub max_tilt: f64,

@@ -276,18 +276,24 @@ fn read(world: &World, object: Entity, prev_theta: f64) -> State {
 /// biased solve and the relaxation), so the step's mean force is
 /// `normal_impulse / (2 h)` (the loads then sum to m g: checked by a test).
 fn loads(world: &World, feet: &[Entity], h: f64) -> Vec<f64> {
+    let mut out = vec![0.0; feet.len()];
+    add_loads(world, feet, h, 1.0, &mut out);
+    out
+}
+
+/// Adds `weight` times each foot's mean normal force over the last step of
+/// length `h` (N, see [`loads`]) to `acc` (no allocation).
+fn add_loads(world: &World, feet: &[Entity], h: f64, weight: f64, acc: &mut [f64]) {
     let graph = world.resource::<ContactGraph>();
-    feet.iter()
-        .map(|&foot| {
-            graph
-                .contact_pairs_with(foot)
-                .flat_map(|pair| &pair.manifolds)
-                .flat_map(|manifold| &manifold.points)
-                .map(|p| p.normal_impulse)
-                .sum::<f64>()
-                / (2.0 * h)
-        })
-        .collect()
+    for (a, &foot) in acc.iter_mut().zip(feet) {
+        let impulse: f64 = graph
+            .contact_pairs_with(foot)
+            .flat_map(|pair| &pair.manifolds)
+            .flat_map(|manifold| &manifold.points)
+            .map(|p| p.normal_impulse)
+            .sum();
+        *a += weight * impulse / (2.0 * h);
+    }
 }
 
 /// Runs `steps` steps of `ticks` each with the pusher at rest.
@@ -364,6 +370,9 @@ pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, 
     }];
     let n_feet = scene.feet.len();
     let mut tail_loads = Vec::with_capacity(problem.pushes.len());
+    // The run's last fifth (steps whose middle is past it), time-weighted.
+    let run_from = 0.8 * problem.duration();
+    let (mut run_acc, mut run_t) = (vec![0.0; n_feet], 0.0);
     let (mut max_tilt, mut max_drift) = (0.0f64, 0.0f64);
     let mut t_seg = 0.0;
     for (j, push) in problem.pushes.iter().enumerate() {
@@ -400,10 +409,12 @@ pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, 
             let gap = anchor - state.position - state.rotation * scene.anchor;
             max_drift = max_drift.max(gap.x.hypot(gap.y));
             if 0.5 * (t0 + t1) >= tail_from {
-                for (a, n) in acc.iter_mut().zip(loads(app.world(), &scene.feet, h)) {
-                    *a += n * h;
-                }
+                add_loads(app.world(), &scene.feet, h, h, &mut acc);
                 acc_t += h;
+            }
+            if 0.5 * (t0 + t1) >= run_from {
+                add_loads(app.world(), &scene.feet, h, h, &mut run_acc);
+                run_t += h;
             }
             history.push(StepRecord {
                 segment: j,
@@ -430,6 +441,10 @@ pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, 
         rest_loads,
         mu,
         segment_tail_loads: tail_loads,
+        loads: run_acc
+            .iter()
+            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+            .collect(),
         max_tilt,
         max_joint_drift: max_drift,
         steps,

@@ -118,19 +118,25 @@ impl Engine for JoltModel {
             ..self.settings
         })
         .run(problem)?;
+        let mut diagnostics = serde_json::json!({
+            "steps": r.steps,
+            "max_joint_drift": r.max_joint_drift,
+            "max_tilt": r.max_tilt,
+            "max_lift": r.max_lift,
+            "rest_loads": r.rest_loads,
+            "manifold_sizes": r.manifold_sizes,
+            "mu": r.mu,
+        });
+        // `jolt_box`: per corner of its manifold, reported only when the
+        // corners are the supports (crate::JoltRun::loads).
+        if let Some(loads) = &r.loads {
+            diagnostics["loads"] = serde_json::json!(loads);
+        }
         Ok(EngineRun {
             dt,
             steps: r.steps,
             wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "steps": r.steps,
-                "max_joint_drift": r.max_joint_drift,
-                "max_tilt": r.max_tilt,
-                "max_lift": r.max_lift,
-                "rest_loads": r.rest_loads,
-                "manifold_sizes": r.manifold_sizes,
-                "mu": r.mu,
-            }),
+            diagnostics,
             trajectory: r.trajectory,
         })
     }

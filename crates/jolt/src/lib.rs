@@ -206,6 +206,13 @@ pub struct JoltRun {
     /// the settle phase): box corners in the order of
     /// [`predict::box_corners`], feet in the problem's order.
     pub rest_loads: Vec<f64>,
+    /// The time-weighted mean normal force of each support over the last
+    /// fifth of the run (N), in the problem's support order: the engine
+    /// diagnostics' `"loads"`. Jolt reports a normal impulse per contact
+    /// point, so `jolt_box` has one per corner of its manifold; they are the
+    /// supports' loads when every support sits on a corner of the box, and
+    /// None otherwise.
+    pub loads: Option<Vec<f64>>,
     /// Number of manifolds between the object and the floor after the
     /// settle phase, and their sizes (contact points each).
     pub manifold_sizes: Vec<usize>,

@@ -3,7 +3,7 @@
 use std::f64::consts::{PI, TAU};
 
 use pushval_engine::StepRecord;
-use pushval_model::{ModelError, Problem, SolverStats, Trajectory, Vec2};
+use pushval_model::{Body, ModelError, Problem, SolverStats, Trajectory, Vec2};
 
 use crate::predict::{box_corners, friction_slip_angle};
 use crate::sys::{BodyState, Collider, Spec, World};
@@ -375,6 +375,9 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
     let mut tail_angle = Vec::new();
     let mut tail_angle_law = Vec::new();
     let mut tail_load_range = Vec::new();
+    // The run's last fifth (steps whose middle is past it), time-weighted.
+    let run_from = (1.0 - TAIL) * problem.duration();
+    let (mut run_n, mut run_t) = (vec![0.0; n_sup], 0.0);
     let mut t_seg = 0.0;
     for (j, push) in problem.pushes.iter().enumerate() {
         let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
@@ -416,12 +419,26 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
             }
             max_tilt = max_tilt.max(tilt_of(st.rotation));
             max_lift = max_lift.max((st.com[2] - z_rest).abs());
+            let in_run_tail = 0.5 * (t0 + t1) >= run_from;
+            if in_run_tail && k < tail_from {
+                let c = contacts(&world, (mass, iz), &st, &targets, h)?;
+                for (a, x) in run_n.iter_mut().zip(&c.supports) {
+                    *a += x.normal * h;
+                }
+                run_t += h;
+            }
             if k >= tail_from {
                 let w = st.angular[2];
                 acc_w += w * h;
                 acc_w2 += w * w * h;
                 acc_t += h;
                 let c = contacts(&world, (mass, iz), &st, &targets, h)?;
+                if in_run_tail {
+                    for (a, x) in run_n.iter_mut().zip(&c.supports) {
+                        *a += x.normal * h;
+                    }
+                    run_t += h;
+                }
                 for (r, x) in load_range.iter_mut().zip(&c.supports) {
                     r[0] = r[0].min(x.normal);
                     r[1] = r[1].max(x.normal);
@@ -486,6 +503,14 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         wall_time: Default::default(),
         mu,
         rest_loads,
+        loads: support_loads(
+            body,
+            &targets,
+            run_n
+                .iter()
+                .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+                .collect(),
+        ),
         manifold_sizes,
         segment_tail_omega: tail_omega,
         segment_tail_omega_std: tail_omega_std,
@@ -498,6 +523,34 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         max_joint_drift: max_drift,
         history,
     })
+}
+
+/// The loads of `targets` (feet, or the box's corners) in the problem's
+/// support order: the feet's as they are; the box's corners' when every
+/// support sits on a corner of its own (within 1e-9 m), else None (the
+/// box's contact points are its corners, not the supports).
+fn support_loads(body: &Body, targets: &[Vec2], loads: Vec<f64>) -> Option<Vec<f64>> {
+    if targets.len() == body.len()
+        && body
+            .supports()
+            .zip(targets)
+            .all(|(s, t)| (s.position - t).norm() == 0.0)
+    {
+        return Some(loads);
+    }
+    let mut out = Vec::with_capacity(body.len());
+    let mut used = vec![false; targets.len()];
+    for s in body.supports() {
+        let k = targets
+            .iter()
+            .position(|t| (s.position - t).norm() <= 1e-9)?;
+        if used[k] {
+            return None;
+        }
+        used[k] = true;
+        out.push(loads[k]);
+    }
+    Some(out)
 }
 
 /// `prev` moved to the branch of `angle` nearest to it.

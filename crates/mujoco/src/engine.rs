@@ -4,7 +4,8 @@
 //! available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, ModelEntry, OptionError, COULOMB,
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
+    OptionError, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -32,6 +33,12 @@ fn build(cone: Cone, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionErro
     };
     if let Some(dt) = opts.dt {
         settings.timestep = dt;
+    }
+    if let Some(h) = opts.non_negative("cm_height")? {
+        settings.cm_height = h;
+    }
+    if let Some(h) = opts.non_negative("push_height")? {
+        settings.push_height = h;
     }
     Ok(Box::new(MujocoModel { settings }))
 }
@@ -90,6 +97,10 @@ impl Engine for MujocoModel {
     fn default_dt(&self) -> f64 {
         self.settings.timestep
     }
+    /// `cm_height` and `push_height` (m, ≥ 0; [`MujocoSettings`]).
+    fn option_keys(&self) -> &'static [&'static str] {
+        &["cm_height", "push_height"]
+    }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = MujocoSettings {
             timestep: dt,
@@ -100,14 +111,18 @@ impl Engine for MujocoModel {
             "dt": dt,
             "timestep": dt,
             "cone": s.cone.as_str(),
+            "cm_height": s.cm_height,
+            "push_height": s.push_height,
             "label": s.label(),
         })
     }
-    /// The elliptic cone follows Coulomb's law (`crate::theory`); the
-    /// pyramidal cone's lock on its diagonal has no closed form of ω here.
+    /// The elliptic cone follows Coulomb's law (`crate::theory`), with the
+    /// loads moved by the tilting balance when the centre of mass or the
+    /// pusher is above the floor; the pyramidal cone's lock on its diagonal
+    /// has no closed form of ω here.
     fn law(&self) -> Option<&dyn FrictionLaw> {
         match self.settings.cone {
-            Cone::Elliptic => Some(&COULOMB),
+            Cone::Elliptic => Some(self),
             Cone::Pyramidal => None,
         }
     }
@@ -126,8 +141,62 @@ impl Engine for MujocoModel {
                 "max_pusher_gap": r.max_pusher_gap,
                 "max_penetration": r.max_penetration,
                 "max_tilt": r.max_tilt,
+                "loads": r.loads,
             }),
             trajectory: r.trajectory,
         })
+    }
+}
+
+impl MujocoModel {
+    /// Whether the centre of mass or the pusher is above the floor (the
+    /// push then moves load between the feet).
+    pub fn raised(&self) -> bool {
+        self.settings.cm_height != 0.0 || self.settings.push_height != 0.0
+    }
+}
+
+/// The elliptic cone with a raised centre of mass or pusher: Coulomb at
+/// every foot with the feet calibrated at rest (`μ_i = F_i / N_i`) and the
+/// loads of the quasi-static tilting balance, spread by the least-norm rule
+/// ([`crate::theory::calibrated_load_transfer`]). At both heights 0 the
+/// loads are the rest loads and the steady state is [`COULOMB`]'s.
+impl FrictionLaw for MujocoModel {
+    fn law_name(&self) -> &'static str {
+        "Coulomb at every foot (elliptic cone) with the loads of the tilting balance (pushval_mujoco::theory::calibrated_load_transfer)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+        if !self.raised() {
+            return COULOMB.steady(problem, segment, dt);
+        }
+        let (omega, _) = self.transfer(problem, segment)?;
+        Some(LawSteady {
+            omega,
+            class: if omega == 0.0 {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
+        })
+    }
+    /// The feet's loads (N) in the steady state, least-norm split of the
+    /// weight `m g` at rest plus the transfer; a negative load means the
+    /// foot would lift (the scene's assumptions fail there).
+    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        self.transfer(problem, segment).map(|(_, loads)| loads)
+    }
+}
+
+impl MujocoModel {
+    fn transfer(&self, problem: &Problem, segment: usize) -> Option<(f64, Vec<f64>)> {
+        let push = problem.pushes.get(segment)?;
+        let s = &self.settings;
+        crate::theory::calibrated_load_transfer(
+            &problem.body,
+            push,
+            problem.body.mass() * s.gravity,
+            s.cm_height,
+            s.push_height,
+        )
     }
 }

@@ -252,6 +252,9 @@ pub struct MujocoRun {
     /// Per segment, the time-weighted mean normal force of each foot over the
     /// segment's last 20 % (N).
     pub tail_loads: Vec<Vec<f64>>,
+    /// The time-weighted mean normal force of each foot over the last fifth
+    /// of the run (N), in support order: the engine diagnostics' `"loads"`.
+    pub loads: Vec<f64>,
     /// Per segment, the mean ω over the segment's last 20 % of steps (rad/s).
     pub segment_tail_omega: Vec<f64>,
     /// Per segment, the standard deviation of ω over the same steps (rad/s).

@@ -221,6 +221,10 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
     let mut tail_omega = Vec::with_capacity(problem.pushes.len());
     let mut tail_std = Vec::with_capacity(problem.pushes.len());
     let mut loads = vec![0.0; n];
+    // The run's last fifth (steps whose middle is past it), time-weighted.
+    let run_from = 0.8 * problem.duration();
+    let mut run_load_sum = vec![0.0; n];
+    let mut run_load_t = 0.0;
     let mut t = 0.0;
     let mut steps = 0usize;
     for (j, push) in problem.pushes.iter().enumerate() {
@@ -263,8 +267,18 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
             .sqrt();
             max_gap = max_gap.max(gap);
             max_pen = max_pen.max(max_penetration(&data));
-            if k >= tail_from {
+            let in_run_tail = t - 0.5 * hk >= run_from;
+            if k >= tail_from || in_run_tail {
                 foot_loads(&data, n, &mut loads);
+            }
+            if in_run_tail {
+                run_load_sum
+                    .iter_mut()
+                    .zip(&loads)
+                    .for_each(|(a, b)| *a += b * hk);
+                run_load_t += hk;
+            }
+            if k >= tail_from {
                 load_sum.iter_mut().zip(&loads).for_each(|(a, b)| *a += b);
                 w_sum += s.w[2];
                 w2_sum += s.w[2] * s.w[2];
@@ -326,6 +340,10 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         rest_loads,
         mu,
         tail_loads,
+        loads: run_load_sum
+            .iter()
+            .map(|a| a / run_load_t.max(f64::MIN_POSITIVE))
+            .collect(),
         segment_tail_omega: tail_omega,
         segment_tail_omega_std: tail_std,
         max_pusher_gap: max_gap,

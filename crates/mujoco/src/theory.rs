@@ -125,6 +125,55 @@ pub fn transferred_loads(
         .collect()
 }
 
+/// The loads (N) of the supports at rest by the least-norm rule: the
+/// `N_i = a + b · p_i` with `Σ N_i = weight` (N) and `Σ p_i N_i = 0` (the
+/// supports' positions are relative to the centre of mass). Statics for up
+/// to three supports; for more, the elastic-foundation split (equal loads on
+/// a symmetric square). None when the supports lie on one line.
+pub fn rest_loads(body: &Body, weight: f64) -> Option<Vec<f64>> {
+    let pts: Vec<Vec2> = body.supports().map(|s| s.position).collect();
+    let n = pts.len() as f64;
+    let sx: f64 = pts.iter().map(|p| p.x).sum();
+    let sy: f64 = pts.iter().map(|p| p.y).sum();
+    let sxx: f64 = pts.iter().map(|p| p.x * p.x).sum();
+    let syy: f64 = pts.iter().map(|p| p.y * p.y).sum();
+    let sxy: f64 = pts.iter().map(|p| p.x * p.y).sum();
+    let m = [[n, sx, sy], [sx, sxx, sxy], [sy, sxy, syy]];
+    let a = solve3(m, [weight, 0.0, 0.0]);
+    if a == [0.0; 3] {
+        return None;
+    }
+    Some(pts.iter().map(|p| a[0] + a[1] * p.x + a[2] * p.y).collect())
+}
+
+/// The steady state under Coulomb friction with load transfer for a scene
+/// whose feet were calibrated at rest (`μ_i = F_i / N_i^rest`, the MuJoCo
+/// adapter's calibration, with the [`rest_loads`] of weight `weight`): the
+/// steady ω (rad/s) and the feet's loads (N), from
+/// [`steady_omega_load_transfer`]. With both heights 0 the loads are the
+/// rest loads and ω is the Coulomb model's. None where a support with
+/// friction carries no load at rest or the iteration finds no root.
+pub fn calibrated_load_transfer(
+    body: &Body,
+    push: &Push,
+    weight: f64,
+    h_cm: f64,
+    h_push: f64,
+) -> Option<(f64, Vec<f64>)> {
+    let rest = rest_loads(body, weight)?;
+    let mut mu = Vec::with_capacity(rest.len());
+    for (s, &n) in body.supports().zip(&rest) {
+        if s.friction == 0.0 {
+            mu.push(0.0);
+        } else if n > 0.0 {
+            mu.push(s.friction / n);
+        } else {
+            return None;
+        }
+    }
+    steady_omega_load_transfer(body, push, &mu, &rest, h_cm, h_push)
+}
+
 /// The least-norm ΔN with `Σ ΔN_i = 0` and `Σ p_i ΔN_i = dm`.
 fn least_norm_loads(pts: &[Vec2], dm: Vec2) -> Vec<f64> {
     // ΔN_i = a + b·p_i; solve the 3×3 normal equations.

@@ -9,7 +9,11 @@ use pushval_engine::{
 };
 use pushval_model::{ModelError, Problem};
 
-use crate::predict::{at_rest, lock_moments, rest_moments, steady_from_rest, AtRest};
+use pushval_model::{Body, Support};
+
+use crate::predict::{
+    at_rest, lock_moments, pgs_rest_loads, rest_moments, steady_from_rest, AtRest,
+};
 use crate::{FootContacts, FrictionType, PhysxSettings, PhysxSimulator, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the `physx`
@@ -154,14 +158,17 @@ impl Engine for PhysxModel {
                 "max_lift": r.max_lift,
                 "rest_loads": r.rest_loads,
                 "mu": r.mu,
+                "loads": r.loads,
             }),
             trajectory: r.trajectory,
         })
     }
 }
 
-/// PhysX's friction rows in closed form (`crate::predict`): the law of the
-/// friction type on welded or separate feet, the class of ω = 0 from the
+/// PhysX's friction rows in closed form (`crate::predict`), capped by the
+/// friction PhysX gives the feet at rest (`μ̄ N_i`, N_i the PGS split of
+/// [`pgs_rest_loads`]): the law of the friction type on welded or separate
+/// feet, the class of ω = 0 from the
 /// lock (`|M₀| ≤ H`) and hold (`|M₀| ≤ S`) criteria, and the steady ω a run
 /// from rest reaches. PhysX's contact order is taken as the supports' order
 /// (on the paper plate it gives feet 0 and 2 the `t0` rows, as PhysX does).
@@ -182,7 +189,7 @@ impl FrictionLaw for PhysxModel {
     }
     fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
         let push = problem.pushes.get(segment)?;
-        let body = &problem.body;
+        let body = &self.engine_body(problem)?;
         let points: Vec<[f64; 2]> = body
             .supports()
             .map(|s| [s.position.x, s.position.y])
@@ -208,5 +215,46 @@ impl FrictionLaw for PhysxModel {
             omega: steady_from_rest(body, push, law).omega,
             class,
         })
+    }
+    /// PhysX's loads at rest ([`pgs_rest_loads`]: the PGS split of `m g`
+    /// over the feet, in the supports' order). The centre of mass and the
+    /// pusher are on the floor's plane, so the push moves no load.
+    fn loads(&self, problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        Some(self.rest_loads(problem))
+    }
+}
+
+impl PhysxModel {
+    /// The closed form of PhysX's rest loads for `problem` (N, support
+    /// order; [`pgs_rest_loads`] with the scene's mass, tilt inertia and
+    /// gravity, contacts visited in the supports' order).
+    pub fn rest_loads(&self, problem: &Problem) -> Vec<f64> {
+        let body = &problem.body;
+        let s = &self.settings;
+        let points: Vec<[f64; 2]> = body
+            .supports()
+            .map(|p| [p.position.x, p.position.y])
+            .collect();
+        let order: Vec<usize> = (0..points.len()).collect();
+        let t = s.plate_thickness;
+        let tilt = 0.5 * body.inertia_cm() + body.mass() * t * t / 12.0;
+        pgs_rest_loads(&points, body.mass(), tilt, body.mass() * s.gravity, &order)
+    }
+
+    /// The body the law's rows see: every foot's cap `μ̄ N_i` with PhysX's
+    /// one coefficient `μ̄ = Σ F_i / (m g)` and its rest loads
+    /// ([`Self::rest_loads`]), as the engine has them.
+    fn engine_body(&self, problem: &Problem) -> Option<Body> {
+        let body = &problem.body;
+        let mu = body.total_friction() / (body.mass() * self.settings.gravity);
+        let supports: Vec<Support> = body
+            .supports()
+            .zip(self.rest_loads(problem))
+            .map(|(s, n)| Support {
+                position: s.position,
+                friction: mu * n,
+            })
+            .collect();
+        Body::new(body.mass(), body.inertia_cm(), body.contact(), &supports).ok()
     }
 }

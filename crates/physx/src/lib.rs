@@ -354,6 +354,9 @@ pub struct PhysxRun {
     pub segment_tail_omega_std: Vec<f64>,
     /// Per segment, each foot's mean normal force (N) over the last 20 %.
     pub segment_tail_loads: Vec<Vec<f64>>,
+    /// The time-weighted mean normal force of each foot over the last fifth
+    /// of the run (N), in support order: the engine diagnostics' `"loads"`.
+    pub loads: Vec<f64>,
     /// Per segment, the mean pusher force over the last 20 % (N, object
     /// frame, the force the pusher applies to the object), from the joint's
     /// constraint force.

@@ -198,6 +198,46 @@ pub fn patch_anchors(points: &[[f64; 2]], order: &[usize]) -> (usize, usize) {
     }
 }
 
+/// The normal loads (N) PhysX's PGS gives rigid feet at rest, in support
+/// order: the limit of Gauss–Seidel sweeps, visiting the contacts in the
+/// order `order` (support indices) and starting from zero impulses, on the
+/// normal rows' effective-mass system `K λ = b 1` (the same gravity velocity
+/// to cancel at every foot), scaled to carry `weight` (N). `K_ij = 1/m +
+/// (x_i x_j + y_i y_j)/I_t` for feet at `points` (m, relative to the centre
+/// of mass) of a body of mass `mass` (kg) and tilt inertia `tilt_inertia`
+/// (kg m², both horizontal axes). With three feet this is statics; with more
+/// the system is singular (statically indeterminate) and the sweeps' start
+/// and order pick the split: on the paper plate about 2/7 and 3/14 of m g on the
+/// diagonals (2.803 / 2.102 N), which warm starting then keeps. A foot whose
+/// impulse would turn negative is clamped at 0, as PGS does.
+pub fn pgs_rest_loads(
+    points: &[[f64; 2]],
+    mass: f64,
+    tilt_inertia: f64,
+    weight: f64,
+    order: &[usize],
+) -> Vec<f64> {
+    let n = points.len();
+    let k = |i: usize, j: usize| {
+        1.0 / mass + (points[i][0] * points[j][0] + points[i][1] * points[j][1]) / tilt_inertia
+    };
+    let mut lambda = vec![0.0; n];
+    for _ in 0..100_000 {
+        let mut change = 0.0f64;
+        for &i in order {
+            let residual = 1.0 - (0..n).map(|j| k(i, j) * lambda[j]).sum::<f64>();
+            let next = (lambda[i] + residual / k(i, i)).max(0.0);
+            change = change.max((next - lambda[i]).abs());
+            lambda[i] = next;
+        }
+        if change <= 1e-15 * mass {
+            break;
+        }
+    }
+    let total: f64 = lambda.iter().sum();
+    lambda.iter().map(|l| l * weight / total).collect()
+}
+
 fn sgn(x: f64) -> f64 {
     if x > 0.0 {
         1.0

@@ -462,6 +462,9 @@ impl World {
         let mut tail_omega_std = Vec::new();
         let mut tail_loads = Vec::new();
         let mut tail_force = Vec::new();
+        // The run's last fifth (steps whose middle is past it), time-weighted.
+        let run_from = (1.0 - TAIL) * problem.duration();
+        let (mut run_n, mut run_t) = (vec![0.0; n_feet], 0.0);
         let mut t_seg = 0.0;
         for (j, push) in problem.pushes.iter().enumerate() {
             let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
@@ -496,6 +499,12 @@ impl World {
                 }
                 max_tilt = max_tilt.max(state.tilt);
                 max_lift = max_lift.max((p[2] - z_rest).abs());
+                if 0.5 * (t0 + t1) >= run_from {
+                    for (a, l) in run_n.iter_mut().zip(&loads) {
+                        *a += l * h;
+                    }
+                    run_t += h;
+                }
                 if k >= tail_from {
                     acc_w += state.omega * h;
                     acc_w2 += state.omega * state.omega * h;
@@ -555,6 +564,10 @@ impl World {
             segment_tail_omega: tail_omega,
             segment_tail_omega_std: tail_omega_std,
             segment_tail_loads: tail_loads,
+            loads: run_n
+                .iter()
+                .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+                .collect(),
             segment_tail_pusher_force: tail_force,
             min_loads,
             max_tilt,

@@ -41,7 +41,8 @@ fn build(friction: ContactFriction, opts: &EngineOptions) -> Result<Box<dyn Engi
             FeetColliders::Compound
         };
     }
-    if let Some(h) = opts.non_negative("cm_height")? {
+    // The ball feet hang below the centre of mass: it must be above the floor.
+    if let Some(h) = opts.positive("cm_height")? {
         settings.cm_height = h;
     }
     if let Some(h) = opts.non_negative("push_height")? {
@@ -130,6 +131,7 @@ impl Engine for Rapier3dModel {
                 "max_joint_drift": r.max_joint_drift,
                 "max_tilt": r.max_tilt,
                 "max_lift": r.max_lift,
+                "loads": r.loads,
             }),
             trajectory: r.trajectory,
         })
@@ -181,5 +183,16 @@ impl FrictionLaw for Rapier3dModel {
                 LawClass::Turns
             },
         })
+    }
+    /// The feet's loads (N) at the steady state: `m g` shared as springs ∝
+    /// normal effective mass (statics for three feet), moved by the tilting
+    /// moment `h_push f_c − h_cm m a_cm`; a foot whose load would be negative
+    /// lifts off and carries 0 ([`crate::predict::predict_steady`]).
+    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        let push = problem.pushes.get(segment)?;
+        let scene = self.settings.scene(problem).ok()?;
+        predict_steady(&scene, push, self.predict_law(), true)
+            .ok()
+            .map(|p| p.loads)
     }
 }

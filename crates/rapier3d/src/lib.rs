@@ -279,6 +279,9 @@ pub struct Rapier3dRun {
     pub segment_tail_omega: Vec<f64>,
     /// Per segment, each foot's mean normal force (N) over the last 20 %.
     pub segment_tail_loads: Vec<Vec<f64>>,
+    /// The time-weighted mean normal force of each foot over the last fifth
+    /// of the run (N), in support order: the engine diagnostics' `"loads"`.
+    pub loads: Vec<f64>,
     /// Per segment, each foot's mean friction force magnitude (N) over the
     /// last 20 % (compare with `μ_i N_i`: below it, the foot sticks).
     pub segment_tail_friction: Vec<Vec<f64>>,

@@ -345,6 +345,9 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
     let mut tail_loads = Vec::new();
     let mut tail_friction = Vec::new();
     let mut tail_slip = Vec::new();
+    // The run's last fifth (steps whose middle is past it), time-weighted.
+    let run_from = (1.0 - TAIL) * problem.duration();
+    let (mut run_n, mut run_t) = (vec![0.0; n_feet], 0.0);
     let mut t_seg = 0.0;
     for (j, push) in problem.pushes.iter().enumerate() {
         let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
@@ -387,6 +390,12 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
             }
             max_tilt = max_tilt.max(state.tilt);
             max_lift = max_lift.max((tr.z - z_rest).abs());
+            if 0.5 * (t0 + t1) >= run_from {
+                for (a, &f) in run_n.iter_mut().zip(&normal) {
+                    *a += f * h;
+                }
+                run_t += h;
+            }
             if k >= tail_from {
                 acc_w += state.omega * h;
                 acc_t += h;
@@ -442,6 +451,10 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         rest_loads,
         segment_tail_omega: tail_omega,
         segment_tail_loads: tail_loads,
+        loads: run_n
+            .iter()
+            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+            .collect(),
         segment_tail_friction: tail_friction,
         segment_tail_min_slip: tail_slip,
         min_loads,
