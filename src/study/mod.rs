@@ -124,8 +124,9 @@ pub const LOADS: usize = 4;
 /// Values of a run's row: ω of the engine, of Coulomb and of the law
 /// (rad/s), the law's class code ([`class_code`]) and its rest moments,
 /// then [`LOADS`] support loads measured by the engine and as many
-/// predicted by the law (N; NaN where unknown).
-pub const RUN_WIDTH: usize = 7 + 2 * LOADS;
+/// predicted by the law (N; NaN where unknown), and the engine's angle at
+/// the end of the run (rad).
+pub const RUN_WIDTH: usize = 8 + 2 * LOADS;
 
 /// A sweep of the study file, ready to run.
 pub struct SweepPlan {
@@ -446,6 +447,8 @@ fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
         let loads = loads.unwrap_or_default();
         row.extend((0..LOADS).map(|k| loads.get(k).copied().unwrap_or(f64::NAN)));
     }
+    let end = run.as_ref().and_then(|r| r.trajectory.samples.last());
+    row.push(end.map_or(f64::NAN, |s| s.theta));
     row
 }
 

@@ -249,7 +249,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
 
 /// Loads of a row, `n` engine then `n` law columns (blank where unknown).
 fn loads_cells(r: &[f64]) -> String {
-    r[7..RUN_WIDTH]
+    r[7..7 + 2 * LOADS]
         .iter()
         .map(|v| opt(*v))
         .collect::<Vec<_>>()
@@ -272,8 +272,8 @@ fn sweeps(
             .collect();
         let has_loads = sel
             .iter()
-            .any(|(_, r)| r[7..RUN_WIDTH].iter().any(|v| v.is_finite()));
-        let mut csv = String::from("value,speed,phi,dt,theta0,omega_engine,omega_coulomb,omega_law,class,err_vs_coulomb,err_vs_law");
+            .any(|(_, r)| r[7..7 + 2 * LOADS].iter().any(|v| v.is_finite()));
+        let mut csv = String::from("value,speed,phi,dt,theta0,omega_engine,omega_coulomb,omega_law,class,err_vs_coulomb,err_vs_law,theta_end");
         if has_loads {
             for who in ["engine", "law"] {
                 for k in 1..=LOADS {
@@ -314,12 +314,13 @@ fn sweeps(
             };
             let _ = write!(
                 csv,
-                "{},{speed},{phi},{dt},{theta0},{},{},{},{}",
+                "{},{speed},{phi},{dt},{theta0},{},{},{},{},{}",
                 sw.spec.values[i],
                 run_line(r),
                 class,
                 opt(ec),
-                opt(el)
+                opt(el),
+                opt(r[RUN_WIDTH - 1])
             );
             let _ = write!(
                 md,
@@ -350,7 +351,7 @@ fn sweeps(
                     md,
                     " {} | {} |",
                     fmt(&r[7..7 + LOADS]),
-                    fmt(&r[7 + LOADS..RUN_WIDTH])
+                    fmt(&r[7 + LOADS..7 + 2 * LOADS])
                 );
             }
             csv.push('\n');

@@ -501,13 +501,36 @@ fn the_box_idiom_locks_from_every_start_and_the_disk_ignores_the_start() {
     for r in &disk {
         assert!((val(r, "omega_engine") - w0).abs() < 1e-12, "{r:?}");
     }
+    // It locks at a stable zero of the frozen law's moment,
+    // `idioms::lock_angles` (mod π/2; measured within 2e-3 rad of one).
     let boxed = sweep("rapier2d_impulse_box", "theta0");
     assert_eq!(boxed.len(), 8);
+    let quarter = std::f64::consts::FRAC_PI_2;
     for r in &boxed {
         let p = problem(0.5, val(r, "phi"), 8.0, None);
         assert!(
             val(r, "omega_engine").abs() < 1e-3 * coulomb(&p).abs(),
             "{r:?}"
+        );
+        let locks = pushval_rapier2d::idioms::lock_angles(
+            pushval_rapier2d::FrictionModel::ImpulseBox,
+            &p.body,
+            &p.pushes[0],
+            val(r, "dt"),
+            720,
+        );
+        let end = val(r, "theta_end").rem_euclid(quarter);
+        let near = locks
+            .iter()
+            .filter(|(_, stable)| *stable)
+            .map(|(a, _)| {
+                let d = (end - a.rem_euclid(quarter)).abs();
+                d.min(quarter - d)
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            near < 1e-2,
+            "{r:?}: {near} rad from a stable lock of {locks:?}"
         );
     }
 }

@@ -86,7 +86,9 @@ fn separate_one_directional_is_the_line_law() {
         let pred = steady_omega(&engine_body(&b, &r1), &p, Law::Line, 0.0);
         assert!(!pred.sticks);
         let (w1, w2) = (r1.segment_tail_omega[0], r2.segment_tail_omega[0]);
-        assert!(rel(w1, pred.omega) < 1e-2, "v {v}: {w1} vs {}", pred.omega);
+        // Measured 5.4e-4, 1.5e-3, 3.4e-3 at v 0.2, 0.5, 1 (first order in
+        // dt: the extrapolation below closes it).
+        assert!(rel(w1, pred.omega) < 4e-3, "v {v}: {w1} vs {}", pred.omega);
         assert!(
             rel(w2, pred.omega) < rel(w1, pred.omega),
             "v {v}: no approach"
@@ -155,8 +157,9 @@ fn small_feet_turn_as_each_law_predicts() {
         assert!(!locks(&eb, &p, law), "{f:?} {contacts:?}");
         let pred = steady_omega(&eb, &p, law, 0.0);
         let w = r.segment_tail_omega[0];
+        // Measured 5.9e-4 to 7.2e-4, 4.5e-3 for two-directional.
         assert!(
-            rel(w, pred.omega) < 1e-2,
+            rel(w, pred.omega) < 6e-3,
             "{f:?} {contacts:?}: {w} vs {}",
             pred.omega
         );
@@ -178,7 +181,8 @@ fn welded_one_directional_pulls_with_every_other_foot() {
     let weight = b.mass() * 9.81;
     for f in [FrictionType::Patch, FrictionType::TwoDirectional] {
         let r = run(&b, p, settings(f, FootContacts::Welded, 1e-3));
-        assert!(rel(along(&r), r.mu * weight) < 1e-2, "{f:?}: {}", along(&r));
+        // Measured 1.4e-5 (patch), 2.4e-4 (two-directional).
+        assert!(rel(along(&r), r.mu * weight) < 5e-4, "{f:?}: {}", along(&r));
     }
     let r = run(
         &b,
@@ -186,7 +190,8 @@ fn welded_one_directional_pulls_with_every_other_foot() {
         settings(FrictionType::OneDirectional, FootContacts::Welded, 1e-3),
     );
     let two = r.mu * (r.rest_loads[0] + r.rest_loads[2]);
-    assert!(rel(along(&r), two) < 1e-2, "{} vs {two}", along(&r));
+    // Measured 8.1e-4.
+    assert!(rel(along(&r), two) < 2e-3, "{} vs {two}", along(&r));
 }
 
 /// PhysX's PGS shares the weight of four rigid feet unequally (the support is
