@@ -247,6 +247,14 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     w.file("README.md", text.as_bytes())
 }
 
+/// `[engine]` options as TOML reads them: `k = v, …`.
+fn options_text(o: &std::collections::BTreeMap<String, serde_json::Value>) -> String {
+    o.iter()
+        .map(|(k, v)| format!("{k} = {v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Loads of a row, `n` engine then `n` law columns (blank where unknown).
 fn loads_cells(r: &[f64]) -> String {
     r[7..7 + 2 * LOADS]
@@ -289,7 +297,7 @@ fn sweeps(
              | {} | v_c (m/s) | ω engine | ω* Coulomb | ω law | class | vs Coulomb | vs law |{}\n|---|---|---|---|---|---|---|---|{}\n",
             sw.spec.over,
             sw.spec.values,
-            if sw.spec.engine.is_empty() { String::new() } else { format!(", `[engine]` {:?}", sw.spec.engine) }
+            if sw.spec.engine.is_empty() { String::new() } else { format!(", `[engine]` {}", options_text(&sw.spec.engine)) }
                 + &sw.spec.stop.map_or(String::new(), |s| format!(", then the pusher at rest for {s} s: ω engine is the mean |ω| over the rest's tail, the models' ω at rest")),
             sw.t_run,
             100.0 * sw.tail,
@@ -434,7 +442,7 @@ fn readme(
         if plan.setups[0].options.values.is_empty() {
             String::new()
         } else {
-            format!(", `[engine]` {:?}", plan.setups[0].options.values)
+            format!(", `[engine]` {}", options_text(&plan.setups[0].options.values))
         }
     );
     if let Some(a) = &plan.spec.about {
