@@ -220,6 +220,35 @@ impl Plan {
         if let Err(why) = engine.availability() {
             bail!("the model `{model}` is not in this build: {why}");
         }
+        // Every `[engine]` key of the file must be one the model reads:
+        // (where the file names it, the key).
+        let mut keys: Vec<(String, &str)> = spec
+            .engine
+            .keys()
+            .map(|k| (format!("engine.{k}"), k.as_str()))
+            .collect();
+        for (i, v) in spec.variant.iter().enumerate() {
+            keys.extend(
+                v.engine
+                    .keys()
+                    .map(|k| (format!("variant[{i}].engine.{k}"), k.as_str())),
+            );
+        }
+        for (i, w) in spec.sweep.iter().enumerate() {
+            keys.extend(
+                w.engine
+                    .keys()
+                    .map(|k| (format!("sweep[{i}].engine.{k}"), k.as_str())),
+            );
+            keys.extend(w.key().map(|k| (format!("sweep[{i}].over"), k)));
+        }
+        if let Some((at, k)) = keys.iter().find(|(_, k)| !engine.accepts_option(k)) {
+            bail!(
+                "{}: key `{at}`: the model `{model}` reads no [engine] key `{k}` (it reads: {})",
+                studies.join(format!("{model}.toml")).display(),
+                engine.option_keys().join(", ")
+            );
+        }
         let dt = spec.dt.unwrap_or(engine.default_dt());
         let mut setups = vec![Setup {
             name: String::new(),
@@ -254,16 +283,9 @@ impl Plan {
         let creep = (0..TABLE_SPEEDS.len()).filter(|&v| law_locks(v)).collect();
         let tail = spec.tail.unwrap_or(0.2);
         let mut sweeps = Vec::new();
-        for (n, w) in spec.sweep.iter().enumerate() {
+        for w in &spec.sweep {
             let engines = match w.key() {
                 Some(key) => {
-                    if !setups[0].engine.accepts_option(key) {
-                        bail!(
-                            "{}: key `sweep[{n}].over`: the model `{model}` reads no [engine] key `{key}` (it reads: {})",
-                            studies.join(format!("{model}.toml")).display(),
-                            setups[0].engine.option_keys().join(", ")
-                        );
-                    }
                     let mut e = Vec::new();
                     for x in &w.values {
                         let mut o = w.engine.clone();

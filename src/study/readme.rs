@@ -247,6 +247,15 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     w.file("README.md", text.as_bytes())
 }
 
+/// `v` to 3 decimals, `–` where undefined.
+fn dec3(v: &f64) -> String {
+    if v.is_finite() {
+        format!("{v:.3}")
+    } else {
+        "–".into()
+    }
+}
+
 /// `[engine]` options as TOML reads them: `k = v, …`.
 fn options_text(o: &std::collections::BTreeMap<String, serde_json::Value>) -> String {
     o.iter()
@@ -343,18 +352,7 @@ fn sweeps(
             );
             if has_loads {
                 let _ = write!(csv, ",{}", loads_cells(r));
-                let fmt = |x: &[f64]| {
-                    x.iter()
-                        .map(|v| {
-                            if v.is_finite() {
-                                format!("{v:.3}")
-                            } else {
-                                "–".into()
-                            }
-                        })
-                        .collect::<Vec<_>>()
-                        .join(" ")
-                };
+                let fmt = |x: &[f64]| x.iter().map(dec3).collect::<Vec<_>>().join(" ");
                 let _ = write!(
                     md,
                     " {} | {} |",

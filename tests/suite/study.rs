@@ -548,6 +548,14 @@ fn bad_sweeps_exit_2_naming_the_key() {
             "sweep[0].over",
         ),
         (
+            "[[sweep]]\nname = \"a\"\nover = \"dt\"\nvalues = [1e-3]\nengine = { no_such_key = 1 }\n",
+            "sweep[0].engine.no_such_key",
+        ),
+        (
+            "[[variant]]\nname = \"a\"\nengine = { substep = 4 }\n",
+            "variant[0].engine.substep",
+        ),
+        (
             "[[sweep]]\nname = \"a\"\nover = \"dt\"\nvalues = [1e-3, -1e-3]\n",
             "sweep[0].values[1]",
         ),
