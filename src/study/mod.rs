@@ -5,25 +5,13 @@
 //! through [`Engine::law`]) explains it.
 //!
 //! For a model, in `results/friction_models/MODEL/` (or `--out DIR`):
-//!
-//! * `paper_plate.csv`: the steady ω at v_c 0.2, 0.5, 1 m/s, φ = π/4 + 0.3,
-//!   against the Coulomb model's ω* and the law's;
-//! * `map.csv`: the same over a 20 × 20 (Fr, φ) grid (5 × 5 `--quick`), with
-//!   the law's class of each cell (`turns`, `locked`, `semi_stable`), and
-//!   `map.svg` drawn from it alone ([`figure`]; `study index` redraws it);
-//! * `dt_ladder.csv`: the steady ω at 0.5 m/s over a ladder of steps, its
-//!   observed order and the Richardson extrapolation at the declared order;
-//! * `creep.csv`, where the law locks at a table push: the same ladder
-//!   there, to show whether the engine's creep shrinks with the step;
-//! * `variants.csv` and `map_NAME.csv`: the tables (and maps) of the
-//!   study file's variants (other `[engine]` options or supports);
-//! * `sweep_NAME.csv`: one quantity of the runs (speed, φ, the start θ, the
-//!   step or an `[engine]` option) over the study file's list, with the
-//!   supports' loads as the engine measures them and as the law predicts;
-//! * `rest_moments.csv`, where the law holds a map cell from one side: the
-//!   rest moments M₀, H and S of every map cell;
-//! * `coulomb_fit.csv`: the Coulomb model fitted to the engine ([`fit`]);
-//! * `README.md`, written from those files' data ([`readme`]).
+//! `paper_plate.csv` (steady ω at v_c 0.2, 0.5, 1 m/s against Coulomb's ω*
+//! and the law's), `map.csv` over the (Fr, φ) grid with the law's class and
+//! its figure `map.svg` ([`figure`]), `dt_ladder.csv` (observed order,
+//! Richardson), `creep.csv` where the law locks, `variants.csv` /
+//! `map_NAME.csv`, `sweep_NAME.csv` (one quantity over a list, with engine
+//! and law support loads), `rest_moments.csv` where the law is semi-stable,
+//! `coulomb_fit.csv` ([`fit`]) and `README.md` from those files ([`readme`]).
 //!
 //! What a study varies is data, `studies/MODEL.toml` ([`spec`]); nothing
 //! here names an engine. `all` runs every model of this build and writes an
@@ -259,11 +247,16 @@ impl Plan {
             dt,
             map: true,
         }];
-        for v in &spec.variant {
+        // A model the file's options refuse, named by the file and key.
+        let file = studies.join(format!("{model}.toml"));
+        let built = |o: &EngineOptions, at: String| {
+            build(model, o).map_err(|e| anyhow::anyhow!("{}: key `{at}`: {e}", file.display()))
+        };
+        for (i, v) in spec.variant.iter().enumerate() {
             let options = spec.options(&v.engine);
             setups.push(Setup {
                 name: v.name.clone(),
-                engine: build(model, &options)?,
+                engine: built(&options, format!("variant[{i}].engine"))?,
                 options,
                 supports_half: v.supports_half,
                 phi: v.phi.unwrap_or(PHI_TABLE),
@@ -283,18 +276,27 @@ impl Plan {
         let creep = (0..TABLE_SPEEDS.len()).filter(|&v| law_locks(v)).collect();
         let tail = spec.tail.unwrap_or(0.2);
         let mut sweeps = Vec::new();
-        for w in &spec.sweep {
+        for (n, w) in spec.sweep.iter().enumerate() {
             let engines = match w.key() {
                 Some(key) => {
                     let mut e = Vec::new();
-                    for x in &w.values {
+                    for (k, &x) in w.values.iter().enumerate() {
                         let mut o = w.engine.clone();
-                        o.insert(key.to_string(), (*x).into());
-                        e.push(build(model, &spec.options(&o))?);
+                        // A whole number as TOML's integer: counts are options too.
+                        let v = if x.fract() == 0.0 && x.abs() < 9e15 {
+                            (x as i64).into()
+                        } else {
+                            x.into()
+                        };
+                        o.insert(key.to_string(), v);
+                        e.push(built(&spec.options(&o), format!("sweep[{n}].values[{k}]"))?);
                     }
                     e
                 }
-                None => vec![build(model, &spec.options(&w.engine))?],
+                None => vec![built(
+                    &spec.options(&w.engine),
+                    format!("sweep[{n}].engine"),
+                )?],
             };
             sweeps.push(SweepPlan {
                 engines,
@@ -528,14 +530,11 @@ pub fn run_model(model: &str, dir: &Path, opts: &Options) -> anyhow::Result<Summ
             notes: Vec::new(),
         });
     }
-    let (rows, computed) = if opts.merge {
-        (
-            parts.merge(dir, tasks.len(), |i| Some(plan.width(&tasks[i])))?,
-            0,
-        )
+    let computed = if opts.merge { 0 } else { tasks.len() };
+    let rows = if opts.merge {
+        parts.merge(dir, tasks.len(), |i| Some(plan.width(&tasks[i])))?
     } else {
-        let rows = par_rows(&tasks, opts.progress, model, |t| plan.eval(t));
-        (rows, tasks.len())
+        par_rows(&tasks, opts.progress, model, |t| plan.eval(t))
     };
     let mut w = Writer::new(dir)?;
     readme::write(&plan, &tasks, &rows, &mut w)?;
@@ -574,10 +573,6 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
             .unwrap_or_else(|| Path::new(DEFAULT_OUT).join(name));
         return run_model(name, &dir, opts);
     }
-    let root = opts
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
     let mut sum = Summary::default();
     for m in &all {
         let e = crate::registry::engine(m, &EngineOptions::default());

@@ -302,15 +302,16 @@ fn sweeps(
         let name = &sw.spec.name;
         let _ = write!(
             md,
-            "\n## Sweep {name} (`sweep_{name}.csv`)\n\n`{}` over {:?}{}; {} s runs, ω the mean over the last {} %{}.\n\n\
+            "\n## Sweep {name} (`sweep_{name}.csv`)\n\n`{}` over {:?}{}; {}{}.\n\n\
              | {} | v_c (m/s) | ω engine | ω* Coulomb | ω law | class | vs Coulomb | vs law |{}\n|---|---|---|---|---|---|---|---|{}\n",
             sw.spec.over,
             sw.spec.values,
-            if sw.spec.engine.is_empty() { String::new() } else { format!(", `[engine]` {}", options_text(&sw.spec.engine)) }
-                + &sw.spec.stop.map_or(String::new(), |s| format!(", then the pusher at rest for {s} s: ω engine is the mean |ω| over the rest's tail, the models' ω at rest")),
-            sw.t_run,
-            100.0 * sw.tail,
-            if has_loads { "; loads in N, supports in the problem's order" } else { "" },
+            if sw.spec.engine.is_empty() { String::new() } else { format!(", `[engine]` {}", options_text(&sw.spec.engine)) },
+            match sw.spec.stop {
+                Some(s) => format!("{} s pushes, then the pusher at rest for {s} s: ω engine is the mean |ω| over the rest's last {} s, the models' ω at rest", sw.t_run, sw.tail * s),
+                None => format!("{} s runs, ω the mean over the last {} %", sw.t_run, 100.0 * sw.tail),
+            },
+            if has_loads { "; loads in N, supports in the problem's order, the engine's averaged over the run's last fifth" } else { "" },
             sw.spec.over,
             if has_loads { " loads engine | loads law |" } else { "" },
             if has_loads { "---|---|" } else { "" },
@@ -377,9 +378,10 @@ fn rest_moments(
     w: &mut Writer,
 ) -> anyhow::Result<String> {
     let mut csv = String::from("variant,froude,phi,class,moment,lock,hold\n");
-    let mut semi = 0usize;
+    let (mut semi, mut cells) = (0usize, 0usize);
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Map { s, i, j } = *t {
+            cells += 1;
             let _ = writeln!(
                 csv,
                 "{},{},{},{},{},{},{}",
@@ -400,7 +402,7 @@ fn rest_moments(
     w.file("rest_moments.csv", csv.as_bytes())?;
     Ok(format!(
         "\n## Rest moments (`rest_moments.csv`)\n\nWhere the law holds ω = 0 from one side only (H < |M₀| ≤ S) it gives the sliding rows' moment at ω = 0, M₀, the largest |M₀| they lock, H, \
-         and the largest that sticking rows hold, S (N m): {semi} map cells, every map of the study.\n"
+         and the largest that sticking rows hold, S (N m). The file lists every cell of every map of the study ({cells}); {semi} are semi-stable and carry M₀, H and S.\n"
     ))
 }
 

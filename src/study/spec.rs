@@ -169,23 +169,31 @@ impl Spec {
             if !matches!(w.over.as_str(), "speed" | "phi" | "theta0" | "dt")
                 && w.key().is_none_or(|k| k.is_empty())
             {
-                return Err((
-                    at("over"),
-                    format!(
-                        "must be speed, phi, theta0, dt or engine.KEY, got \"{}\"",
-                        w.over
-                    ),
-                ));
+                let why = format!(
+                    "must be speed, phi, theta0, dt or engine.KEY, got \"{}\"",
+                    w.over
+                );
+                return Err((at("over"), why));
             }
             if w.values.is_empty() {
                 return Err((at("values"), "needs at least one value".into()));
             }
+            // A key the sweep's values replace would be ignored: refused.
+            let set = [w.speeds.is_some(), w.phi.is_some(), w.dt.is_some()];
+            let fixed = ["speed", "phi", "dt"]
+                .iter()
+                .zip(["speeds", "phi", "dt"])
+                .zip(set);
+            if let Some(((_, k), _)) = fixed
+                .into_iter()
+                .find(|((o, _), set)| *set && w.over == **o)
+            {
+                return Err((at(k), "is what the sweep varies; remove it".into()));
+            }
             for (k, &v) in w.values.iter().enumerate() {
-                if !v.is_finite() {
-                    return Err((
-                        format!("{}[{k}]", at("values")),
-                        format!("must be finite, got {v}"),
-                    ));
+                if w.values[..k].contains(&v) || !v.is_finite() {
+                    let why = format!("must be finite and listed once, got {v}");
+                    return Err((format!("{}[{k}]", at("values")), why));
                 }
                 if matches!(w.over.as_str(), "speed" | "dt") {
                     pos(&format!("{}[{k}]", at("values")), Some(v))?;

@@ -303,6 +303,8 @@ fn an_outside_engine_study_fills_its_declared_law() {
             col(&row, "omega_law"),
             col(&row, "omega_coulomb"),
         );
+        // The wiring: `omega_law` is the declared law's period mean (the
+        // same closed form; what is tested below is the engine against it).
         if let Some(l) = law {
             assert!((wl - l).abs() <= 1e-12 * l.abs().max(1.0), "{line} vs {l}");
         }

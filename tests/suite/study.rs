@@ -556,6 +556,18 @@ fn bad_sweeps_exit_2_naming_the_key() {
             "variant[0].engine.substep",
         ),
         (
+            "[[sweep]]\nname = \"a\"\nover = \"speed\"\nvalues = [1.0]\nspeeds = [0.5]\n",
+            "sweep[0].speeds",
+        ),
+        (
+            "[[sweep]]\nname = \"a\"\nover = \"phi\"\nvalues = [1.0, 0.5, 1.0]\n",
+            "sweep[0].values[2]",
+        ),
+        (
+            "[[sweep]]\nname = \"a\"\nover = \"engine.solver_iterations\"\nvalues = [4.0, 0.0]\n",
+            "sweep[0].values[1]",
+        ),
+        (
             "[[sweep]]\nname = \"a\"\nover = \"dt\"\nvalues = [1e-3, -1e-3]\n",
             "sweep[0].values[1]",
         ),
@@ -706,4 +718,39 @@ fn avian3d_and_physx_loads_obey_statics() {
             assert!((n[0] - n[1]).abs() > 0.5, "{r:?}: the split is not m g / 4");
         }
     }
+}
+
+#[test]
+fn a_sweep_over_a_count_option_builds_its_engines() {
+    // Whole numbers reach the engine as integers (TOML's counts): the plan
+    // of a `solver_iterations` sweep builds, and a shard that computes no
+    // task writes its part file.
+    let studies = tempfile::tempdir().unwrap();
+    std::fs::write(
+        studies.path().join("rapier2d.toml"),
+        "[[sweep]]\nname = \"iters\"\nover = \"engine.solver_iterations\"\nvalues = [1, 4]\n",
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .current_dir(root())
+        .args([
+            "study",
+            "rapier2d",
+            "--quick",
+            "--shard",
+            "hash:1/100000",
+            "--studies",
+        ])
+        .arg(studies.path())
+        .arg("--out")
+        .arg(dir.path())
+        .env("CI", "1")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }

@@ -34,8 +34,8 @@ pub struct Spec {
     /// version; None when the file gives none.
     pub version: Option<String>,
     /// The friction law in closed form the engine follows, by name (one of
-    /// the laws pushval knows: `pushval engines` lists them); None when the
-    /// file names none. The registry checks the name.
+    /// the laws of `pushval::registry::laws`; an unknown name is refused
+    /// naming the known ones); None when the file names none.
     pub law: Option<String>,
 }
 
