@@ -29,29 +29,11 @@ fn avian3d(cm_height: f64) -> Box<dyn Engine> {
 const TRIANGLE: [[f64; 2]; 3] = [[-0.1, -0.08], [0.12, -0.06], [-0.01, 0.11]];
 
 /// The loads (N) of three feet at `TRIANGLE` carrying `weight` (N) with
-/// first moment `moment` (N m): `Σ N = W`, `Σ N p = M`, by Cramer's rule.
+/// first moment `moment` (N m): `Σ N = W`, `Σ N p = M`.
 fn statics3(weight: f64, moment: [f64; 2]) -> [f64; 3] {
-    let m = [
-        [1.0, 1.0, 1.0],
-        [TRIANGLE[0][0], TRIANGLE[1][0], TRIANGLE[2][0]],
-        [TRIANGLE[0][1], TRIANGLE[1][1], TRIANGLE[2][1]],
-    ];
-    let b = [weight, moment[0], moment[1]];
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&m);
-    let mut out = [0.0; 3];
-    for (k, o) in out.iter_mut().enumerate() {
-        let mut mk = m;
-        for r in 0..3 {
-            mk[r][k] = b[r];
-        }
-        *o = det(&mk) / d;
-    }
-    out
+    let m = nalgebra::Matrix3::from_fn(|r, c| if r == 0 { 1.0 } else { TRIANGLE[c][r - 1] });
+    let b = nalgebra::Vector3::new(weight, moment[0], moment[1]);
+    m.lu().solve(&b).expect("the feet are not collinear").into()
 }
 
 fn triangle(speed: f64, duration: f64) -> Problem {

@@ -190,26 +190,12 @@ fn least_norm_loads(pts: &[Vec2], dm: Vec2) -> Vec<f64> {
     pts.iter().map(|p| a[0] + a[1] * p.x + a[2] * p.y).collect()
 }
 
-/// Cramer's rule for a 3×3 system (singular: zeros).
+/// The 3×3 system `m x = b` (singular: zeros).
 fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&m);
-    if d.abs() < 1e-300 {
-        return [0.0; 3];
-    }
-    let mut out = [0.0; 3];
-    for (k, o) in out.iter_mut().enumerate() {
-        let mut mk = m;
-        for r in 0..3 {
-            mk[r][k] = b[r];
-        }
-        *o = det(&mk) / d;
-    }
-    out
+    let m = nalgebra::Matrix3::from_fn(|r, c| m[r][c]);
+    m.lu()
+        .solve(&nalgebra::Vector3::from(b))
+        .map_or([0.0; 3], |x| x.into())
 }
 
 /// Steady ω with load transfer: iterate `ω → forces(ω) → loads → ω` from
