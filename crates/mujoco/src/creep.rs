@@ -1017,20 +1017,12 @@ pub fn report_markdown(csv: &str) -> Result<String, String> {
         .iter()
         .filter(|r| cell(r, "case") == "held" && in_domain(r) && settles(r))
     {
-        let key = |x: &Row| {
-            [
-                "group",
-                "impratio",
-                "cone",
-                "solref",
-                "solimp",
-                "dt",
-                "feet",
-                "noslip",
-                "direction",
-                "load_fraction",
-            ]
-            .map(|k| cell(x, k).to_string())
+        // A run's settings: the CSV's columns up to `case`.
+        let key = |x: &Row| -> Vec<String> {
+            CSV_COLUMNS[..10]
+                .iter()
+                .map(|k| cell(x, k).to_string())
+                .collect()
         };
         let k = key(r);
         if let Some(s) = find(&|x: &Row| cell(x, "case") == "sliding" && settles(x) && key(x) == k)
