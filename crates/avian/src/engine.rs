@@ -4,8 +4,8 @@
 //! are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
+    ModelEntry, OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -48,17 +48,68 @@ fn availability() -> Result<(), String> {
 }
 
 /// The `avian2d` model.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Avian2dModel {
+    info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Avian2dSettings,
 }
 
+impl Avian2dModel {
+    /// The model with `settings`.
+    pub fn new(settings: Avian2dSettings) -> Self {
+        // First order: the trajectory's error is proportional to the substep
+        // (measured: see the crate's README; the steady ω converges faster).
+        let info = EngineInfo::new(
+            "avian2d",
+            "top-down rigid body, kinematic pusher through a revolute joint, Coulomb force at every support in Avian's substep loop",
+            "pushval-avian",
+            ENGINE_CRATE_2D,
+            1.0,
+            settings.dt,
+        )
+        .with_options(OptionKeys::Listed(OPTION_KEYS))
+        .with_availability(availability());
+        Self { info, settings }
+    }
+}
+
+impl Default for Avian2dModel {
+    fn default() -> Self {
+        Self::new(Avian2dSettings::default())
+    }
+}
+
 /// The `avian3d` model.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Avian3dModel {
+    info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Avian3dSettings,
+}
+
+impl Avian3dModel {
+    /// The model with `settings`.
+    pub fn new(settings: Avian3dSettings) -> Self {
+        // First order in the step (measured: see the crate's README).
+        let info = EngineInfo::new(
+            "avian3d",
+            "plate on ball feet on a floor, Avian's own contact friction (Coulomb along -u per contact point)",
+            "pushval-avian",
+            ENGINE_CRATE_3D,
+            1.0,
+            settings.dt,
+        )
+        .with_options(OptionKeys::Listed(&["substeps", "cm_height"]))
+        .with_availability(availability());
+        Self { info, settings }
+    }
+}
+
+impl Default for Avian3dModel {
+    fn default() -> Self {
+        Self::new(Avian3dSettings::default())
+    }
 }
 
 /// The Avian models: the crate's entries in pushval's engine registry.
@@ -74,7 +125,7 @@ pub fn models() -> Vec<ModelEntry> {
                 if let Some(n) = substeps(o)? {
                     settings.substeps = n;
                 }
-                Ok(Box::new(Avian2dModel { settings }))
+                Ok(Box::new(Avian2dModel::new(settings)))
             },
         },
         ModelEntry {
@@ -90,38 +141,15 @@ pub fn models() -> Vec<ModelEntry> {
                 if let Some(h) = o.non_negative("cm_height")? {
                     settings.cm_height = h;
                 }
-                Ok(Box::new(Avian3dModel { settings }))
+                Ok(Box::new(Avian3dModel::new(settings)))
             },
         },
     ]
 }
 
 impl Engine for Avian2dModel {
-    fn name(&self) -> &'static str {
-        "avian2d"
-    }
-    fn description(&self) -> &'static str {
-        "top-down rigid body, kinematic pusher through a revolute joint, Coulomb force at every support in Avian's substep loop"
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-avian"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        ENGINE_CRATE_2D
-    }
-    /// First order: the trajectory's error is proportional to the substep
-    /// (measured: see the crate's README; the steady ω converges faster).
-    fn order(&self) -> f64 {
-        1.0
-    }
-    fn availability(&self) -> Result<(), String> {
-        availability()
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.dt
-    }
-    fn option_keys(&self) -> &'static [&'static str] {
-        OPTION_KEYS
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = Avian2dSettings {
@@ -129,7 +157,7 @@ impl Engine for Avian2dModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": dt,
             "substeps": s.substeps,
             "label": s.label(),
@@ -158,30 +186,8 @@ impl Engine for Avian2dModel {
 }
 
 impl Engine for Avian3dModel {
-    fn name(&self) -> &'static str {
-        "avian3d"
-    }
-    fn description(&self) -> &'static str {
-        "plate on ball feet on a floor, Avian's own contact friction (Coulomb along -u per contact point)"
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-avian"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        ENGINE_CRATE_3D
-    }
-    /// First order in the step (measured: see the crate's README).
-    fn order(&self) -> f64 {
-        1.0
-    }
-    fn availability(&self) -> Result<(), String> {
-        availability()
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.dt
-    }
-    fn option_keys(&self) -> &'static [&'static str] {
-        &["substeps", "cm_height"]
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = Avian3dSettings {
@@ -189,7 +195,7 @@ impl Engine for Avian3dModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": dt,
             "substeps": s.substeps,
             "foot_radius": s.foot_radius,

@@ -3,8 +3,8 @@
 //! friction idiom, informational).
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
+    ModelEntry, OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -26,10 +26,44 @@ const BOX2D_SOURCE: &str = "Box2D 3.2.0 snapshot 56edae7";
 const OPTION_KEYS: &[&str] = &["substeps"];
 
 /// One Box2D model: a friction law and the scenario's engine settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Box2dModel {
+    info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Box2dSettings,
+}
+
+impl Box2dModel {
+    /// The model of `settings`' friction law.
+    pub fn new(settings: Box2dSettings) -> Self {
+        let (name, description) = match settings.friction {
+            Friction::Coulomb => (
+                "box2d",
+                "Box2D v3: top-down rigid body, kinematic pusher through a revolute joint, Coulomb force at every support",
+            ),
+            Friction::MotorJoint => (
+                "box2d_motor_joint",
+                "Box2D v3 top-down friction idiom: motor joint to the ground capped at mu m g and mu m g r_mean, no per-support forces",
+            ),
+        };
+        // First order: the friction forces are explicit in the step-start
+        // state and the pusher is steered at the step-start heading
+        // (measured: see the crate's README).
+        let info = EngineInfo::new(
+            name,
+            description,
+            "pushval-box2d",
+            ENGINE_CRATE,
+            1.0,
+            settings.dt,
+        )
+        .with_version(format!(
+            "{} {} ({BOX2D_SOURCE}, f64 positions)",
+            ENGINE_CRATE.name, ENGINE_CRATE.version
+        ))
+        .with_options(OptionKeys::Listed(OPTION_KEYS));
+        Self { info, settings }
+    }
 }
 
 /// The settings the `[engine]` table asks for, over the adapter's defaults.
@@ -55,7 +89,7 @@ fn build(friction: Friction, opts: &EngineOptions) -> Result<Box<dyn Engine>, Op
         friction,
         ..settings_from(opts)?
     };
-    Ok(Box::new(Box2dModel { settings }))
+    Ok(Box::new(Box2dModel::new(settings)))
 }
 
 /// The Box2D models, one row each: the crate's entries in pushval's engine
@@ -74,45 +108,8 @@ pub fn models() -> Vec<ModelEntry> {
 }
 
 impl Engine for Box2dModel {
-    fn name(&self) -> &'static str {
-        match self.settings.friction {
-            Friction::Coulomb => "box2d",
-            Friction::MotorJoint => "box2d_motor_joint",
-        }
-    }
-    fn description(&self) -> &'static str {
-        match self.settings.friction {
-            Friction::Coulomb => {
-                "Box2D v3: top-down rigid body, kinematic pusher through a revolute joint, Coulomb force at every support"
-            }
-            Friction::MotorJoint => {
-                "Box2D v3 top-down friction idiom: motor joint to the ground capped at mu m g and mu m g r_mean, no per-support forces"
-            }
-        }
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-box2d"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        ENGINE_CRATE
-    }
-    fn version(&self) -> String {
-        format!(
-            "{} {} ({BOX2D_SOURCE}, f64 positions)",
-            ENGINE_CRATE.name, ENGINE_CRATE.version
-        )
-    }
-    /// First order: the friction forces are explicit in the step-start
-    /// state and the pusher is steered at the step-start heading (measured:
-    /// see the crate's README).
-    fn order(&self) -> f64 {
-        1.0
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.dt
-    }
-    fn option_keys(&self) -> &'static [&'static str] {
-        OPTION_KEYS
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = Box2dSettings {
@@ -120,7 +117,7 @@ impl Engine for Box2dModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": s.dt,
             "substeps": s.substeps,
             "friction_model": s.friction.as_str(),

@@ -71,52 +71,123 @@ pub struct EngineCrate {
     pub version: &'static str,
 }
 
-/// One engine model: an engine, a scene and a friction law, runnable at any
-/// time step. Implemented by each engine crate; used through `dyn Engine`.
-pub trait Engine: Send + Sync {
-    /// The model name used in scenarios and outputs (`"rapier2d"`, …).
-    /// Compiled-in adapters return a `&'static str`; an outside engine
-    /// (declared in `pushval.toml`) returns the name it was declared under.
-    fn name(&self) -> &str;
+/// Which `[engine]` keys a model reads, besides `dt`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OptionKeys {
+    /// Exactly these keys; the command line refuses any other.
+    Listed(&'static [&'static str]),
+    /// Every key (an outside engine receives the table verbatim).
+    Any,
+}
+
+/// What a model is, in one value: everything the harness, the listings and
+/// the outputs need to know about an engine model besides running it.
+///
+/// Built once by the model's constructor ([`EngineInfo::new`] and the
+/// `with_*` setters) and returned by [`Engine::info`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct EngineInfo {
+    /// The model name used in scenarios and outputs (`"rapier2d"`, …); an
+    /// outside engine's is the name it was declared under.
+    pub name: String,
     /// One line saying what the model is (scene and friction law).
-    fn description(&self) -> &str;
-    /// The adapter crate (`pushval-rapier2d`, …), or where an outside
-    /// engine was declared (`outside: pushval.toml`).
-    fn adapter(&self) -> &str;
-    /// The engine crate this adapter depends on, with its version.
-    fn engine_crate(&self) -> EngineCrate;
-    /// The engine's version as shown to users; defaults to the engine crate's
-    /// (an adapter over a native library names the library's version too).
-    fn version(&self) -> String {
-        let c = self.engine_crate();
-        format!("{} {}", c.name, c.version)
-    }
+    pub description: String,
+    /// The adapter crate (`pushval-rapier2d`, …), or where an outside engine
+    /// was declared (`outside: pushval.toml`).
+    pub adapter: String,
+    /// The engine crate the adapter depends on, with its version.
+    pub engine_crate: EngineCrate,
+    /// The engine's version as shown to users: by default the engine crate's
+    /// (`rapier2d-f64 0.36.1`); an adapter over a native library names the
+    /// library's too.
+    pub version: String,
     /// The order of accuracy in the time step the model's steady ω and
     /// trajectory show (measured: see the adapter's README).
-    fn order(&self) -> f64;
+    pub order: f64,
+    /// The time step used when neither the scenario nor the ladder sets one (s).
+    pub default_dt: f64,
+    /// The `[engine]` keys the model reads, besides `dt`.
+    pub options: OptionKeys,
     /// Whether `[run] gate` may name it: it runs the scene the dynamic model
     /// describes closely enough that agreement is a meaningful test (an
     /// engine whose friction law differs can still be gated, and fails).
-    fn gateable(&self) -> bool {
-        true
-    }
+    pub gateable: bool,
     /// `Ok` when this build can run it; otherwise why not, naming the cargo
     /// feature that brings it in (e.g. "build with --features mujoco").
-    fn availability(&self) -> Result<(), String> {
-        Ok(())
+    pub available: Result<(), String>,
+}
+
+impl EngineInfo {
+    /// A gateable, available model reading no `[engine]` key besides `dt`,
+    /// whose version is its engine crate's.
+    pub fn new(
+        name: impl Into<String>,
+        description: impl Into<String>,
+        adapter: impl Into<String>,
+        engine_crate: EngineCrate,
+        order: f64,
+        default_dt: f64,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            description: description.into(),
+            adapter: adapter.into(),
+            version: format!("{} {}", engine_crate.name, engine_crate.version),
+            engine_crate,
+            order,
+            default_dt,
+            options: OptionKeys::Listed(&[]),
+            gateable: true,
+            available: Ok(()),
+        }
     }
-    /// The time step used when neither the scenario nor the ladder sets one (s).
-    fn default_dt(&self) -> f64;
-    /// The `[engine]` keys this model reads, besides `dt`.
-    fn option_keys(&self) -> &'static [&'static str] {
-        &[]
+
+    /// The `[engine]` keys the model reads.
+    #[must_use]
+    pub fn with_options(mut self, options: OptionKeys) -> Self {
+        self.options = options;
+        self
     }
-    /// Whether the model reads the `[engine]` key `key`: by default, whether
-    /// [`Engine::option_keys`] lists it. An outside engine receives the whole
-    /// table verbatim and accepts every key.
-    fn accepts_option(&self, key: &str) -> bool {
-        self.option_keys().contains(&key)
+
+    /// The version as shown to users.
+    #[must_use]
+    pub fn with_version(mut self, version: impl Into<String>) -> Self {
+        self.version = version.into();
+        self
     }
+
+    /// Whether this build can run the model.
+    #[must_use]
+    pub fn with_availability(mut self, available: Result<(), String>) -> Self {
+        self.available = available;
+        self
+    }
+
+    /// Whether `[run] gate` may name the model.
+    #[must_use]
+    pub fn with_gateable(mut self, gateable: bool) -> Self {
+        self.gateable = gateable;
+        self
+    }
+
+    /// Whether the model reads the `[engine]` key `key`.
+    pub fn accepts_option(&self, key: &str) -> bool {
+        match self.options {
+            OptionKeys::Listed(keys) => keys.contains(&key),
+            OptionKeys::Any => true,
+        }
+    }
+}
+
+/// One engine model: an engine, a scene and a friction law, runnable at any
+/// time step. Implemented by each engine crate; used through `dyn Engine`.
+///
+/// Four methods: what the model is ([`EngineInfo`]), the settings of a run,
+/// the run, and the friction law it declares. The accessors on `dyn Engine`
+/// (`name()`, `order()`, …) read [`Engine::info`].
+pub trait Engine: Send + Sync {
+    /// What the model is (name, version, order, default step, options, …).
+    fn info(&self) -> &EngineInfo;
     /// The settings that produce a run at `dt`, as JSON for the outputs
     /// (includes `"engine"`: the version, and `"dt"`).
     fn settings(&self, dt: f64) -> serde_json::Value;
@@ -127,6 +198,58 @@ pub trait Engine: Send + Sync {
     /// friction at every support). None by default.
     fn law(&self) -> Option<&dyn FrictionLaw> {
         None
+    }
+}
+
+/// Shorthands for the fields of [`Engine::info`].
+impl dyn Engine + '_ {
+    /// [`EngineInfo::name`].
+    pub fn name(&self) -> &str {
+        &self.info().name
+    }
+    /// [`EngineInfo::description`].
+    pub fn description(&self) -> &str {
+        &self.info().description
+    }
+    /// [`EngineInfo::adapter`].
+    pub fn adapter(&self) -> &str {
+        &self.info().adapter
+    }
+    /// [`EngineInfo::engine_crate`].
+    pub fn engine_crate(&self) -> EngineCrate {
+        self.info().engine_crate
+    }
+    /// [`EngineInfo::version`].
+    pub fn version(&self) -> String {
+        self.info().version.clone()
+    }
+    /// [`EngineInfo::order`].
+    pub fn order(&self) -> f64 {
+        self.info().order
+    }
+    /// [`EngineInfo::gateable`].
+    pub fn gateable(&self) -> bool {
+        self.info().gateable
+    }
+    /// [`EngineInfo::available`].
+    pub fn availability(&self) -> Result<(), String> {
+        self.info().available.clone()
+    }
+    /// [`EngineInfo::default_dt`].
+    pub fn default_dt(&self) -> f64 {
+        self.info().default_dt
+    }
+    /// The keys of [`EngineInfo::options`] (none listed for an engine that
+    /// accepts every key).
+    pub fn option_keys(&self) -> &'static [&'static str] {
+        match self.info().options {
+            OptionKeys::Listed(keys) => keys,
+            OptionKeys::Any => &[],
+        }
+    }
+    /// [`EngineInfo::accepts_option`].
+    pub fn accepts_option(&self, key: &str) -> bool {
+        self.info().accepts_option(key)
     }
 }
 

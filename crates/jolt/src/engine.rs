@@ -4,8 +4,8 @@
 //! listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
+    ModelEntry, OptionError,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -22,10 +22,44 @@ pub const ENGINE_CRATE: EngineCrate = EngineCrate {
 pub const JOLT_VERSION: &str = "5.6.0";
 
 /// One Jolt model (a collider).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct JoltModel {
+    info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: JoltSettings,
+}
+
+impl JoltModel {
+    /// The model of `settings`' scene.
+    pub fn new(settings: JoltSettings) -> Self {
+        let description = match settings.scene {
+            Scene::Box => {
+                "plate as one box collider on a floor, Jolt 5.6 (one 4-point manifold: friction disc at the points' average plus a twist row)"
+            }
+            Scene::Feet => {
+                "plate on sphere feet on a floor, Jolt 5.6 (one-point manifolds, manifold reduction off: a friction disc per foot)"
+            }
+        };
+        // Symplectic Euler with the pusher at the mid-step heading: first order.
+        let info = EngineInfo::new(
+            settings.scene.model_name(),
+            description,
+            "pushval-jolt",
+            ENGINE_CRATE,
+            1.0,
+            settings.dt,
+        )
+        .with_version(format!(
+            "Jolt {JOLT_VERSION} ({} {})",
+            ENGINE_CRATE.name, ENGINE_CRATE.version
+        ))
+        .with_availability(if AVAILABLE {
+            Ok(())
+        } else {
+            Err("build with --features jolt (needs cmake: apt-get install cmake)".into())
+        });
+        Self { info, settings }
+    }
 }
 
 fn build(scene: Scene, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
@@ -36,7 +70,7 @@ fn build(scene: Scene, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionEr
     if let Some(dt) = opts.dt {
         settings.dt = dt;
     }
-    Ok(Box::new(JoltModel { settings }))
+    Ok(Box::new(JoltModel::new(settings)))
 }
 
 /// The Jolt models: the crate's entries in pushval's engine registry.
@@ -54,44 +88,8 @@ pub fn models() -> Vec<ModelEntry> {
 }
 
 impl Engine for JoltModel {
-    fn name(&self) -> &'static str {
-        self.settings.scene.model_name()
-    }
-    fn description(&self) -> &'static str {
-        match self.settings.scene {
-            Scene::Box => {
-                "plate as one box collider on a floor, Jolt 5.6 (one 4-point manifold: friction disc at the points' average plus a twist row)"
-            }
-            Scene::Feet => {
-                "plate on sphere feet on a floor, Jolt 5.6 (one-point manifolds, manifold reduction off: a friction disc per foot)"
-            }
-        }
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-jolt"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        ENGINE_CRATE
-    }
-    fn version(&self) -> String {
-        format!(
-            "Jolt {JOLT_VERSION} ({} {})",
-            ENGINE_CRATE.name, ENGINE_CRATE.version
-        )
-    }
-    /// Symplectic Euler with the pusher at the mid-step heading: first order.
-    fn order(&self) -> f64 {
-        1.0
-    }
-    fn availability(&self) -> Result<(), String> {
-        if AVAILABLE {
-            Ok(())
-        } else {
-            Err("build with --features jolt (needs cmake: apt-get install cmake)".into())
-        }
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.dt
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
         Some(self)
@@ -102,7 +100,7 @@ impl Engine for JoltModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": dt,
             "scene": s.scene.as_str(),
             "velocity_steps": s.velocity_steps,

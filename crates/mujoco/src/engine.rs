@@ -4,8 +4,8 @@
 //! available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
+    ModelEntry, OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -20,10 +20,47 @@ pub const ENGINE_CRATE: EngineCrate = EngineCrate {
 };
 
 /// One MuJoCo model (a friction cone).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MujocoModel {
+    info: EngineInfo,
     /// The settings of a run (its `timestep` is replaced by the run's dt).
     pub settings: MujocoSettings,
+}
+
+impl MujocoModel {
+    /// The model of `settings`' friction cone.
+    pub fn new(settings: MujocoSettings) -> Self {
+        let (name, description) = match settings.cone {
+            Cone::Pyramidal => (
+                "mujoco_pyramidal",
+                "plate on sphere feet on a floor, MuJoCo's soft contacts, pyramidal friction cone",
+            ),
+            Cone::Elliptic => (
+                "mujoco_elliptic",
+                "plate on sphere feet on a floor, MuJoCo's soft contacts, elliptic friction cone",
+            ),
+        };
+        // Semi-implicit Euler: first order. Options: `cm_height` and
+        // `push_height` (m, >= 0; [`MujocoSettings`]).
+        let info = EngineInfo::new(
+            name,
+            description,
+            "pushval-mujoco",
+            ENGINE_CRATE,
+            1.0,
+            settings.timestep,
+        )
+        .with_options(OptionKeys::Listed(&["cm_height", "push_height"]))
+        .with_availability(if AVAILABLE {
+            Ok(())
+        } else {
+            Err(
+                "build with --features mujoco (and run scripts/setup-mujoco.sh for libmujoco.so)"
+                    .into(),
+            )
+        });
+        Self { info, settings }
+    }
 }
 
 fn build(cone: Cone, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
@@ -40,7 +77,7 @@ fn build(cone: Cone, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionErro
     if let Some(h) = opts.non_negative("push_height")? {
         settings.push_height = h;
     }
-    Ok(Box::new(MujocoModel { settings }))
+    Ok(Box::new(MujocoModel::new(settings)))
 }
 
 /// The MuJoCo models: the crate's entries in pushval's engine registry.
@@ -58,48 +95,8 @@ pub fn models() -> Vec<ModelEntry> {
 }
 
 impl Engine for MujocoModel {
-    fn name(&self) -> &'static str {
-        match self.settings.cone {
-            Cone::Pyramidal => "mujoco_pyramidal",
-            Cone::Elliptic => "mujoco_elliptic",
-        }
-    }
-    fn description(&self) -> &'static str {
-        match self.settings.cone {
-            Cone::Pyramidal => {
-                "plate on sphere feet on a floor, MuJoCo's soft contacts, pyramidal friction cone"
-            }
-            Cone::Elliptic => {
-                "plate on sphere feet on a floor, MuJoCo's soft contacts, elliptic friction cone"
-            }
-        }
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-mujoco"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        ENGINE_CRATE
-    }
-    /// Semi-implicit Euler: first order.
-    fn order(&self) -> f64 {
-        1.0
-    }
-    fn availability(&self) -> Result<(), String> {
-        if AVAILABLE {
-            Ok(())
-        } else {
-            Err(
-                "build with --features mujoco (and run scripts/setup-mujoco.sh for libmujoco.so)"
-                    .into(),
-            )
-        }
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.timestep
-    }
-    /// `cm_height` and `push_height` (m, ≥ 0; [`MujocoSettings`]).
-    fn option_keys(&self) -> &'static [&'static str] {
-        &["cm_height", "push_height"]
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = MujocoSettings {
@@ -107,7 +104,7 @@ impl Engine for MujocoModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": dt,
             "timestep": dt,
             "cone": s.cone.as_str(),

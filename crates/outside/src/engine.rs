@@ -4,7 +4,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use pushval_engine::{
-    trajectory_from_steps, Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, StepRecord,
+    trajectory_from_steps, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw,
+    OptionKeys, StepRecord,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -23,8 +24,7 @@ pub struct OutsideEngine {
     spec: Arc<Spec>,
     law: Option<Arc<dyn FrictionLaw>>,
     options: EngineOptions,
-    adapter: String,
-    description: String,
+    info: EngineInfo,
 }
 
 impl std::fmt::Debug for OutsideEngine {
@@ -45,14 +45,36 @@ impl OutsideEngine {
             || spec.file.display().to_string(),
             |f| f.to_string_lossy().into_owned(),
         );
+        let adapter = format!("outside: {file}");
+        let description = format!(
+            "outside engine: `{}` run from {} (declared in {})",
+            spec.command_line(),
+            spec.dir.display(),
+            spec.file.display()
+        );
+        // The protocol's crate: an outside engine links no engine crate.
+        let engine_crate = EngineCrate {
+            name: "pushval-outside",
+            version: env!("CARGO_PKG_VERSION"),
+        };
+        let version = spec
+            .version
+            .clone()
+            .unwrap_or_else(|| format!("unversioned ({adapter} gives no version)"));
+        let info = EngineInfo::new(
+            spec.name.clone(),
+            description,
+            adapter,
+            engine_crate,
+            spec.order,
+            options.dt.unwrap_or(spec.dt),
+        )
+        .with_version(version)
+        .with_availability(spec.availability())
+        // Every key: the process receives the whole `[engine]` table.
+        .with_options(OptionKeys::Any);
         Self {
-            adapter: format!("outside: {file}"),
-            description: format!(
-                "outside engine: `{}` run from {} (declared in {})",
-                spec.command_line(),
-                spec.dir.display(),
-                spec.file.display()
-            ),
+            info,
             options: options.clone(),
             spec,
             law: None,
@@ -84,44 +106,12 @@ impl OutsideEngine {
 }
 
 impl Engine for OutsideEngine {
-    fn name(&self) -> &str {
-        &self.spec.name
-    }
-    fn description(&self) -> &str {
-        &self.description
-    }
-    fn adapter(&self) -> &str {
-        &self.adapter
-    }
-    /// The protocol's crate: an outside engine links no engine crate.
-    fn engine_crate(&self) -> EngineCrate {
-        EngineCrate {
-            name: "pushval-outside",
-            version: env!("CARGO_PKG_VERSION"),
-        }
-    }
-    fn version(&self) -> String {
-        self.spec
-            .version
-            .clone()
-            .unwrap_or_else(|| format!("unversioned ({} gives no version)", self.adapter))
-    }
-    fn order(&self) -> f64 {
-        self.spec.order
-    }
-    fn availability(&self) -> Result<(), String> {
-        self.spec.availability()
-    }
-    fn default_dt(&self) -> f64 {
-        self.options.dt.unwrap_or(self.spec.dt)
-    }
-    /// Every key: the process receives the whole `[engine]` table.
-    fn accepts_option(&self, _key: &str) -> bool {
-        true
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": dt,
             "command": self.spec.command,
             "declared_in": self.spec.file.display().to_string(),

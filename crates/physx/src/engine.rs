@@ -4,8 +4,8 @@
 //! `physx` feature they are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
+    ModelEntry, OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -28,10 +28,52 @@ pub const ENGINE_CRATE: EngineCrate = EngineCrate {
 pub const PHYSX_SDK_VERSION: &str = "5.1.3";
 
 /// One PhysX model (a friction type).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PhysxModel {
+    info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: PhysxSettings,
+}
+
+impl PhysxModel {
+    /// The model of `settings`' friction type.
+    pub fn new(settings: PhysxSettings) -> Self {
+        let description = match settings.friction {
+            FrictionType::Patch => {
+                "plate on sphere feet on a ground plane, PhysX 5 PGS, patch friction (ePATCH)"
+            }
+            FrictionType::TwoDirectional => {
+                "plate on sphere feet on a ground plane, PhysX 5 PGS, per-point two-axis friction (eTWO_DIRECTIONAL)"
+            }
+            FrictionType::OneDirectional => {
+                "plate on sphere feet on a ground plane, PhysX 5 PGS, per-point one-axis friction (eONE_DIRECTIONAL)"
+            }
+        };
+        // Symplectic Euler with the pusher at the mid-step heading: first order.
+        let info = EngineInfo::new(
+            settings.friction.model_name(),
+            description,
+            "pushval-physx",
+            ENGINE_CRATE,
+            1.0,
+            settings.dt,
+        )
+        .with_version(format!(
+            "{} {} (PhysX {})",
+            ENGINE_CRATE.name, ENGINE_CRATE.version, PHYSX_SDK_VERSION
+        ))
+        .with_options(OptionKeys::Listed(&[
+            "contacts",
+            "position_iterations",
+            "velocity_iterations",
+        ]))
+        .with_availability(if AVAILABLE {
+            Ok(())
+        } else {
+            Err("build with --features physx (needs clang++: apt-get install clang)".into())
+        });
+        Self { info, settings }
+    }
 }
 
 fn build(friction: FrictionType, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
@@ -55,7 +97,7 @@ fn build(friction: FrictionType, opts: &EngineOptions) -> Result<Box<dyn Engine>
     if let Some(n) = opts.integer("velocity_iterations", 1)? {
         settings.velocity_iterations = n.min(255) as u32;
     }
-    Ok(Box::new(PhysxModel { settings }))
+    Ok(Box::new(PhysxModel::new(settings)))
 }
 
 /// The PhysX models: the crate's entries in pushval's engine registry.
@@ -77,50 +119,8 @@ pub fn models() -> Vec<ModelEntry> {
 }
 
 impl Engine for PhysxModel {
-    fn name(&self) -> &'static str {
-        self.settings.friction.model_name()
-    }
-    fn description(&self) -> &'static str {
-        match self.settings.friction {
-            FrictionType::Patch => {
-                "plate on sphere feet on a ground plane, PhysX 5 PGS, patch friction (ePATCH)"
-            }
-            FrictionType::TwoDirectional => {
-                "plate on sphere feet on a ground plane, PhysX 5 PGS, per-point two-axis friction (eTWO_DIRECTIONAL)"
-            }
-            FrictionType::OneDirectional => {
-                "plate on sphere feet on a ground plane, PhysX 5 PGS, per-point one-axis friction (eONE_DIRECTIONAL)"
-            }
-        }
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-physx"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        ENGINE_CRATE
-    }
-    fn version(&self) -> String {
-        format!(
-            "{} {} (PhysX {})",
-            ENGINE_CRATE.name, ENGINE_CRATE.version, PHYSX_SDK_VERSION
-        )
-    }
-    /// Symplectic Euler with the pusher at the mid-step heading: first order.
-    fn order(&self) -> f64 {
-        1.0
-    }
-    fn availability(&self) -> Result<(), String> {
-        if AVAILABLE {
-            Ok(())
-        } else {
-            Err("build with --features physx (needs clang++: apt-get install clang)".into())
-        }
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.dt
-    }
-    fn option_keys(&self) -> &'static [&'static str] {
-        &["contacts", "position_iterations", "velocity_iterations"]
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
         Some(self)
@@ -131,7 +131,7 @@ impl Engine for PhysxModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": dt,
             "friction_type": s.friction.physx_name(),
             "contacts": s.contacts.as_str(),

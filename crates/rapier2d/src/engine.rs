@@ -2,8 +2,8 @@
 //! Coulomb forces, gated by default) and the four 2-D friction idioms.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
+    ModelEntry, OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -22,10 +22,9 @@ pub const ENGINE_CRATE: EngineCrate = EngineCrate {
 const IDIOM_SLIP_SPEED: f64 = 0.01;
 
 /// One rapier2d model: a friction law and the scenario's engine settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Rapier2dModel {
-    name: &'static str,
-    description: &'static str,
+    info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: EngineSettings,
 }
@@ -33,9 +32,37 @@ pub struct Rapier2dModel {
 impl Rapier2dModel {
     /// The model with the given name and settings.
     pub fn new(name: &'static str, description: &'static str, settings: EngineSettings) -> Self {
+        let engine_crate = match settings.precision {
+            Precision::F64 => ENGINE_CRATE,
+            Precision::F32 => EngineCrate {
+                name: "rapier2d",
+                ..ENGINE_CRATE
+            },
+        };
+        // Second order in leapfrog mode, first in the others (measured: see
+        // the crate's README).
+        let order = match settings.friction_velocity {
+            FrictionVelocity::Leapfrog => 2.0,
+            _ => 1.0,
+        };
+        let keys = if matches!(
+            settings.friction_model,
+            FrictionModel::RegularisedLinear { .. } | FrictionModel::RegularisedTanh { .. }
+        ) {
+            REGULARISED_KEYS
+        } else {
+            OPTION_KEYS
+        };
         Self {
-            name,
-            description,
+            info: EngineInfo::new(
+                name,
+                description,
+                "pushval-rapier2d",
+                engine_crate,
+                order,
+                settings.dt,
+            )
+            .with_options(OptionKeys::Listed(keys)),
             settings,
         }
     }
@@ -166,44 +193,8 @@ pub fn models() -> Vec<ModelEntry> {
 }
 
 impl Engine for Rapier2dModel {
-    fn name(&self) -> &'static str {
-        self.name
-    }
-    fn description(&self) -> &'static str {
-        self.description
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-rapier2d"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        match self.settings.precision {
-            Precision::F64 => ENGINE_CRATE,
-            Precision::F32 => EngineCrate {
-                name: "rapier2d",
-                ..ENGINE_CRATE
-            },
-        }
-    }
-    /// Second order in leapfrog mode, first in the others (measured: see the
-    /// crate's README).
-    fn order(&self) -> f64 {
-        match self.settings.friction_velocity {
-            FrictionVelocity::Leapfrog => 2.0,
-            _ => 1.0,
-        }
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.dt
-    }
-    fn option_keys(&self) -> &'static [&'static str] {
-        if matches!(
-            self.settings.friction_model,
-            FrictionModel::RegularisedLinear { .. } | FrictionModel::RegularisedTanh { .. }
-        ) {
-            REGULARISED_KEYS
-        } else {
-            OPTION_KEYS
-        }
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = EngineSettings {
@@ -211,7 +202,7 @@ impl Engine for Rapier2dModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": s.dt,
             "solver_iterations": s.solver_iterations,
             "pgs_iterations": s.pgs_iterations,
@@ -241,7 +232,7 @@ impl Engine for Rapier2dModel {
         })
         .run(problem)?;
         let mut trajectory = r.trajectory;
-        trajectory.model = self.name.to_string();
+        trajectory.model = self.info.name.clone();
         Ok(EngineRun {
             trajectory,
             dt,

@@ -3,8 +3,8 @@
 //! `Simplified`), the plate on ball feet on a ground plane.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
+    ModelEntry, OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -20,10 +20,38 @@ pub const ENGINE_CRATE: EngineCrate = EngineCrate {
 };
 
 /// One rapier3d model.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Rapier3dModel {
+    info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Rapier3dSettings,
+}
+
+impl Rapier3dModel {
+    /// The model of `settings`' contact friction.
+    pub fn new(settings: Rapier3dSettings) -> Self {
+        let (name, description) = match settings.friction {
+            ContactFriction::Coulomb => (
+                "rapier3d",
+                "plate on ball feet on a ground plane, rapier's own contact friction (FrictionModel::Coulomb)",
+            ),
+            ContactFriction::Simplified => (
+                "rapier3d_simplified",
+                "plate on ball feet on a ground plane, rapier's default FrictionModel::Simplified",
+            ),
+        };
+        // Symplectic Euler with the pusher at the mid-step heading: first order.
+        let info = EngineInfo::new(
+            name,
+            description,
+            "pushval-rapier3d",
+            ENGINE_CRATE,
+            1.0,
+            settings.dt,
+        )
+        .with_options(OptionKeys::Listed(&["feet", "cm_height", "push_height"]));
+        Self { info, settings }
+    }
 }
 
 fn build(friction: ContactFriction, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
@@ -48,7 +76,7 @@ fn build(friction: ContactFriction, opts: &EngineOptions) -> Result<Box<dyn Engi
     if let Some(h) = opts.non_negative("push_height")? {
         settings.push_height = h;
     }
-    Ok(Box::new(Rapier3dModel { settings }))
+    Ok(Box::new(Rapier3dModel::new(settings)))
 }
 
 /// The rapier3d models: the crate's entries in pushval's engine registry.
@@ -66,37 +94,8 @@ pub fn models() -> Vec<ModelEntry> {
 }
 
 impl Engine for Rapier3dModel {
-    fn name(&self) -> &'static str {
-        match self.settings.friction {
-            ContactFriction::Coulomb => "rapier3d",
-            ContactFriction::Simplified => "rapier3d_simplified",
-        }
-    }
-    fn description(&self) -> &'static str {
-        match self.settings.friction {
-            ContactFriction::Coulomb => {
-                "plate on ball feet on a ground plane, rapier's own contact friction (FrictionModel::Coulomb)"
-            }
-            ContactFriction::Simplified => {
-                "plate on ball feet on a ground plane, rapier's default FrictionModel::Simplified"
-            }
-        }
-    }
-    fn adapter(&self) -> &'static str {
-        "pushval-rapier3d"
-    }
-    fn engine_crate(&self) -> EngineCrate {
-        ENGINE_CRATE
-    }
-    /// Symplectic Euler with the pusher at the mid-step heading: first order.
-    fn order(&self) -> f64 {
-        1.0
-    }
-    fn default_dt(&self) -> f64 {
-        self.settings.dt
-    }
-    fn option_keys(&self) -> &'static [&'static str] {
-        &["feet", "cm_height", "push_height"]
+    fn info(&self) -> &EngineInfo {
+        &self.info
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
         Some(self)
@@ -107,7 +106,7 @@ impl Engine for Rapier3dModel {
             ..self.settings
         };
         serde_json::json!({
-            "engine": self.version(),
+            "engine": self.info.version,
             "dt": s.dt,
             "friction_model": s.friction.as_str(),
             "feet": s.feet.as_str(),
