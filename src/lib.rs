@@ -9,6 +9,7 @@ pub mod outside;
 pub mod power;
 pub mod registry;
 pub mod report;
+pub mod shipped;
 pub mod stress;
 pub mod study;
 pub mod track;

@@ -3,7 +3,7 @@
 //! Exit codes: 0 every gated tolerance holds, 1 a tolerance failed, 2 unusable
 //! input or an error (nothing is written then).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
@@ -211,6 +211,17 @@ enum Command {
         #[arg(long, value_name = "NAME")]
         engine: Option<String>,
     },
+    /// Write what pushval ships inside its binary (the scenarios, the study
+    /// files and the protocol's JSON schemas) into OUT/scenarios,
+    /// OUT/studies and OUT/schemas, to read or to start from.
+    Shipped {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = ".")]
+        out: PathBuf,
+        /// Overwrite files that exist.
+        #[arg(long)]
+        force: bool,
+    },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
         file: PathBuf,
@@ -220,25 +231,52 @@ enum Command {
     },
 }
 
-/// Every scenario file in the default folder: `./scenarios`, else the one
-/// beside this crate's manifest.
-fn default_scenarios() -> anyhow::Result<Vec<PathBuf>> {
-    let local = PathBuf::from("scenarios");
-    let dir = if local.is_dir() {
-        local
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
-    };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .with_context(|| format!("reading {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    if files.is_empty() {
-        bail!("no scenario files in {}", dir.display());
+/// The scenarios the main job validates when no file is named: every
+/// `*.toml` of the project's `scenarios/` (beside the `pushval.toml` in use),
+/// else of `./scenarios`, else the shipped ones. Shipped scenarios that name
+/// a model this registry lacks (an outside engine of pushval's own
+/// repository) are skipped with a note.
+fn default_scenarios() -> anyhow::Result<Vec<Scenario>> {
+    let dirs = [
+        pushval::registry::project_dir().map(|d| d.join("scenarios")),
+        Some(PathBuf::from("scenarios")),
+    ];
+    if let Some(dir) = dirs.into_iter().flatten().find(|d| d.is_dir()) {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+            .with_context(|| format!("reading {}", dir.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        files.sort();
+        if files.is_empty() {
+            bail!("no scenario files in {}", dir.display());
+        }
+        return load_all(&files);
     }
-    Ok(files)
+    let mut out = Vec::new();
+    for (name, text) in pushval::shipped::SCENARIOS {
+        let label = pushval::shipped::label("scenarios", name);
+        let raw = Scenario::from_toml(text, &label)?;
+        let missing: Vec<&String> = raw
+            .models
+            .iter()
+            .chain(&raw.gate)
+            .filter(|m| {
+                !pushval_scenario::ANALYTIC_MODELS.contains(&m.as_str())
+                    && pushval::registry::entry(m).is_none()
+            })
+            .collect();
+        if let Some(m) = missing.first() {
+            eprintln!(
+                "note: skipping {}: model `{m}` is not in this registry ({})",
+                label.display(),
+                pushval::registry::engines_file()
+            );
+            continue;
+        }
+        out.push(pushval::registry::from_toml(text, &label)?);
+    }
+    Ok(out)
 }
 
 /// Loads every file first, so that unusable input stops the run before any work.
@@ -254,12 +292,11 @@ fn validate(
     as_json: bool,
     junit: Option<PathBuf>,
 ) -> anyhow::Result<ExitCode> {
-    let files = if files.is_empty() {
+    let scenarios = if files.is_empty() {
         default_scenarios()?
     } else {
-        files
+        load_all(&files)?
     };
-    let scenarios = load_all(&files)?;
     let opts = RunOptions::default();
     let mut reports: Vec<ScenarioReport> = Vec::new();
     for sc in &scenarios {
@@ -387,6 +424,12 @@ fn main() -> ExitCode {
         None => validate(Vec::new(), false, None),
         Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Shipped { out, force }) => {
+            pushval::shipped::write_out(&out, force).map(|files| {
+                println!("wrote {} files under {}", files.len(), out.display());
+                ExitCode::SUCCESS
+            })
+        }
         Some(Command::Problem { file, dt, engine }) => problem(file, dt, engine),
         Some(Command::Power { out, quick }) => pushval::power::cli(&out, quick),
         Some(Command::Fit {

@@ -49,8 +49,27 @@ fn law(name: &str) -> Option<Arc<dyn FrictionLaw>> {
 }
 
 /// The file outside engines are declared in when `--engines` names none:
-/// `pushval.toml` in the current directory.
+/// `pushval.toml`, found as cargo finds `Cargo.toml` ([`find_engines_file`]).
 pub const ENGINES_FILE: &str = "pushval.toml";
+
+/// The `pushval.toml` that applies in `dir`: the one in `dir`, else in its
+/// nearest parent that has one; None when no folder up to the root has one.
+pub fn find_engines_file(dir: &Path) -> Option<PathBuf> {
+    dir.ancestors()
+        .map(|d| d.join(ENGINES_FILE))
+        .find(|f| f.is_file())
+}
+
+/// The folder of the `pushval.toml` in use (the project's root, whose
+/// `scenarios/` the main job validates), or None when none was found.
+pub fn project_dir() -> Option<PathBuf> {
+    OUTSIDE
+        .read()
+        .expect("not poisoned")
+        .as_ref()
+        .filter(|o| o.config.is_some())
+        .and_then(|o| o.searched.parent().map(Path::to_path_buf))
+}
 
 /// The outside engines in use: the file searched and what it declared
 /// (None: the file does not exist).
@@ -63,13 +82,18 @@ struct Outside {
 static OUTSIDE: RwLock<Option<Outside>> = RwLock::new(None);
 
 /// Loads the outside engines: `file` (from `--engines`; it must exist), or
-/// [`ENGINES_FILE`] in the current directory when present. A name that is
+/// the [`ENGINES_FILE`] of the current folder or its nearest parent that has
+/// one ([`find_engines_file`]). A name that is
 /// already an analytic model or a compiled-in engine is refused, naming the
 /// file and the key. Replaces what an earlier call loaded.
 pub fn use_engines_file(file: Option<&Path>) -> Result<(), pushval_outside::ConfigError> {
     let (searched, required) = match file {
         Some(f) => (f.to_path_buf(), true),
-        None => (PathBuf::from(ENGINES_FILE), false),
+        None => {
+            let cwd = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
+            let found = find_engines_file(&cwd);
+            (found.unwrap_or_else(|| cwd.join(ENGINES_FILE)), false)
+        }
     };
     let searched = std::path::absolute(&searched).unwrap_or(searched);
     let config = if required || searched.is_file() {

@@ -70,14 +70,19 @@ impl Options {
     }
 }
 
-/// `./scenarios` when it exists, else the one beside this crate's manifest.
+/// The scenarios folder the commands read: the project's `scenarios/`
+/// (beside the `pushval.toml` in use), else `./scenarios`, else the shipped
+/// scenarios written out once ([`crate::shipped::materialized`]).
 pub fn default_scenario_dir() -> PathBuf {
-    let local = PathBuf::from("scenarios");
-    if local.is_dir() {
-        local
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
-    }
+    let dirs = [
+        crate::registry::project_dir().map(|d| d.join("scenarios")),
+        Some(PathBuf::from("scenarios")),
+    ];
+    dirs.into_iter()
+        .flatten()
+        .find(|d| d.is_dir())
+        .or_else(|| crate::shipped::materialized("scenarios").ok())
+        .unwrap_or_else(|| PathBuf::from("scenarios"))
 }
 
 /// What a figure shows, for `results/README.md`.

@@ -34,7 +34,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context};
+use anyhow::Context;
 use pushval_engine::EngineOptions;
 use serde::Deserialize;
 
@@ -96,14 +96,14 @@ pub struct Variant {
     pub map: bool,
 }
 
-/// The folder of the study files: `studies/` here, else the package's.
+/// The folder of the study files: `./studies`, else the shipped study files
+/// written out once ([`crate::shipped::materialized`]).
 pub fn default_dir() -> PathBuf {
     let local = PathBuf::from("studies");
     if local.is_dir() {
-        local
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("studies")
+        return local;
     }
+    crate::shipped::materialized("studies").unwrap_or(local)
 }
 
 impl Spec {
@@ -254,22 +254,30 @@ fn name_ok(key: &str, name: &str) -> Result<(), (String, String)> {
     Ok(())
 }
 
-/// Refuses a study file for a model the registry does not list.
+/// The study files of `dir` named after no model of the registry: each is
+/// skipped with a note on standard error (a folder of study files serves
+/// several registries: the user's `pushval.toml` lists other engines than
+/// pushval's own).
 pub fn check_names(dir: &Path, models: &[String]) -> anyhow::Result<()> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(());
     };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.extension().is_some_and(|x| x == "toml") {
+    let mut skipped: Vec<PathBuf> = entries
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .filter(|p| {
             let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-            if !models.iter().any(|m| m == stem) {
-                bail!(
-                    "{}: no engine model `{stem}`; a study file is named after a model of `pushval engines`",
-                    p.display()
-                );
-            }
-        }
+            !models.iter().any(|m| m == stem)
+        })
+        .collect();
+    skipped.sort();
+    for p in skipped {
+        eprintln!(
+            "note: skipping {}: no engine model `{}` in this registry (`pushval engines`)",
+            p.display(),
+            p.file_stem().and_then(|s| s.to_str()).unwrap_or_default()
+        );
     }
     Ok(())
 }

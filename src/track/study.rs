@@ -175,11 +175,10 @@ fn measurements(s: &[Sample]) -> Vec<Measurement> {
         .collect()
 }
 
+/// A shipped scenario (the binary's own copy: the study measures pushval's
+/// scenarios whatever folder it runs in).
 fn load(name: &str) -> anyhow::Result<Scenario> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenarios")
-        .join(name);
-    Ok(crate::registry::load(&path)?)
+    crate::shipped::scenario(name)
 }
 
 /// The paper pushes.

@@ -2,6 +2,7 @@
 //! the optimised test profile (see the README's test command).
 
 mod adapters;
+mod anywhere;
 mod assumptions;
 mod bad_input;
 mod cli;
