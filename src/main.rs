@@ -40,6 +40,11 @@ enum Command {
         /// Also write a JUnit XML report to this file (for CI systems).
         #[arg(long, value_name = "FILE")]
         junit: Option<PathBuf>,
+        /// Refuse (exit 2) any [tolerance] number above the default auto
+        /// ceiling whose file gives no `reason` (for CI that runs scenarios
+        /// it did not write).
+        #[arg(long)]
+        deny_loose: bool,
     },
     /// Measure an outside trajectory (trajectory.csv columns) against the
     /// dynamic model and rapier2d with the scenario's tolerances; exit 1 when
@@ -291,12 +296,26 @@ fn validate(
     files: Vec<PathBuf>,
     as_json: bool,
     junit: Option<PathBuf>,
+    deny_loose: bool,
 ) -> anyhow::Result<ExitCode> {
     let scenarios = if files.is_empty() {
         default_scenarios()?
     } else {
         load_all(&files)?
     };
+    if deny_loose {
+        for sc in scenarios.iter().filter(|sc| sc.tolerance.reason.is_none()) {
+            if let Some(l) = sc.tolerance.loosened().first() {
+                bail!(
+                    "{}: key `{}`: {} is above the default auto ceiling {} and the file gives no [tolerance] reason (--deny-loose)",
+                    sc.path.display(),
+                    l.key,
+                    l.value,
+                    l.ceiling
+                );
+            }
+        }
+    }
     let opts = RunOptions::default();
     let mut reports: Vec<ScenarioReport> = Vec::new();
     for sc in &scenarios {
@@ -421,8 +440,13 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let result = match cli.command {
-        None => validate(Vec::new(), false, None),
-        Some(Command::Validate { files, json, junit }) => validate(files, json, junit),
+        None => validate(Vec::new(), false, None, false),
+        Some(Command::Validate {
+            files,
+            json,
+            junit,
+            deny_loose,
+        }) => validate(files, json, junit, deny_loose),
         Some(Command::Run { file, out }) => run(file, out),
         Some(Command::Shipped { out, force }) => {
             pushval::shipped::write_out(&out, force).map(|files| {

@@ -104,6 +104,8 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "rhs_evals": run.map(|r| r.trajectory.stats.rhs_evals),
                 "diagnostics": run.map_or(Value::Null, |r| r.diagnostics.clone()),
                 "tolerance": c.tolerance.as_ref().map_or(Value::Null, |t| t.json()),
+                "loosened": c.pass.is_some() && !sc.tolerance.loosened().is_empty(),
+                "warnings": if c.pass.is_some() { gate_warnings(sc, &c.model) } else { Vec::new() },
                 "convergence": c.convergence.as_ref().map_or(Value::Null, |v| json!({
                     "dts": v.dts,
                     "expected_order": v.expected_order,
@@ -137,6 +139,10 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "position_max": limit(sc.tolerance.position_max),
                 "theta_max": limit(sc.tolerance.theta_max),
                 "auto_ceiling": sc.tolerance.auto_ceiling.map(num),
+                "loosened": sc.tolerance.loosened().iter().map(|l| json!({
+                    "key": l.key, "value": num(l.value), "ceiling": num(l.ceiling),
+                })).collect::<Vec<_>>(),
+                "reason": sc.tolerance.reason,
             },
         },
         "segments": segments,
@@ -154,6 +160,38 @@ pub fn summary(report: &ScenarioReport) -> Value {
             "min_support_speed": num(a.min_support_speed),
         },
     })
+}
+
+/// What a gated row must say about the gate itself: a loosened tolerance
+/// (a `[tolerance]` number above the default auto ceiling, with the file's
+/// reason or the lack of one), and a scenario that switches continuously
+/// while engines switch impulsively.
+pub fn gate_warnings(sc: &pushval_scenario::Scenario, model: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let loose = sc.tolerance.loosened();
+    if !loose.is_empty() {
+        let keys: Vec<String> = loose
+            .iter()
+            .map(|l| format!("{} = {} > {}", l.key, fmt_e(l.value), fmt_e(l.ceiling)))
+            .collect();
+        out.push(format!(
+            "LOOSENED {} ({})",
+            keys.join(", "),
+            sc.tolerance
+                .reason
+                .as_ref()
+                .map_or("no reason given".to_string(), |r| format!("reason: {r}"))
+        ));
+    }
+    if sc.switching == pushval_model::Switching::Continuous
+        && !pushval_scenario::ANALYTIC_MODELS.contains(&model)
+    {
+        out.push(
+            "switching = \"continuous\": the model blends pushes over a switch, engines switch impulsively (differences at each switch are expected; use \"impulsive\" to gate an engine)"
+                .to_string(),
+        );
+    }
+    out
 }
 
 /// Short names of the assumption checks that failed, for the table.
@@ -283,6 +321,9 @@ pub fn table(reports: &[ScenarioReport]) -> String {
             }
             if c.model == "dynamic" && !flags.is_empty() {
                 notes.push(format!("assumptions fail: {}", flags.join(", ")));
+            }
+            if c.pass.is_some() {
+                notes.extend(gate_warnings(&r.scenario, &c.model));
             }
             rows.push([
                 r.scenario.name.clone(),

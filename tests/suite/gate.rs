@@ -486,3 +486,108 @@ fn gated_rows_say_their_dt_ladder_verdict_and_what_they_catch() {
         figure_at(0.5)
     );
 }
+
+/// A `[tolerance]` number above the default auto ceiling is a loosened gate:
+/// the row and summary.json say so, with the file's reason or its lack;
+/// `validate --deny-loose` refuses an unexplained one naming the key and
+/// accepts an explained one. 100 m lets a trajectory 1.5 m off pass, which
+/// is why it must be marked.
+#[test]
+fn loosened_tolerances_are_marked_and_deny_loose_refuses_unexplained_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper-square-v0.2.toml"),
+    )
+    .unwrap();
+    assert!(
+        !base.contains("[tolerance]"),
+        "the base scenario sets no tolerance"
+    );
+    let loose = dir.path().join("loose.toml");
+    std::fs::write(
+        &loose,
+        format!("{base}\n[tolerance]\nposition_max = 100.0\n"),
+    )
+    .unwrap();
+    let explained = dir.path().join("explained.toml");
+    std::fs::write(
+        &explained,
+        format!("{base}\n[tolerance]\nposition_max = 100.0\nreason = \"smoke test only\"\n"),
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_pushval");
+    let out = std::process::Command::new(bin)
+        .args(["validate", "--json"])
+        .arg(&loose)
+        .output()
+        .unwrap();
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = &doc[0]["settings"]["tolerance"]["loosened"][0];
+    assert_eq!(l["key"], "tolerance.position_max");
+    assert_eq!(l["value"], 100.0);
+    assert_eq!(l["ceiling"], 1e-3);
+    assert_eq!(doc[0]["models"]["rapier2d"]["loosened"], true);
+    let table = std::process::Command::new(bin)
+        .arg("validate")
+        .arg(&loose)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(text.contains("LOOSENED tolerance.position_max"), "{text}");
+    assert!(text.contains("no reason given"), "{text}");
+    let denied = std::process::Command::new(bin)
+        .args(["validate", "--deny-loose"])
+        .arg(&loose)
+        .output()
+        .unwrap();
+    assert_eq!(denied.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&denied.stderr);
+    assert!(
+        err.contains("loose.toml") && err.contains("tolerance.position_max"),
+        "{err}"
+    );
+    let ok = std::process::Command::new(bin)
+        .args(["validate", "--deny-loose"])
+        .arg(&explained)
+        .output()
+        .unwrap();
+    assert_eq!(
+        ok.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(String::from_utf8_lossy(&ok.stdout).contains("reason: smoke test only"));
+}
+
+/// A gated engine on a scenario that switches continuously: the row says
+/// that engines switch impulsively.
+#[test]
+fn continuous_switching_is_named_in_the_engine_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper-square-v0.2.toml"),
+    )
+    .unwrap();
+    let f = dir.path().join("c.toml");
+    let text = if base.contains("switching") {
+        base.replace("switching = \"impulsive\"", "switching = \"continuous\"")
+    } else {
+        base.replace("[run]", "[run]\nswitching = \"continuous\"")
+    };
+    assert!(text.contains("switching = \"continuous\""), "{text}");
+    std::fs::write(&f, text).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .args(["validate", "--json"])
+        .arg(&f)
+        .output()
+        .unwrap();
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+    let w = doc[0]["models"]["rapier2d"]["warnings"].to_string();
+    assert!(w.contains("engines switch impulsively"), "{w}");
+    assert_eq!(
+        doc[0]["models"]["dynamic"]["warnings"],
+        serde_json::json!([])
+    );
+}

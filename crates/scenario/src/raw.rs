@@ -184,6 +184,8 @@ pub struct RawTolerance {
     pub theta_max: Option<RawLimit>,
     /// [m, rad, relative]: the most an `"auto"` figure may be
     pub auto_ceiling: Option<Vec<f64>>,
+    /// Why the file loosens the gate past the default ceiling
+    pub reason: Option<String>,
 }
 
 /// A tolerance figure as written: a number, or a word (`"auto"`).

@@ -25,7 +25,7 @@ use pushval_model::{Body, ContactLimits, Initial, Problem, Push, Support, Switch
 pub use engine::MAX_ENGINE_STEPS;
 pub use run::{check_sample_count, ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS, MAX_SAMPLES};
 pub use supports::SupportLoad;
-pub use tolerance::{Limit, Tolerance, DEFAULT_AUTO_CEILING};
+pub use tolerance::{Limit, Loosened, Tolerance, DEFAULT_AUTO_CEILING};
 
 use crate::raw::RawScenario;
 use crate::ScenarioError;

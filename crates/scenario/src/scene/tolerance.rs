@@ -31,7 +31,7 @@ impl Limit {
 
 /// `[tolerance]`: what `validate` asserts between a gated engine and the
 /// dynamic model.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Tolerance {
     /// Relative error of the steady ω per settled segment.
     pub omega_steady_rel: Limit,
@@ -45,6 +45,52 @@ pub struct Tolerance {
     /// an auto figure below it fails the gate; the tolerance never widens
     /// past it.
     pub auto_ceiling: [f64; 3],
+    /// `[tolerance] reason`: why the file loosens the gate (see
+    /// [`Tolerance::loosened`]), shown beside the loosened figures.
+    pub reason: Option<String>,
+}
+
+/// One number of a `[tolerance]` table above the default auto ceiling: a
+/// gate the file loosened past what pushval would assert on its own.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Loosened {
+    /// The key, e.g. `tolerance.position_max` or `tolerance.auto_ceiling[0]`.
+    pub key: String,
+    /// The number written (in the figure's unit).
+    pub value: f64,
+    /// The default auto ceiling of that figure ([`DEFAULT_AUTO_CEILING`]).
+    pub ceiling: f64,
+}
+
+impl Tolerance {
+    /// Every number of the table above [`DEFAULT_AUTO_CEILING`] (a figure or
+    /// a raised `auto_ceiling`), in the order position, theta, steady ω.
+    pub fn loosened(&self) -> Vec<Loosened> {
+        let figures = [
+            ("tolerance.position_max", self.position_max),
+            ("tolerance.theta_max", self.theta_max),
+            ("tolerance.omega_steady_rel", self.omega_steady_rel),
+        ];
+        let mut out = Vec::new();
+        for (i, (key, limit)) in figures.into_iter().enumerate() {
+            let ceiling = DEFAULT_AUTO_CEILING[i];
+            if let Some(v) = limit.value().filter(|v| *v > ceiling) {
+                out.push(Loosened {
+                    key: key.to_string(),
+                    value: v,
+                    ceiling,
+                });
+            }
+            if self.auto_ceiling[i] > ceiling {
+                out.push(Loosened {
+                    key: format!("tolerance.auto_ceiling[{i}]"),
+                    value: self.auto_ceiling[i],
+                    ceiling,
+                });
+            }
+        }
+        out
+    }
 }
 
 impl Default for Tolerance {
@@ -54,6 +100,7 @@ impl Default for Tolerance {
             position_max: Limit::Auto,
             theta_max: Limit::Auto,
             auto_ceiling: DEFAULT_AUTO_CEILING,
+            reason: None,
         }
     }
 }
@@ -94,7 +141,18 @@ pub(super) fn from_raw(raw: Option<RawTolerance>, file: &Path) -> Result<Toleran
             ))
         }
     };
+    let reason = match rt.reason {
+        Some(r) if r.trim().is_empty() => {
+            return Err(ScenarioError::new(
+                file,
+                "tolerance.reason",
+                "must say why the gate is loosened; got an empty string",
+            ))
+        }
+        r => r,
+    };
     Ok(Tolerance {
+        reason,
         auto_ceiling,
         omega_steady_rel: limit("tolerance.omega_steady_rel", rt.omega_steady_rel)?,
         position_max: limit("tolerance.position_max", rt.position_max)?,
