@@ -466,6 +466,7 @@ fn main() -> ExitCode {
             },
         ),
     };
+    pushval_outside::shutdown_sessions();
     match result {
         Ok(code) => code,
         Err(e) => {
