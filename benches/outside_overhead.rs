@@ -30,6 +30,14 @@
 //! * `engine_run`: `Engine::run` of the outside engine (the process plus
 //!   pushval's document, parse and resample), with `python3` from PATH.
 //!
+//! * `engine_run_once_fixture_resolved`, `engine_run_session_*`: the same
+//!   stepping (`simulate` of pure_python.py) behind the session test adapter
+//!   (`crates/outside/tests/fixtures/session_adapter.py --simulate`), one
+//!   process per run (`--once`) and as a session (`session = true`: one
+//!   process answering every run, started by a warm-up run outside the
+//!   timing). pure_python.py itself reads pushval-problem/1 only, one
+//!   process per run.
+//!
 //! The protocol's overhead per run is `engine_run − adapter_stepping`; the
 //! rows `overhead_*` give it and `overhead_share_*` its share of the run.
 //! (`spawn_venv`: the virtual environment of `scripts/setup-adapters.sh`,
@@ -44,7 +52,8 @@ use criterion::Criterion;
 use pushval_engine::{trajectory_from_steps, Engine, EngineOptions};
 use pushval_model::Problem;
 use pushval_outside::{
-    csv, history_from_rows, problem_document, run_process, Config, OutsideEngine, Spec,
+    csv, history_from_rows, problem_document, run_process, shutdown_sessions, Config, Limits,
+    OutsideEngine, Spec,
 };
 use pushval_scenario::Scenario;
 
@@ -80,6 +89,18 @@ fn spec(python: &str) -> Arc<Spec> {
     Arc::new(cfg.engines.into_iter().next().expect("one engine"))
 }
 
+/// The session test adapter wrapping pure_python.py's stepping, as a
+/// session (`session = true`) or one process per run (`--once`).
+fn fixture_spec(python: &str, session: bool) -> Arc<Spec> {
+    let text = format!(
+        "[engine.pure_python_fixture]\ncommand = [{python:?}, \"crates/outside/tests/fixtures/session_adapter.py\", \"--simulate\", \"adapters/python/pure_python.py\"{}]\norder = 1\n{}",
+        if session { "" } else { ", \"--once\"" },
+        if session { "session = true\n" } else { "" }
+    );
+    let cfg = Config::from_toml(&text, &root().join("pushval.toml")).expect("a valid engines file");
+    Arc::new(cfg.engines.into_iter().next().expect("one engine"))
+}
+
 /// The interpreter `python3` on PATH runs (through a shim or not).
 fn resolved_python() -> String {
     let o = Command::new("python3")
@@ -104,8 +125,19 @@ fn which(cmd: &str) -> String {
 
 fn process(program: &str, args: &[&str], input: &[u8]) -> pushval_outside::ProcessOutput {
     let args: Vec<String> = args.iter().map(|a| a.to_string()).collect();
-    let out = run_process(Path::new(program), &args, &root(), input, TIMEOUT)
-        .unwrap_or_else(|e| panic!("{program}: {}", e.what));
+    let unlimited = Limits {
+        max_rows: u64::MAX,
+        max_bytes: u64::MAX,
+    };
+    let out = run_process(
+        Path::new(program),
+        &args,
+        &root(),
+        input,
+        TIMEOUT,
+        unlimited,
+    )
+    .unwrap_or_else(|e| panic!("{program}: {}", e.what));
     assert!(
         out.status.success(),
         "{program} {args:?}: {}",
@@ -257,6 +289,36 @@ fn main() {
         run_r,
         format!("OutsideEngine::run (command {py})"),
     );
+    // The same stepping behind the session test adapter: one process per
+    // run, then one session for every run (its start outside the timing).
+    let once = OutsideEngine::new(fixture_spec(&py, false), &options);
+    let once_run = time(runs, || once.run(&problem, DT).unwrap());
+    put(
+        &mut rows,
+        "engine_run_once_fixture_resolved",
+        once_run,
+        format!("OutsideEngine::run, session_adapter.py --simulate pure_python.py --once ({py}): one process per run"),
+    );
+    let mut session_rows = Vec::new();
+    for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
+        let session = OutsideEngine::new(fixture_spec(python, true), &options);
+        let warm = session.run(&problem, DT).unwrap();
+        assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
+        let r = time(runs, || session.run(&problem, DT).unwrap());
+        let last = session.run(&problem, DT).unwrap();
+        assert_eq!(
+            last.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
+            "one process served every run"
+        );
+        put(
+            &mut rows,
+            &format!("engine_run_session_{label}"),
+            r,
+            format!("OutsideEngine::run, session_adapter.py --simulate pure_python.py as a session ({python}): one process for {} runs, started before the timing", runs + 2),
+        );
+        session_rows.push((format!("session_{label}"), r));
+        shutdown_sessions();
+    }
     // The adapter's own input and output (imports, json.load, writing the
     // rows), by difference.
     let med = |name: &str| {
@@ -275,13 +337,19 @@ fn main() {
         (proc_r.0 - spawn_r.0 - stepping.0, proc_r.1 - spawn_r.1 - stepping.1),
         "adapter_process_resolved − spawn_resolved_interpreter − adapter_stepping: the adapter's imports, json.load and CSV writing".into(),
     );
-    for (label, r) in [("python3_on_path", run), ("resolved", run_r)] {
+    let mut overheads = vec![
+        ("python3_on_path".to_string(), run),
+        ("resolved".to_string(), run_r),
+        ("once_fixture_resolved".to_string(), once_run),
+    ];
+    overheads.extend(session_rows);
+    for (label, r) in overheads {
         let over = r.0 - stepping.0;
         put(
             &mut rows,
             &format!("overhead_{label}"),
             (over, r.1 - stepping.1),
-            format!("engine_run_{label} − adapter_stepping (median − median, min − min)"),
+            format!("engine_run_{label} − adapter_stepping (median − median, min − min): the protocol's cost per run"),
         );
         rows.push((
             format!("overhead_share_{label}"),

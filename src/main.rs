@@ -533,6 +533,7 @@ fn main() -> ExitCode {
             },
         ),
     };
+    pushval_outside::shutdown_sessions();
     match result {
         Ok(code) => code,
         Err(e) => {

@@ -441,3 +441,52 @@ fn fit_recovers_the_inertia_of_an_outside_engine() {
         "inertia_cm {inertia}, the adapter's {truth}"
     );
 }
+
+/// A session engine through the binary: the gate's dt ladder runs the
+/// problem several times on the processes of one pool (at most one per
+/// core), and none of them outlives `pushval`.
+#[test]
+fn a_session_engine_serves_the_ladder_and_ends_with_pushval() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("pids");
+    let fixture = root()
+        .join("crates/outside/tests/fixtures/session_adapter.py")
+        .display()
+        .to_string();
+    let (o, _) = run_with(
+        &[
+            "python3",
+            &fixture,
+            "--pid-log",
+            &log.display().to_string(),
+            "--simulate",
+            &adapter(),
+        ],
+        "session = true\n",
+    );
+    let t = text(&o);
+    // The fixture steps with semi-implicit Euler where the scenario's auto
+    // tolerances expect Heun: a FAIL or a pass, never an input error.
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{t}");
+    let pids: Vec<u32> = std::fs::read_to_string(&log)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(' ').next().unwrap().parse().unwrap())
+        .collect();
+    let mut distinct = pids.clone();
+    distinct.sort_unstable();
+    distinct.dedup();
+    let cores = std::thread::available_parallelism().unwrap().get();
+    assert!(
+        pids.len() >= 2 && distinct.len() <= cores && distinct.len() < pids.len(),
+        "{} problems on {} processes: {t}",
+        pids.len(),
+        distinct.len()
+    );
+    for pid in distinct {
+        assert!(
+            !Path::new(&format!("/proc/{pid}")).exists(),
+            "session process {pid} outlived pushval"
+        );
+    }
+}

@@ -10,7 +10,19 @@ pub const DEFAULT_DT: f64 = 1e-3;
 pub const DEFAULT_TIMEOUT_S: f64 = 120.0;
 
 /// The keys an `[engine.NAME]` table may hold.
-const KEYS: &[&str] = &["command", "order", "dt", "timeout_s", "version", "law"];
+const KEYS: &[&str] = &[
+    "command",
+    "order",
+    "dt",
+    "timeout_s",
+    "version",
+    "law",
+    "protocol",
+    "session",
+];
+
+/// The protocol version when `protocol` is absent and `session` is not set.
+pub const DEFAULT_PROTOCOL: u32 = 1;
 
 /// One outside engine as `pushval.toml` declares it.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,6 +49,13 @@ pub struct Spec {
     /// the laws of `pushval::registry::laws`; an unknown name is refused
     /// naming the known ones); None when the file names none.
     pub law: Option<String>,
+    /// The `pushval-problem/N` version the process reads: 1 (the default)
+    /// or 2 (`switching` and `limits` in the document; needed for sessions).
+    pub protocol: u32,
+    /// One process serves many problems (`session = true`, protocol 2): one
+    /// document per line in, each answer ended by `#end` or `#error
+    /// MESSAGE`; default false (one process per run).
+    pub session: bool,
 }
 
 impl Spec {
@@ -262,8 +281,32 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
         Some(toml::Value::String(s)) => Some(s.clone()),
         Some(v) => return Err(err("law", format!("must be a string, got {v}"))),
     };
+    let session = match t.get("session") {
+        None => false,
+        Some(toml::Value::Boolean(b)) => *b,
+        Some(v) => return Err(err("session", format!("must be true or false, got {v}"))),
+    };
+    let protocol = match t.get("protocol") {
+        None if session => 2,
+        None => DEFAULT_PROTOCOL,
+        Some(toml::Value::Integer(n @ (1 | 2))) => *n as u32,
+        Some(v) => {
+            return Err(err(
+                "protocol",
+                format!("must be 1 (pushval-problem/1) or 2 (pushval-problem/2), got {v}"),
+            ))
+        }
+    };
+    if session && protocol < 2 {
+        return Err(err(
+            "protocol",
+            "session = true needs protocol 2 (sessions are part of pushval-problem/2)".into(),
+        ));
+    }
     Ok(Spec {
         law,
+        protocol,
+        session,
         name: name.to_string(),
         command,
         dir: dir.to_path_buf(),

@@ -1,11 +1,15 @@
-//! The `pushval-problem/1` document: one run's problem, as JSON.
+//! The `pushval-problem/1` and `/2` documents: one run's problem, as JSON.
 
 use pushval_engine::EngineOptions;
-use pushval_model::Problem;
+use pushval_model::{Problem, Switching};
 use serde_json::{json, Value};
 
-/// The document's `format` value.
+use crate::limits::Limits;
+
+/// The document's `format` value (version 1).
 pub const FORMAT: &str = "pushval-problem/1";
+/// The document's `format` value (version 2).
+pub const FORMAT_V2: &str = "pushval-problem/2";
 
 /// The gravity (m/s²) a document states when the options carry no scene.
 const DEFAULT_GRAVITY: f64 = 9.81;
@@ -114,6 +118,36 @@ pub fn problem_document(
         "gravity": gravity,
         "options": opts,
     })
+}
+
+/// The `pushval-problem/2` document: the version 1 document of
+/// [`problem_document`] with `format` = [`FORMAT_V2`], `switching` (what ω
+/// does when the pusher's velocity jumps: `"impulsive"`, the angular
+/// momentum about the contact is kept, or `"continuous"`) and `limits`
+/// (`max_rows`, `max_bytes`: pushval's cap on this run's output; past it the
+/// process is killed and the run is an error).
+pub fn problem_document_v2(
+    engine: &str,
+    problem: &Problem,
+    options: &EngineOptions,
+    dt: f64,
+    limits: Limits,
+) -> Value {
+    let mut doc = problem_document(engine, problem, options, dt);
+    let o = doc.as_object_mut().expect("the document is an object");
+    o.insert("format".into(), json!(FORMAT_V2));
+    o.insert(
+        "switching".into(),
+        json!(match problem.switching {
+            Switching::Impulsive => "impulsive",
+            Switching::Continuous => "continuous",
+        }),
+    );
+    o.insert(
+        "limits".into(),
+        json!({"max_rows": limits.max_rows, "max_bytes": limits.max_bytes}),
+    );
+    doc
 }
 
 /// Counter-clockwise convex hull (Andrew's monotone chain), collinear

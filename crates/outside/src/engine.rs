@@ -11,8 +11,10 @@ use pushval_model::{ModelError, Problem};
 
 use crate::config::Spec;
 use crate::csv;
-use crate::document::problem_document;
-use crate::process::{last_lines, run_process};
+use crate::document::{problem_document, problem_document_v2};
+use crate::limits::Limits;
+use crate::process::{last_lines, run_process, ProcessError};
+use crate::session;
 
 /// How many lines of a failed process's standard error a message quotes.
 const STDERR_LINES: usize = 8;
@@ -125,38 +127,59 @@ impl Engine for OutsideEngine {
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let start = Instant::now();
         problem.check()?;
-        let doc = problem_document(&self.spec.name, problem, &self.options, dt);
-        let input = serde_json::to_vec(&doc).expect("a JSON value serialises");
-        let out = run_process(
-            &self.spec.program(),
-            &self.spec.command[1..],
-            &self.spec.dir,
-            &input,
-            Duration::from_secs_f64(self.spec.timeout_s),
-        )
-        .map_err(|e| {
+        let limits = Limits::for_problem(problem, dt);
+        let doc = if self.spec.protocol >= 2 {
+            problem_document_v2(&self.spec.name, problem, &self.options, dt, limits)
+        } else {
+            problem_document(&self.spec.name, problem, &self.options, dt)
+        };
+        let mut input = serde_json::to_vec(&doc).expect("a JSON value serialises");
+        let timeout = Duration::from_secs_f64(self.spec.timeout_s);
+        let broken = |e: ProcessError| {
             ModelError::Adapter(format!(
                 "{}: {}; {}",
                 self.who(),
                 e.what,
                 last_lines(&e.stderr, STDERR_LINES)
             ))
-        })?;
+        };
+        let input_bytes = input.len();
+        let (stdout, stderr, process_time, served_by) = if self.spec.session {
+            // One document per line (compact JSON holds no line break).
+            input.push(b'\n');
+            let a = session::answer(&self.spec, input, limits, timeout).map_err(broken)?;
+            let about = serde_json::json!({"pid": a.pid, "answered_before": a.answered_before});
+            (a.stdout, a.stderr, a.elapsed, Some(about))
+        } else {
+            let out = run_process(
+                &self.spec.program(),
+                &self.spec.command[1..],
+                &self.spec.dir,
+                &input,
+                timeout,
+                limits,
+            )
+            .map_err(broken)?;
+            if !out.status.success() {
+                return Err(broken(ProcessError {
+                    what: match out.status.code() {
+                        Some(c) => format!("exited with status {c}"),
+                        None => format!("was ended by a signal ({})", out.status),
+                    },
+                    stderr: out.stderr,
+                }));
+            }
+            (out.stdout, out.stderr, out.elapsed, None)
+        };
         let fail = |what: String| {
             ModelError::Adapter(format!(
                 "{}: {what}; {}",
                 self.who(),
-                last_lines(&out.stderr, STDERR_LINES)
+                last_lines(&stderr, STDERR_LINES)
             ))
         };
-        if !out.status.success() {
-            return Err(fail(match out.status.code() {
-                Some(c) => format!("exited with status {c}"),
-                None => format!("was ended by a signal ({})", out.status),
-            }));
-        }
         let parse_start = Instant::now();
-        let text = std::str::from_utf8(&out.stdout)
+        let text = std::str::from_utf8(&stdout)
             .map_err(|e| fail(format!("wrote standard output that is not UTF-8 ({e})")))?;
         let rows = csv::read(text, &[], &["t", "x", "y", "theta", "omega"])
             .map_err(|e| fail(format!("wrote a malformed row on its standard output: {e}")))?;
@@ -171,10 +194,12 @@ impl Engine for OutsideEngine {
             wall_time: start.elapsed(),
             diagnostics: serde_json::json!({
                 "rows": rows.len(),
-                "process_wall_time_s": out.elapsed.as_secs_f64(),
+                "process_wall_time_s": process_time.as_secs_f64(),
                 "parse_resample_time_s": parse_time.as_secs_f64(),
-                "input_bytes": input.len(),
-                "output_bytes": out.stdout.len(),
+                "input_bytes": input_bytes,
+                "output_bytes": stdout.len(),
+                "protocol": self.spec.protocol,
+                "session": served_by,
             }),
         })
     }

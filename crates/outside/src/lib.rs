@@ -1,19 +1,29 @@
 //! Outside engines: a simulator pushval does not link, run as a process.
 //!
 //! A project declares its engines in `pushval.toml` (`[engine.NAME]`:
-//! `command`, `order`, `dt`, `timeout_s`, `version`; see [`Config`]). One run
-//! is one process, started in that file's folder: pushval writes one
-//! `pushval-problem/1` JSON document ([`problem_document`]) to its standard
-//! input and closes it; the process writes CSV (`t,x,y,theta,omega`, one row
-//! per engine step or per sample over `[0, T]`) to its standard output and
-//! exits 0. [`OutsideEngine`] implements [`pushval_engine::Engine`], so the
-//! harness, the dt ladder, the gate, `compare`, `power`, `fit` and the studies
-//! run an outside engine like a compiled-in one.
+//! `command`, `order`, `dt`, `timeout_s`, `version`, `law`, `protocol`,
+//! `session`; see [`Config`]). By default one run is one process, started in
+//! that file's folder: pushval writes one `pushval-problem/1` JSON document
+//! ([`problem_document`]) to its standard input and closes it; the process
+//! writes CSV (`t,x,y,theta,omega`, one row per engine step or per sample
+//! over `[0, T]`) to its standard output and exits 0. An engine declaring
+//! `protocol = 2` receives the `pushval-problem/2` document instead
+//! ([`problem_document_v2`]: `switching` and `limits` added); one declaring
+//! `session = true` (protocol 2 implied) is one process serving many
+//! problems, one document per line, each answer ended by `#end` or
+//! `#error MESSAGE` (a pool of at most one per core; [`shutdown_sessions`]
+//! ends them). [`OutsideEngine`] implements [`pushval_engine::Engine`], so
+//! the harness, the dt ladder, the gate, `compare`, `power`, `fit` and the
+//! studies run an outside engine like a compiled-in one.
 //!
 //! Errors are [`pushval_model::ModelError::Adapter`]: they name the engine,
 //! the command and the last lines of its standard error, or the line and the
-//! column of a malformed row. A run past `timeout_s` is killed (with its
-//! process group) and is an error, never a pass.
+//! column of a malformed row. A run past `timeout_s`, or whose output passes
+//! its cap ([`Limits`], from the problem's length), is killed and is an
+//! error that says so, never a pass; the output is read as it arrives and
+//! never held beyond the cap. At a timeout, at a cap and after every exit,
+//! every process the adapter started is ended too, whether it left the
+//! process group (`setsid`) or not (see the `tree` module).
 //!
 //! It also holds the one CSV reader of pushval's numeric trajectory files
 //! ([`csv`]), which `pushval compare` shares.
@@ -26,9 +36,17 @@ mod config;
 pub mod csv;
 mod document;
 mod engine;
+pub mod limits;
 mod process;
+mod session;
+mod stream;
+mod tree;
 
-pub use config::{Config, ConfigError, Spec, DEFAULT_DT, DEFAULT_ORDER, DEFAULT_TIMEOUT_S};
-pub use document::{problem_document, FORMAT};
+pub use config::{
+    Config, ConfigError, Spec, DEFAULT_DT, DEFAULT_ORDER, DEFAULT_PROTOCOL, DEFAULT_TIMEOUT_S,
+};
+pub use document::{problem_document, problem_document_v2, FORMAT, FORMAT_V2};
 pub use engine::{history_from_rows, OutsideEngine};
-pub use process::{run_process, ProcessOutput};
+pub use limits::Limits;
+pub use process::{run_process, ProcessError, ProcessOutput};
+pub use session::{live_sessions, shutdown_sessions};

@@ -1,18 +1,28 @@
-//! One outside run: start the process, write its input, read its output,
-//! kill it at the deadline.
+//! One outside run: start the process, write its input, read its output
+//! (within its cap), end it and everything it started.
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::Path;
 use std::process::{Command, ExitStatus, Stdio};
-use std::sync::mpsc;
 use std::time::{Duration, Instant};
+
+use crate::limits::{Limits, Meter};
+use crate::stream::{Chunks, Piece, Tail};
+use crate::tree::{self, Mark};
+
+/// How often a process that keeps its standard output open (a descendant
+/// holding the pipe) is checked for having exited.
+const EXIT_POLL: Duration = Duration::from_millis(20);
+/// How long, once the process and its descendants are ended, what is left
+/// in the pipes is waited for.
+const DRAIN: Duration = Duration::from_secs(1);
 
 /// What a finished process produced.
 #[derive(Debug)]
 pub struct ProcessOutput {
-    /// Its standard output.
+    /// Its standard output (at most the run's `max_bytes`).
     pub stdout: Vec<u8>,
-    /// Its standard error.
+    /// The end of its standard error (its last 64 KiB).
     pub stderr: Vec<u8>,
     /// How it exited.
     pub status: ExitStatus,
@@ -20,128 +30,127 @@ pub struct ProcessOutput {
     pub elapsed: Duration,
 }
 
-/// Why a process produced no output to read: it did not start, or it ran
-/// past the deadline (and was killed); with its standard error so far.
+/// Why a process produced no output to read: it did not start, it ran
+/// past the deadline, or its output passed its cap (then it was killed);
+/// with the end of its standard error.
 #[derive(Debug)]
 pub struct ProcessError {
     /// What happened, one sentence.
     pub what: String,
-    /// Its standard error up to then.
+    /// The end of its standard error up to then.
     pub stderr: Vec<u8>,
 }
 
 /// Starts `program args` in `dir` (in a process group of its own), writes
-/// `input` to its standard input and closes it, and collects both outputs
-/// until it exits. Past `timeout` the process group is killed and the run is
-/// a [`ProcessError`].
+/// `input` to its standard input and closes it, and reads its standard
+/// output as it comes until it exits; then ends every process it started
+/// and is still running. Past `timeout`, or once the output passes
+/// `limits`, the process and its descendants are killed and the run is a
+/// [`ProcessError`] saying which; the output is never held beyond the cap.
 pub fn run_process(
     program: &Path,
     args: &[String],
     dir: &Path,
     input: &[u8],
     timeout: Duration,
+    limits: Limits,
 ) -> Result<ProcessOutput, ProcessError> {
-    use std::os::unix::process::CommandExt;
     let start = Instant::now();
-    let mut child = Command::new(program)
+    let mut command = Command::new(program);
+    command
         .args(args)
         .current_dir(dir)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .process_group(0)
-        .spawn()
-        .map_err(|e| ProcessError {
-            what: format!("could not start `{}`: {e}", program.display()),
-            stderr: Vec::new(),
-        })?;
+        .stderr(Stdio::piped());
+    let mark = Mark::apply(&mut command);
+    let mut child = command.spawn().map_err(|e| ProcessError {
+        what: format!("could not start `{}`: {e}", program.display()),
+        stderr: Vec::new(),
+    })?;
     let mut stdin = child.stdin.take().expect("piped");
-    let mut stdout = child.stdout.take().expect("piped");
-    let mut stderr = child.stderr.take().expect("piped");
+    let mut out = Chunks::spawn(child.stdout.take().expect("piped"));
+    let err = Tail::spawn(child.stderr.take().expect("piped"));
     let input = input.to_vec();
     // A process that exits without reading its input closes the pipe: the
     // write fails then, and its exit status says the rest.
     let writer = std::thread::spawn(move || {
         let _ = stdin.write_all(&input);
     });
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let mut buf = Vec::new();
-        let r = stdout.read_to_end(&mut buf);
-        let _ = tx.send((buf, r.is_ok()));
-    });
-    let (etx, erx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let mut buf = Vec::new();
-        let _ = stderr.read_to_end(&mut buf);
-        let _ = etx.send(buf);
-    });
     let deadline = start + timeout;
-    let kill = |child: &mut std::process::Child| {
-        let _ = rustix::process::kill_process_group(
-            rustix::process::Pid::from_child(child),
-            rustix::process::Signal::KILL,
-        );
-        let _ = child.kill();
-        let _ = child.wait();
+    let fail = |child: &mut std::process::Child, what: String| {
+        let _ = tree::end(child, &mark);
+        ProcessError {
+            what,
+            stderr: err.get(Duration::from_millis(200)),
+        }
     };
-    let remaining = || deadline.saturating_duration_since(Instant::now());
-    // Standard output closes when the process exits (or closes it).
-    let out = match rx.recv_timeout(remaining()) {
-        Ok((buf, _)) => buf,
-        Err(_) => {
-            kill(&mut child);
-            let stderr = erx
-                .recv_timeout(Duration::from_millis(200))
-                .unwrap_or_default();
-            return Err(ProcessError {
-                what: format!(
+    let mut meter = Meter::new(limits);
+    let mut stdout = Vec::new();
+    // Until the end of its standard output, or its exit while a descendant
+    // holds the pipe open.
+    let mut exited = false;
+    loop {
+        let now = Instant::now();
+        if now >= deadline {
+            return Err(fail(
+                &mut child,
+                format!(
                     "still running after its timeout of {} s: killed",
                     timeout.as_secs_f64()
                 ),
-                stderr,
+            ));
+        }
+        match out.next(deadline.min(now + EXIT_POLL)) {
+            Some(Piece::Bytes(b)) => {
+                if let Err(what) = meter.add(&b) {
+                    return Err(fail(&mut child, what));
+                }
+                stdout.extend_from_slice(&b);
+            }
+            Some(Piece::End) => break,
+            None if tree::has_exited(&mut child) => {
+                exited = true;
+                break;
+            }
+            None => {}
+        }
+    }
+    let mut pause = Duration::from_micros(50);
+    while !exited && !tree::has_exited(&mut child) {
+        let now = Instant::now();
+        if now >= deadline {
+            return Err(fail(
+                &mut child,
+                format!(
+                    "closed its standard output but was still running after its timeout of {} s: killed",
+                    timeout.as_secs_f64()
+                ),
+            ));
+        }
+        std::thread::sleep(pause.min(deadline - now));
+        pause = (pause * 2).min(Duration::from_millis(5));
+    }
+    let elapsed = start.elapsed();
+    // Whatever it left running ends with it.
+    let status = tree::end(&mut child, &mark).map_err(|e| ProcessError {
+        what: format!("could not wait for it: {e}"),
+        stderr: Vec::new(),
+    })?;
+    let drain_until = Instant::now() + DRAIN;
+    while let Some(Piece::Bytes(b)) = out.next(drain_until) {
+        if let Err(what) = meter.add(&b) {
+            return Err(ProcessError {
+                what,
+                stderr: err.get(Duration::from_millis(200)),
             });
         }
-    };
-    let mut pause = Duration::from_micros(50);
-    let status = loop {
-        match child.try_wait() {
-            Ok(Some(s)) => break s,
-            Ok(None) if Instant::now() >= deadline => {
-                kill(&mut child);
-                let stderr = erx
-                    .recv_timeout(Duration::from_millis(200))
-                    .unwrap_or_default();
-                return Err(ProcessError {
-                    what: format!(
-                        "closed its standard output but was still running after its timeout of {} s: killed",
-                        timeout.as_secs_f64()
-                    ),
-                    stderr,
-                });
-            }
-            Ok(None) => {
-                std::thread::sleep(pause.min(remaining()));
-                pause = (pause * 2).min(Duration::from_millis(5));
-            }
-            Err(e) => {
-                kill(&mut child);
-                return Err(ProcessError {
-                    what: format!("could not wait for it: {e}"),
-                    stderr: Vec::new(),
-                });
-            }
-        }
-    };
-    let elapsed = start.elapsed();
+        stdout.extend_from_slice(&b);
+    }
     let _ = writer.join();
-    // A grandchild may hold standard error open: wait briefly, not forever.
-    let stderr = erx
-        .recv_timeout(remaining().max(Duration::from_millis(100)))
-        .unwrap_or_default();
     Ok(ProcessOutput {
-        stdout: out,
-        stderr,
+        stdout,
+        stderr: err.get(Duration::from_millis(200)),
         status,
         elapsed,
     })

@@ -14,8 +14,11 @@ fn root() -> PathBuf {
 }
 
 fn schema() -> Value {
-    let text =
-        std::fs::read_to_string(root().join("adapters/pushval-problem-1.schema.json")).unwrap();
+    schema_file("adapters/pushval-problem-1.schema.json")
+}
+
+fn schema_file(path: &str) -> Value {
+    let text = std::fs::read_to_string(root().join(path)).unwrap();
     serde_json::from_str(&text).unwrap()
 }
 
@@ -38,10 +41,16 @@ fn check(v: &Value, s: &Value, root: &Value, at: &str, errors: &mut Vec<String>)
                     "number" => v.is_number(),
                     "string" => v.is_string(),
                     "boolean" => v.is_boolean(),
+                    "integer" => v.is_u64() || v.is_i64(),
                     t => panic!("type {t}"),
                 };
                 if !ok {
                     errors.push(format!("{at}: not {rule}: {v}"));
+                }
+            }
+            "enum" => {
+                if !rule.as_array().unwrap().contains(v) {
+                    errors.push(format!("{at}: {v} not one of {rule}"));
                 }
             }
             "const" => {
@@ -199,4 +208,55 @@ fn without_a_scene_the_loads_sum_to_the_weight() {
         let f = d["mu"].as_f64().unwrap() * d["normal_force"].as_f64().unwrap();
         assert!((f - s.friction).abs() < 1e-12, "{f} vs {}", s.friction);
     }
+}
+
+/// Version 2: every shipped scenario's document validates against
+/// adapters/pushval-problem-2.schema.json, which is version 1's with
+/// `switching` and `limits` added; a version 1 document does not.
+#[test]
+fn version_2_documents_validate_against_their_schema() {
+    use pushval_outside::{problem_document_v2, Limits};
+    let s2 = schema_file("adapters/pushval-problem-2.schema.json");
+    let errors2 = |doc: &Value| {
+        let mut e = Vec::new();
+        check(doc, &s2, &s2, "$", &mut e);
+        e
+    };
+    let mut switchings = std::collections::BTreeSet::new();
+    for entry in std::fs::read_dir(root().join("scenarios")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let sc = Scenario::from_path(&path).unwrap();
+            let p = sc.problem();
+            let doc =
+                problem_document_v2("mysim", &p, &sc.engine, 1e-3, Limits::for_problem(&p, 1e-3));
+            assert_eq!(errors2(&doc), Vec::<String>::new(), "{}", path.display());
+            switchings.insert(doc["switching"].as_str().unwrap().to_string());
+        }
+    }
+    assert!(switchings.contains("impulsive"), "{switchings:?}");
+    let (_, v1) = doc_of("paper-square-v1.0.toml", 1e-3);
+    let e = errors2(&v1);
+    assert!(e.iter().any(|e| e.contains("missing \"limits\"")), "{e:?}");
+    let s1 = schema();
+    let mut required: Vec<Value> = s1["required"].as_array().unwrap().clone();
+    required.extend([Value::from("switching"), Value::from("limits")]);
+    assert_eq!(&s2["required"], &Value::from(required));
+    let mut bad = problem_document_v2(
+        "x",
+        &doc_of("paper-square-v1.0.toml", 1e-3).0.problem(),
+        &Default::default(),
+        1e-3,
+        Limits {
+            max_rows: 10,
+            max_bytes: 100,
+        },
+    );
+    bad["switching"] = Value::from("smooth");
+    bad["limits"]["max_rows"] = Value::from(1.5);
+    let e = errors2(&bad);
+    assert!(
+        e.iter().any(|e| e.contains("switching")) && e.iter().any(|e| e.contains("max_rows")),
+        "{e:?}"
+    );
 }
