@@ -101,6 +101,10 @@ impl Session {
         command
             .args(&spec.command[1..])
             .current_dir(&spec.dir)
+            // How an adapter tells a session from a one-shot run (the kit,
+            // `pushval.adapter`, reads it): documents one per line, each
+            // answer ended by `#end` or `#error MESSAGE`.
+            .env("PUSHVAL_SESSION", "1")
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
