@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """A pushval outside engine in PyBullet (pybullet==3.2.7).
 
-Reads one pushval-problem/1 document on standard input, writes CSV
-`t,x,y,theta,omega` (one row per step) on standard output.
+One row per Bullet step; the protocol (one-shot or --session, limits,
+progress, --timing) is pushval.adapter's (adapters/python/README.md). Bullet's
+contact makes the pusher's velocity jumps itself: impulsive switching only.
 
 Modes:
   --mode forces   the plate floats (no gravity, no ground); every step each
@@ -29,180 +30,191 @@ weight cancelled each step), and the joint's pivot sits at the feet's
 contact height, so the pushing force does not tip the plate either.
 """
 
-import json
 import math
+import os
 import sys
 
+try:
+    from pushval.adapter import AdapterError, Engine, State, main
+except ImportError:  # run from the source tree without the wheel installed
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+    from pushval.adapter import AdapterError, Engine, State, main
 
-def main(argv):
-    mode = "forces"
-    args = list(argv)
-    while args:
-        a = args.pop(0)
-        if a == "--mode":
-            mode = args.pop(0)
+THICK = 0.005
+FOOT = 0.0025
+SLIDER_MASS = 1e-3
+
+
+class PyBulletPush(Engine):
+    """A plate pushed in PyBullet 3.2.7 (forces or Bullet's own contact)."""
+
+    name = "pybullet_push.py"
+    step_rule = "round"
+    switching_rules = ("impulsive",)
+
+    @classmethod
+    def add_arguments(cls, parser):
+        parser.add_argument(
+            "--mode",
+            choices=("forces", "contact"),
+            default="forces",
+            help="forces: Coulomb forces per support applied by hand; "
+            "contact: Bullet's own contact friction on four feet",
+        )
+
+    def __init__(self, args=None):
+        super().__init__(args)
+        try:
+            import pybullet
+        except ImportError as e:
+            raise AdapterError(f"{e}; install it with scripts/setup-adapters.sh") from None
+        self.p = pybullet
+        self.client = None
+
+    def reset(self, problem):
+        p = self.p
+        mode = self.args.mode
+        client = self.client = p.connect(p.DIRECT)
+        m = problem.mass
+        i_cm = problem.inertia_cm
+        cx, cy = problem.center_of_mass
+        self.sup = sup = [(s.offset[0], s.offset[1], s.mu, s.normal_force) for s in problem.supports]
+        self.rc = rc = problem.contact_offset
+        dt = problem.dt
+        self.g = g = problem.gravity
+        p.setPhysicsEngineParameter(fixedTimeStep=dt, numSubSteps=0, numSolverIterations=50, physicsClientId=client)
+        self.h = dt
+        z0 = FOOT * 2 + THICK / 2 if mode == "contact" else 0.0
+        xs = [q[0] - cx for q in problem.polygon]
+        ys = [q[1] - cy for q in problem.polygon]
+        half = [(max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2, THICK / 2]
+        plate_shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
+        links = []
+        if mode == "contact":
+            # Feet: small spheres fixed under the supports (massless links would
+            # change the inertia, so they are tiny compound children instead).
+            foot_shape = p.createCollisionShape(p.GEOM_SPHERE, radius=FOOT, physicsClientId=client)
+            links = [(foot_shape, (sx, sy, -THICK / 2 - FOOT)) for sx, sy, _, _ in sup]
+        ini = problem.initial
+        th0 = ini.theta
+        self.body = body = p.createMultiBody(
+            baseMass=m,
+            baseCollisionShapeIndex=plate_shape if mode == "contact" else -1,
+            basePosition=[ini.position[0], ini.position[1], z0],
+            baseOrientation=p.getQuaternionFromEuler([0, 0, th0]),
+            linkMasses=[1e-9] * len(links),
+            linkCollisionShapeIndices=[s for s, _ in links],
+            linkVisualShapeIndices=[-1] * len(links),
+            linkPositions=[pos for _, pos in links],
+            linkOrientations=[[0, 0, 0, 1]] * len(links),
+            linkInertialFramePositions=[[0, 0, 0]] * len(links),
+            linkInertialFrameOrientations=[[0, 0, 0, 1]] * len(links),
+            linkParentIndices=[0] * len(links),
+            linkJointTypes=[p.JOINT_FIXED] * len(links),
+            linkJointAxis=[[0, 0, 1]] * len(links),
+            physicsClientId=client,
+        )
+        # The plate's inertia about z is the problem's; x and y large enough
+        # that it does not rock on its feet (and that rocking adds little to a
+        # friction row's effective mass: (h/1)^2/(100 I_cm), h = 7.5 mm).
+        p.changeDynamics(
+            body, -1, localInertiaDiagonal=[100 * i_cm, 100 * i_cm, i_cm],
+            linearDamping=0, angularDamping=0, physicsClientId=client,
+        )
+        if mode == "contact":
+            plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=client)
+            ground = p.createMultiBody(0, plane, physicsClientId=client)
+            p.changeDynamics(ground, -1, lateralFriction=1.0, physicsClientId=client)
+            mus = [s[2] for s in sup]
+            for j in range(len(links)):
+                p.changeDynamics(body, j, lateralFriction=mus[j], physicsClientId=client)
+            p.changeDynamics(body, -1, lateralFriction=0.0, physicsClientId=client)
+            p.setGravity(0, 0, -g, physicsClientId=client)
+            # Settle on the feet before the clock starts.
+            for _ in range(int(0.2 / dt)):
+                p.stepSimulation(physicsClientId=client)
+            p.resetBasePositionAndOrientation(
+                body, [ini.position[0], ini.position[1], p.getBasePositionAndOrientation(body, physicsClientId=client)[0][2]],
+                p.getQuaternionFromEuler([0, 0, th0]), physicsClientId=client)
+        # The pusher: a kinematic (mass 0) point moved each step, joined to the
+        # contact point. In contact mode the joint acts at the feet's contact
+        # height through a light link free to slide vertically (see the top).
+        zp = -(THICK / 2 + 2 * FOOT) if mode == "contact" else 0.0
+        base = self.contact_world()
+        base[2] += zp
+        if mode == "contact":
+            pusher = p.createMultiBody(
+                0, -1, basePosition=base,
+                linkMasses=[SLIDER_MASS], linkCollisionShapeIndices=[-1], linkVisualShapeIndices=[-1],
+                linkPositions=[[0, 0, 0]], linkOrientations=[[0, 0, 0, 1]],
+                linkInertialFramePositions=[[0, 0, 0]], linkInertialFrameOrientations=[[0, 0, 0, 1]],
+                linkParentIndices=[0], linkJointTypes=[p.JOINT_PRISMATIC], linkJointAxis=[[0, 0, 1]],
+                physicsClientId=client)
+            p.changeDynamics(pusher, 0, linearDamping=0, angularDamping=0, jointDamping=0, physicsClientId=client)
+            p.setJointMotorControl2(pusher, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=client)
+            cid = p.createConstraint(body, -1, pusher, 0, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], zp], [0, 0, 0], physicsClientId=client)
         else:
-            print(f"pybullet_push.py: unknown argument {a!r}", file=sys.stderr)
-            return 2
-    if mode not in ("forces", "contact"):
-        print(f"pybullet_push.py: unknown mode {mode!r} (forces, contact)", file=sys.stderr)
-        return 2
-    doc = json.load(sys.stdin)
-    import pybullet as p  # imported late: its banner goes to stdout otherwise
+            pusher = p.createMultiBody(0, -1, basePosition=base, physicsClientId=client)
+            cid = p.createConstraint(body, -1, pusher, -1, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], 0], [0, 0, 0], physicsClientId=client)
+        p.changeConstraint(cid, maxForce=1e6, erp=0.8, physicsClientId=client)
+        self.pusher = pusher
 
-    rows = simulate(p, doc, mode)
-    out = sys.stdout
-    out.write("t,x,y,theta,omega\n")
-    out.write("\n".join(",".join(map(repr, r)) for r in rows))
-    out.write("\n")
-    return 0
+        w0 = 0.0 if ini.from_rest else ini.omega
+        if not ini.from_rest:
+            # The plate moving with the first push at omega = w0.
+            c, s = math.cos(th0), math.sin(th0)
+            px, py = c * rc[0] - s * rc[1], s * rc[0] + c * rc[1]
+            vpx, vpy = problem.pushes[0].world_velocity(th0)
+            p.resetBaseVelocity(body, [vpx + w0 * py, vpy - w0 * px, 0], [0, 0, w0], physicsClientId=client)
+        self.theta = th0
+        return State(ini.position[0], ini.position[1], th0, w0)
 
+    def contact_world(self):
+        """The contact point in the world, at the plate's height."""
+        p = self.p
+        pos, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
+        yaw = p.getEulerFromQuaternion(orn)[2]
+        c, s = math.cos(yaw), math.sin(yaw)
+        rc = self.rc
+        return [pos[0] + c * rc[0] - s * rc[1], pos[1] + s * rc[0] + c * rc[1], pos[2]]
 
-def simulate(p, doc, mode):
-    client = p.connect(p.DIRECT)
-    obj = doc["object"]
-    m = float(obj["mass"])
-    i_cm = float(obj["inertia_cm"])
-    cx, cy = obj["center_of_mass"]
-    sup = [(s["point"][0] - cx, s["point"][1] - cy, s["mu"], s["normal_force"]) for s in doc["supports"]]
-    rc = (doc["contact"]["point"][0] - cx, doc["contact"]["point"][1] - cy)
-    dt = float(doc["dt"])
-    g = float(doc["gravity"])
-    p.setPhysicsEngineParameter(fixedTimeStep=dt, numSubSteps=0, numSolverIterations=50, physicsClientId=client)
-    thick = 0.005
-    foot = 0.0025
-    z0 = foot * 2 + thick / 2 if mode == "contact" else 0.0
-    xs = [q[0] - cx for q in obj["polygon"]]
-    ys = [q[1] - cy for q in obj["polygon"]]
-    half = [(max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2, thick / 2]
-    plate_shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
-    links = []
-    if mode == "contact":
-        # Feet: small spheres fixed under the supports (massless links would
-        # change the inertia, so they are tiny compound children instead).
-        foot_shape = p.createCollisionShape(p.GEOM_SPHERE, radius=foot, physicsClientId=client)
-        links = [(foot_shape, (sx, sy, -thick / 2 - foot)) for sx, sy, _, _ in sup]
-    ini = doc["initial"]
-    th0 = float(ini["theta"])
-    body = p.createMultiBody(
-        baseMass=m,
-        baseCollisionShapeIndex=plate_shape if mode == "contact" else -1,
-        basePosition=[ini["position"][0], ini["position"][1], z0],
-        baseOrientation=p.getQuaternionFromEuler([0, 0, th0]),
-        linkMasses=[1e-9] * len(links),
-        linkCollisionShapeIndices=[s for s, _ in links],
-        linkVisualShapeIndices=[-1] * len(links),
-        linkPositions=[pos for _, pos in links],
-        linkOrientations=[[0, 0, 0, 1]] * len(links),
-        linkInertialFramePositions=[[0, 0, 0]] * len(links),
-        linkInertialFrameOrientations=[[0, 0, 0, 1]] * len(links),
-        linkParentIndices=[0] * len(links),
-        linkJointTypes=[p.JOINT_FIXED] * len(links),
-        linkJointAxis=[[0, 0, 1]] * len(links),
-        physicsClientId=client,
-    )
-    # The plate's inertia about z is the problem's; x and y large enough
-    # that it does not rock on its feet (and that rocking adds little to a
-    # friction row's effective mass: (h/1)^2/(100 I_cm), h = 7.5 mm).
-    p.changeDynamics(
-        body, -1, localInertiaDiagonal=[100 * i_cm, 100 * i_cm, i_cm],
-        linearDamping=0, angularDamping=0, physicsClientId=client,
-    )
-    if mode == "contact":
-        plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=client)
-        ground = p.createMultiBody(0, plane, physicsClientId=client)
-        p.changeDynamics(ground, -1, lateralFriction=1.0, physicsClientId=client)
-        mus = [s[2] for s in sup]
-        for j in range(len(links)):
-            p.changeDynamics(body, j, lateralFriction=mus[j], physicsClientId=client)
-        p.changeDynamics(body, -1, lateralFriction=0.0, physicsClientId=client)
-        p.setGravity(0, 0, -g, physicsClientId=client)
-        # Settle on the feet before the clock starts.
-        for _ in range(int(0.2 / dt)):
-            p.stepSimulation(physicsClientId=client)
-        p.resetBasePositionAndOrientation(
-            body, [ini["position"][0], ini["position"][1], p.getBasePositionAndOrientation(body, physicsClientId=client)[0][2]],
-            p.getQuaternionFromEuler([0, 0, th0]), physicsClientId=client)
-    # The pusher: a kinematic (mass 0) point moved each step, joined to the
-    # contact point. In contact mode the joint acts at the feet's contact
-    # height through a light link free to slide vertically (see the top).
-    zp = -(thick / 2 + 2 * foot) if mode == "contact" else 0.0
-    base = contact_world(body, rc, p, client)
-    base[2] += zp
-    slider_mass = 1e-3
-    if mode == "contact":
-        pusher = p.createMultiBody(
-            0, -1, basePosition=base,
-            linkMasses=[slider_mass], linkCollisionShapeIndices=[-1], linkVisualShapeIndices=[-1],
-            linkPositions=[[0, 0, 0]], linkOrientations=[[0, 0, 0, 1]],
-            linkInertialFramePositions=[[0, 0, 0]], linkInertialFrameOrientations=[[0, 0, 0, 1]],
-            linkParentIndices=[0], linkJointTypes=[p.JOINT_PRISMATIC], linkJointAxis=[[0, 0, 1]],
-            physicsClientId=client)
-        p.changeDynamics(pusher, 0, linearDamping=0, angularDamping=0, jointDamping=0, physicsClientId=client)
-        p.setJointMotorControl2(pusher, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=client)
-        cid = p.createConstraint(body, -1, pusher, 0, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], zp], [0, 0, 0], physicsClientId=client)
-    else:
-        pusher = p.createMultiBody(0, -1, basePosition=base, physicsClientId=client)
-        cid = p.createConstraint(body, -1, pusher, -1, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], 0], [0, 0, 0], physicsClientId=client)
-    p.changeConstraint(cid, maxForce=1e6, erp=0.8, physicsClientId=client)
-
-    pushes = doc["pushes"]
-    w0 = 0.0 if ini["from_rest"] else float(ini["omega"])
-    set_velocity(body, pushes[0], th0, w0, rc, p, client, moving=not ini["from_rest"])
-    rows = [(0.0, ini["position"][0], ini["position"][1], th0, w0)]
-    th_unwrapped = th0
-    for push in pushes:
-        n = max(1, round(push["duration"] / dt))
-        h = push["duration"] / n
-        p.setPhysicsEngineParameter(fixedTimeStep=h, physicsClientId=client)
-        for j in range(n):
-            pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-            yaw = p.getEulerFromQuaternion(orn)[2]
-            if mode == "forces":
-                v, w = p.getBaseVelocity(body, physicsClientId=client)
-                c, s = math.cos(yaw), math.sin(yaw)
-                for sx, sy, mu, nf in sup:
-                    px, py = c * sx - s * sy, s * sx + c * sy
-                    ux, uy = v[0] - w[2] * py, v[1] + w[2] * px
-                    norm = math.hypot(ux, uy)
-                    if norm > 1e-15:
-                        f = mu * nf / norm
-                        p.applyExternalForce(body, -1, [-f * ux, -f * uy, 0],
-                                             [pos[0] + px, pos[1] + py, pos[2]], p.WORLD_FRAME,
-                                             physicsClientId=client)
-            a = yaw + push["phi"]
-            pp = p.getBasePositionAndOrientation(pusher, physicsClientId=client)[0]
-            target = [pp[0] + h * push["speed"] * math.cos(a), pp[1] + h * push["speed"] * math.sin(a), pp[2]]
-            p.resetBasePositionAndOrientation(pusher, target, [0, 0, 0, 1], physicsClientId=client)
-            if mode == "contact":
-                p.applyExternalForce(pusher, 0, [0, 0, slider_mass * g], [0, 0, 0], p.LINK_FRAME, physicsClientId=client)
-            p.stepSimulation(physicsClientId=client)
-            pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+    def step(self, push, h):
+        p, client, body = self.p, self.client, self.body
+        if h != self.h:
+            p.setPhysicsEngineParameter(fixedTimeStep=h, physicsClientId=client)
+            self.h = h
+        pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+        yaw = p.getEulerFromQuaternion(orn)[2]
+        if self.args.mode == "forces":
             v, w = p.getBaseVelocity(body, physicsClientId=client)
-            yaw = p.getEulerFromQuaternion(orn)[2]
-            th_unwrapped += math.remainder(yaw - th_unwrapped, 2 * math.pi)
-            rows.append((push["t_start"] + (j + 1) * h, pos[0], pos[1], th_unwrapped, w[2]))
-    p.disconnect(physicsClientId=client)
-    return rows
+            c, s = math.cos(yaw), math.sin(yaw)
+            for sx, sy, mu, nf in self.sup:
+                px, py = c * sx - s * sy, s * sx + c * sy
+                ux, uy = v[0] - w[2] * py, v[1] + w[2] * px
+                norm = math.hypot(ux, uy)
+                if norm > 1e-15:
+                    f = mu * nf / norm
+                    p.applyExternalForce(body, -1, [-f * ux, -f * uy, 0],
+                                         [pos[0] + px, pos[1] + py, pos[2]], p.WORLD_FRAME,
+                                         physicsClientId=client)
+        a = yaw + push.phi
+        pp = p.getBasePositionAndOrientation(self.pusher, physicsClientId=client)[0]
+        target = [pp[0] + h * push.speed * math.cos(a), pp[1] + h * push.speed * math.sin(a), pp[2]]
+        p.resetBasePositionAndOrientation(self.pusher, target, [0, 0, 0, 1], physicsClientId=client)
+        if self.args.mode == "contact":
+            p.applyExternalForce(self.pusher, 0, [0, 0, SLIDER_MASS * self.g], [0, 0, 0], p.LINK_FRAME, physicsClientId=client)
+        p.stepSimulation(physicsClientId=client)
+        pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+        v, w = p.getBaseVelocity(body, physicsClientId=client)
+        yaw = p.getEulerFromQuaternion(orn)[2]
+        self.theta += math.remainder(yaw - self.theta, 2 * math.pi)
+        return State(pos[0], pos[1], self.theta, w[2])
 
-
-def contact_world(body, rc, p, client):
-    pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    yaw = p.getEulerFromQuaternion(orn)[2]
-    c, s = math.cos(yaw), math.sin(yaw)
-    return [pos[0] + c * rc[0] - s * rc[1], pos[1] + s * rc[0] + c * rc[1], pos[2]]
-
-
-def set_velocity(body, push, th, w, rc, p, client, moving):
-    """The plate moving with the pusher at omega = w (not from rest)."""
-    if not moving:
-        return
-    c, s = math.cos(th), math.sin(th)
-    px, py = c * rc[0] - s * rc[1], s * rc[0] + c * rc[1]
-    a = th + push["phi"]
-    vx, vy = push["speed"] * math.cos(a) + w * py, push["speed"] * math.sin(a) - w * px
-    p.resetBaseVelocity(body, [vx, vy, 0], [0, 0, w], physicsClientId=client)
+    def close(self):
+        if self.client is not None:
+            self.p.disconnect(physicsClientId=self.client)
+            self.client = None
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    main(PyBulletPush)

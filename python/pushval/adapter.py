@@ -1,0 +1,897 @@
+"""The adapter kit: a pushval outside engine in a few lines of Python.
+
+pushval runs an *outside engine* (any simulator) as a process that speaks the
+pushval-problem protocol. This module speaks it; the author writes only the
+simulator's step::
+
+    from pushval.adapter import Engine, Problem, Push, State, main
+
+    class MyEngine(Engine):
+        def reset(self, problem: Problem) -> State:
+            ...  # build the scene at t = 0
+            return State(x, y, theta, omega)
+
+        def step(self, push: Push, dt: float) -> State:
+            ...  # advance dt with the pusher moving as `push` says
+            return State(x, y, theta, omega)
+
+    if __name__ == "__main__":
+        main(MyEngine)
+
+The protocol (what the kit does around those two methods)
+---------------------------------------------------------
+Input: a JSON problem document, ``"format": "pushval-problem/1"`` or
+``"pushval-problem/2"`` (adapters/pushval-problem-1.schema.json; version 2
+adds ``"switching"`` and ``"limits"``). The kit reads it into a `Problem`.
+
+Output: CSV on standard output, header ``t,x,y,theta,omega``, then the first
+row at t = 0 (the state `Engine.reset` returns) and one row per engine step:
+``x, y`` the centre of mass in the world (m), ``theta`` unwrapped (rad),
+``omega`` the angular velocity held over the step ending at ``t`` (rad/s).
+
+Two ways to serve, chosen by one rule pushval relies on:
+
+* **one-shot** (no ``--session`` argument): standard input holds one
+  document, then end of file. The kit writes the CSV and exits 0; a document
+  it cannot read exits 2, a failed run exits 1, both with the reason on
+  standard error and nothing on standard output.
+* **session** (the process is started with ``--session``; pushval passes it
+  when the engine's ``pushval.toml`` table says ``session = true``): standard
+  input holds one document per line. Each is answered with the header, the
+  rows and a line ``#end``, flushed. A document that cannot be read or a run
+  that fails is answered by one line ``#error MESSAGE`` instead (nothing
+  else), and the session goes on. End of file on standard input ends the
+  session (exit 0).
+
+The engine object lives for the whole process: `Engine.reset` is called once
+per problem (so a session reuses what ``__init__`` loaded), `Engine.close`
+after each problem, failed or not.
+
+What the kit does for every problem
+-----------------------------------
+* **Schedule.** Each push segment ``k`` is cut into ``n_k`` equal steps of
+  ``h_k = duration_k / n_k`` (``Engine.step_rule``: ``"ceil"``, the default,
+  gives ``n_k = ceil(duration_k / dt)`` so no step is longer than the
+  problem's ``dt``; ``"round"`` the nearest count). Row times are
+  ``t_start_k + j h_k``, the segment's last row exactly at its end.
+* **Switching.** Where one segment follows another the pusher's velocity
+  jumps; the kit calls ``Engine.switch(before, after)`` before the new
+  segment's first step. An engine whose pusher is a velocity constraint sets
+  its ω there with `Problem.omega_after_switch` (which applies the problem's
+  rule: ``"impulsive"``, the angular momentum about the contact point is
+  kept; ``"continuous"``, ω is kept). An engine whose own contact makes the
+  jump ignores it (the default). The start of an object at rest is a switch
+  too: `Problem.start_omega` gives ω just after it, for `Engine.reset`.
+  An engine that can follow only some rules lists them in
+  ``Engine.switching_rules``; a problem asking another is refused.
+* **Limits.** With version 2's ``"limits": {"max_rows": N, "max_bytes": B}``
+  (pushval kills a process past them), an answer that would exceed them is
+  written at the problem's sample times instead of per step (with a note on
+  standard error); if even that is too large, the run fails with a message
+  saying so instead of being killed. ``Engine.rows = "samples"`` asks for
+  rows at the sample times always.
+* **Checks.** A state that is not four finite numbers fails the run, naming
+  the time.
+* **Progress.** A run longer than a few seconds reports how far it is on
+  standard error (pushval shows an engine's standard error when it fails).
+* **Output hygiene.** `main` points file descriptor 1 at standard error
+  before the engine is built, and keeps the real standard output for the
+  protocol: a library that prints (a banner, a warning) cannot corrupt the
+  CSV or a session's framing.
+
+Options every adapter built with `main` accepts: ``--session`` (above) and
+``--timing`` (after each answer, ``step_time_s=S steps=N`` on standard error:
+the time spent in `Engine.reset` and the steps). The engine adds its own with
+`Engine.add_arguments`.
+
+Standard library only; Python 3.9 or newer.
+"""
+
+from __future__ import annotations
+
+import argparse
+import bisect
+import dataclasses
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass
+from typing import IO, Any, Callable, ClassVar, Iterable, NamedTuple, Sequence
+
+__all__ = [
+    "FORMATS",
+    "HEADER",
+    "SWITCHING_RULES",
+    "AdapterError",
+    "Engine",
+    "Initial",
+    "Limits",
+    "Problem",
+    "ProblemError",
+    "Push",
+    "Run",
+    "State",
+    "Support",
+    "answer",
+    "main",
+    "parse_problem",
+    "serve",
+    "simulate",
+]
+
+#: The document formats the kit reads.
+FORMATS = ("pushval-problem/1", "pushval-problem/2")
+
+#: The CSV header the kit writes.
+HEADER = "t,x,y,theta,omega"
+
+#: What ω does where the pusher's velocity jumps (version 2's ``switching``).
+SWITCHING_RULES = ("impulsive", "continuous")
+
+#: Seconds of stepping before the first progress line, and between lines.
+PROGRESS_EVERY_S = 5.0
+
+
+class ProblemError(ValueError):
+    """A problem document the kit cannot read; the message names the key."""
+
+
+class AdapterError(RuntimeError):
+    """A run that failed for a reason the engine states in its message.
+
+    Raise it from an engine for a clean one-line error (no traceback); any
+    other exception fails the run too, with its traceback on standard error.
+    """
+
+
+# --------------------------------------------------------------------------
+# The problem
+
+
+class State(NamedTuple):
+    """The object's state after a step (or at t = 0)."""
+
+    x: float
+    """World x of the centre of mass (m)."""
+    y: float
+    """World y of the centre of mass (m)."""
+    theta: float
+    """Object angle, unwrapped (rad)."""
+    omega: float
+    """Angular velocity (rad/s): the one held over the step that ended."""
+
+
+@dataclass(frozen=True)
+class Support:
+    """One support point of the object on the floor."""
+
+    point: tuple[float, float]
+    """Position in the scenario file's object frame (m)."""
+    offset: tuple[float, float]
+    """Position relative to the centre of mass, body frame (m)."""
+    mu: float
+    """Friction coefficient at this support (>= 0)."""
+    normal_force: float
+    """Load on this support (N, > 0), as the scenario resolved it."""
+
+    @property
+    def friction(self) -> float:
+        """Magnitude of the Coulomb friction force while sliding, μ N (N)."""
+        return self.mu * self.normal_force
+
+
+@dataclass(frozen=True)
+class Push:
+    """One segment of the schedule: the pusher at a constant velocity."""
+
+    index: int
+    """Position in the schedule (0 for the first)."""
+    t_start: float
+    """Start time (s)."""
+    duration: float
+    """Length (s, > 0)."""
+    speed: float
+    """Pusher speed (m/s, >= 0)."""
+    phi: float
+    """Pusher direction in the object frame (rad): the contact point moves at
+    ``speed * R(theta) (cos phi, sin phi)``."""
+
+    @property
+    def t_end(self) -> float:
+        """End time (s)."""
+        return self.t_start + self.duration
+
+    def velocity(self) -> tuple[float, float]:
+        """The pusher's velocity in the object frame (m/s)."""
+        return self.speed * math.cos(self.phi), self.speed * math.sin(self.phi)
+
+    def world_velocity(self, theta: float) -> tuple[float, float]:
+        """The pusher's velocity in the world when the object is at angle
+        ``theta`` (m/s)."""
+        a = theta + self.phi
+        return self.speed * math.cos(a), self.speed * math.sin(a)
+
+    def steps(self, dt: float, rule: str = "ceil") -> int:
+        """The number of equal steps cutting this segment at about ``dt``:
+        ``"ceil"`` (no step longer than dt, to a relative 1e-12) or
+        ``"round"`` (the nearest count); at least 1."""
+        ratio = self.duration / dt
+        if rule == "ceil":
+            return max(1, math.ceil(ratio * (1.0 - 1e-12)))
+        if rule == "round":
+            return max(1, round(ratio))
+        raise ValueError(f"unknown step rule {rule!r} (ceil, round)")
+
+
+@dataclass(frozen=True)
+class Initial:
+    """The state when the first push starts."""
+
+    position: tuple[float, float]
+    """World position of the centre of mass (m)."""
+    theta: float
+    """Object angle (rad)."""
+    omega: float
+    """Angular velocity (rad/s); ignored when `from_rest`."""
+    from_rest: bool
+    """The object is at rest when the pusher starts (the start is a switch
+    from zero velocity); otherwise it already moves with the first push at
+    ω = `omega`."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Version 2's cap on one answer: past it pushval kills the process."""
+
+    max_rows: int | None = None
+    """Most data rows (the header and framing lines not counted)."""
+    max_bytes: int | None = None
+    """Most bytes of the whole answer (header, rows, framing line)."""
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One run's problem, as the document states it (SI units).
+
+    Positions of the object's points are given twice: ``point`` in the
+    scenario file's object frame (as the document writes them) and
+    ``offset`` relative to the centre of mass (the body frame most
+    simulators want).
+    """
+
+    format: str
+    """The document's format (one of `FORMATS`)."""
+    engine: str
+    """The model name the engine is declared under in pushval.toml."""
+    dt: float
+    """The time step of this run (s)."""
+    mass: float
+    """kg."""
+    inertia_cm: float
+    """Moment of inertia about the centre of mass (kg m²)."""
+    center_of_mass: tuple[float, float]
+    """In the file's object frame (m)."""
+    polygon: tuple[tuple[float, float], ...]
+    """The outline, counter-clockwise, in the file's object frame (m)."""
+    supports: tuple[Support, ...]
+    contact: tuple[float, float]
+    """The pusher's contact point, file's object frame (m)."""
+    initial: Initial
+    pushes: tuple[Push, ...]
+    sample_dt: float
+    """Spacing of the output samples (s)."""
+    gravity: float
+    """m/s²."""
+    options: dict[str, Any]
+    """The scenario's ``[engine]`` table, verbatim."""
+    switching: str = "impulsive"
+    """What ω does where the pusher's velocity jumps (`SWITCHING_RULES`);
+    version 1 documents state none and mean ``"impulsive"``."""
+    limits: Limits = Limits()
+    """The answer's cap (version 2); no cap when the document gives none."""
+
+    @property
+    def version(self) -> int:
+        """The protocol version, 1 or 2."""
+        return int(self.format.rsplit("/", 1)[1])
+
+    @property
+    def contact_offset(self) -> tuple[float, float]:
+        """The contact point relative to the centre of mass, body frame (m)."""
+        return (
+            self.contact[0] - self.center_of_mass[0],
+            self.contact[1] - self.center_of_mass[1],
+        )
+
+    @property
+    def inertia_contact(self) -> float:
+        """Moment of inertia about the contact point, I_cm + m |r_c|² (kg m²)."""
+        rx, ry = self.contact_offset
+        return self.inertia_cm + self.mass * (rx * rx + ry * ry)
+
+    @property
+    def duration(self) -> float:
+        """The end of the last push (s)."""
+        total = 0.0
+        for p in self.pushes:  # summed in order, as pushval sums it
+            total += p.duration
+        return total
+
+    def sample_times(self) -> list[float]:
+        """The times pushval samples at: ``k * sample_dt`` up to the end
+        (inclusive within a relative 1e-9 of a sample step), the end itself
+        last."""
+        end = self.duration
+        n = math.floor(end / self.sample_dt * (1.0 + 1e-12) + 1e-9)
+        times = [k * self.sample_dt for k in range(n + 1)]
+        if end - times[-1] > 1e-9 * self.sample_dt:
+            times.append(end)
+        else:
+            times[-1] = end
+        return times
+
+    def contact_momentum(self, push: Push | None, omega: float) -> float:
+        """Angular momentum about the contact point (kg m²/s) of the object
+        turning at ``omega`` while its contact point moves with ``push``
+        (None: at rest): ``I_P ω - m (r_c × v_push)``, object frame."""
+        h = self.inertia_contact * omega
+        if push is None:
+            return h
+        rx, ry = self.contact_offset
+        return h - self.mass * push.speed * (rx * math.sin(push.phi) - ry * math.cos(push.phi))
+
+    def omega_after_switch(self, before: Push | None, after: Push, omega_before: float) -> float:
+        """ω just after the pusher switches from ``before`` (None: at rest)
+        to ``after``, given ω just before, by the problem's `switching` rule:
+        impulsive keeps the angular momentum about the contact point (the
+        contact impulse has no moment about it), continuous keeps ω."""
+        if self.switching == "continuous":
+            return omega_before
+        rx, ry = self.contact_offset
+        h = self.contact_momentum(before, omega_before)
+        lin = self.mass * after.speed * (rx * math.sin(after.phi) - ry * math.cos(after.phi))
+        return (h + lin) / self.inertia_contact
+
+    def start_omega(self) -> float:
+        """ω when the first push starts: `Initial.omega`, or for an object
+        at rest the value just after the start's switch."""
+        if not self.initial.from_rest:
+            return self.initial.omega
+        return self.omega_after_switch(None, self.pushes[0], 0.0)
+
+    def with_inertia(self, inertia_cm: float) -> Problem:
+        """The same problem with another I_cm (kg m²), e.g. for an engine
+        that is wrong on purpose."""
+        return dataclasses.replace(self, inertia_cm=inertia_cm)
+
+
+# --------------------------------------------------------------------------
+# Reading a document
+
+
+class _Reader:
+    """Typed access to one JSON object; every error names the key's path."""
+
+    def __init__(self, value: Any, path: str):
+        if not isinstance(value, dict):
+            raise ProblemError(f"`{path or 'document'}` must be an object, got {_kind(value)}")
+        self.value = value
+        self.path = path
+
+    def _key(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def has(self, key: str) -> bool:
+        return key in self.value
+
+    def raw(self, key: str) -> Any:
+        if key not in self.value:
+            raise ProblemError(f"`{self._key(key)}` is missing")
+        return self.value[key]
+
+    def obj(self, key: str) -> _Reader:
+        return _Reader(self.raw(key), self._key(key))
+
+    def objects(self, key: str) -> list[_Reader]:
+        items = self.raw(key)
+        if not isinstance(items, list) or not items:
+            raise ProblemError(f"`{self._key(key)}` must be a non-empty array, got {_kind(items)}")
+        return [_Reader(v, f"{self._key(key)}[{i}]") for i, v in enumerate(items)]
+
+    def number(self, key: str, minimum: float | None = None, strict: bool = False) -> float:
+        return _number(self.raw(key), self._key(key), minimum, strict)
+
+    def integer(self, key: str) -> int:
+        v = self.raw(key)
+        if isinstance(v, bool) or not isinstance(v, int) or v <= 0:
+            raise ProblemError(f"`{self._key(key)}` must be a whole number > 0, got {v!r}")
+        return v
+
+    def string(self, key: str) -> str:
+        v = self.raw(key)
+        if not isinstance(v, str):
+            raise ProblemError(f"`{self._key(key)}` must be a string, got {_kind(v)}")
+        return v
+
+    def boolean(self, key: str) -> bool:
+        v = self.raw(key)
+        if not isinstance(v, bool):
+            raise ProblemError(f"`{self._key(key)}` must be true or false, got {v!r}")
+        return v
+
+    def point(self, key: str) -> tuple[float, float]:
+        v = self.raw(key)
+        return _point(v, self._key(key))
+
+
+def _kind(v: Any) -> str:
+    return {dict: "an object", list: "an array", str: "a string", bool: "a boolean"}.get(
+        type(v), "null" if v is None else repr(v)
+    )
+
+
+def _number(v: Any, path: str, minimum: float | None = None, strict: bool = False) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ProblemError(f"`{path}` must be a number, got {_kind(v)}")
+    x = float(v)
+    if not math.isfinite(x):
+        raise ProblemError(f"`{path}` must be finite, got {x!r}")
+    if minimum is not None and (x <= minimum if strict else x < minimum):
+        raise ProblemError(f"`{path}` must be {'>' if strict else '>='} {minimum:g}, got {x!r}")
+    return x
+
+
+def _point(v: Any, path: str) -> tuple[float, float]:
+    if not isinstance(v, list) or len(v) != 2:
+        raise ProblemError(f"`{path}` must be a point [x, y], got {_kind(v)}")
+    return _number(v[0], f"{path}[0]"), _number(v[1], f"{path}[1]")
+
+
+def parse_problem(document: str | bytes | dict[str, Any]) -> Problem:
+    """Reads a pushval-problem document (JSON text or the decoded object).
+
+    Raises `ProblemError` naming the key for a document that is not JSON,
+    has another format, or lacks or mistypes a field. Keys the kit does not
+    know are ignored (a later version may add some).
+    """
+    if isinstance(document, (str, bytes)):
+        try:
+            document = json.loads(document)
+        except ValueError as e:
+            raise ProblemError(f"not JSON: {e}") from None
+    doc = _Reader(document, "")
+    fmt = doc.raw("format")
+    if fmt not in FORMATS:
+        raise ProblemError(f"`format` is {fmt!r}; this kit reads {' and '.join(FORMATS)}")
+    obj = doc.obj("object")
+    com = obj.point("center_of_mass")
+    supports = []
+    for s in doc.objects("supports"):
+        point = s.point("point")
+        supports.append(
+            Support(
+                point=point,
+                offset=(point[0] - com[0], point[1] - com[1]),
+                mu=s.number("mu", 0.0),
+                normal_force=s.number("normal_force", 0.0, strict=True),
+            )
+        )
+    ini = doc.obj("initial")
+    pushes = tuple(
+        Push(
+            index=i,
+            t_start=p.number("t_start", 0.0),
+            duration=p.number("duration", 0.0, strict=True),
+            speed=p.number("speed", 0.0),
+            phi=p.number("phi"),
+        )
+        for i, p in enumerate(doc.objects("pushes"))
+    )
+    polygon = doc.obj("object").raw("polygon")
+    if not isinstance(polygon, list) or len(polygon) < 2:
+        raise ProblemError(f"`object.polygon` must be an array of at least 2 points, got {_kind(polygon)}")
+    options = doc.raw("options")
+    if not isinstance(options, dict):
+        raise ProblemError(f"`options` must be an object, got {_kind(options)}")
+    switching = "impulsive"
+    limits = Limits()
+    if fmt != FORMATS[0]:
+        if doc.has("switching"):
+            switching = doc.string("switching")
+            if switching not in SWITCHING_RULES:
+                raise ProblemError(f"`switching` is {switching!r}; known: {', '.join(SWITCHING_RULES)}")
+        if doc.has("limits"):
+            lim = doc.obj("limits")
+            limits = Limits(
+                max_rows=lim.integer("max_rows") if lim.has("max_rows") else None,
+                max_bytes=lim.integer("max_bytes") if lim.has("max_bytes") else None,
+            )
+    return Problem(
+        format=fmt,
+        engine=doc.string("engine"),
+        dt=doc.number("dt", 0.0, strict=True),
+        mass=obj.number("mass", 0.0, strict=True),
+        inertia_cm=obj.number("inertia_cm", 0.0, strict=True),
+        center_of_mass=com,
+        polygon=tuple(_point(q, f"object.polygon[{i}]") for i, q in enumerate(polygon)),
+        supports=tuple(supports),
+        contact=doc.obj("contact").point("point"),
+        initial=Initial(
+            position=ini.point("position"),
+            theta=ini.number("theta"),
+            omega=ini.number("omega"),
+            from_rest=ini.boolean("from_rest"),
+        ),
+        pushes=pushes,
+        sample_dt=doc.number("sample_dt", 0.0, strict=True),
+        gravity=doc.number("gravity", 0.0, strict=True),
+        options=options,
+        switching=switching,
+        limits=limits,
+    )
+
+
+# --------------------------------------------------------------------------
+# The engine
+
+
+class Engine:
+    """An outside engine: subclass it, implement `reset` and `step`.
+
+    Class attributes tune what the kit does around them (see the module
+    docs): `name`, `switching_rules`, `step_rule`, `rows`.
+    """
+
+    name: ClassVar[str] = ""
+    """How messages name the engine; empty: the script's file name."""
+    switching_rules: ClassVar[tuple[str, ...]] = SWITCHING_RULES
+    """The switching rules this engine can follow (a problem asking another
+    is refused). An engine whose own contact makes the switch follows
+    ``("impulsive",)`` only."""
+    step_rule: ClassVar[str] = "ceil"
+    """How a segment is cut into steps: ``"ceil"`` (no step longer than the
+    problem's dt) or ``"round"`` (the nearest count); see `Push.steps`."""
+    rows: ClassVar[str] = "steps"
+    """``"steps"``: one row per step (best for pushval's resampler);
+    ``"samples"``: one row per sample time."""
+
+    @classmethod
+    def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
+        """Adds the engine's own command-line options to ``parser``; their
+        values reach ``__init__`` as ``args``. None by default."""
+
+    def __init__(self, args: argparse.Namespace | None = None):
+        """Built once per process (load heavy things here: a session reuses
+        them). ``args``: the parsed command line."""
+        self.args = args if args is not None else argparse.Namespace()
+
+    def reset(self, problem: Problem) -> State:
+        """Builds the scene of ``problem`` and returns the state at t = 0
+        (the first row). An engine that sets ω itself starts at
+        `Problem.start_omega`."""
+        raise NotImplementedError(f"{type(self).__name__}.reset")
+
+    def switch(self, before: Push, after: Push) -> None:
+        """The pusher's velocity jumps from ``before`` to ``after`` (at
+        ``after.t_start``, before its first step). An engine whose pusher is
+        a velocity constraint sets ω to
+        ``problem.omega_after_switch(before, after, omega)``. Default:
+        nothing (the engine's own contact makes the jump)."""
+
+    def step(self, push: Push, dt: float) -> State:
+        """Advances the scene by ``dt`` (s) with the pusher's contact point
+        moving at ``push.world_velocity(theta)``, and returns the state at
+        the step's end (ω: the one held over the step)."""
+        raise NotImplementedError(f"{type(self).__name__}.step")
+
+    def close(self) -> None:
+        """Called after every problem, failed or not: release what `reset`
+        built. Default: nothing."""
+
+
+@dataclass
+class Run:
+    """What `simulate` produced."""
+
+    rows: list[tuple[float, float, float, float, float]]
+    """``(t, x, y, theta, omega)``: t = 0 first, then one per step."""
+    steps: int
+    """The number of steps."""
+    step_time_s: float
+    """Wall time in `Engine.reset` and the steps (s)."""
+
+
+def _engine_name(engine: Engine) -> str:
+    return engine.name or os.path.basename(sys.argv[0] or "") or type(engine).__name__
+
+
+def _state(value: Any, t: float) -> tuple[float, float, float, float]:
+    try:
+        x, y, theta, omega = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise AdapterError(
+            f"the engine's state at t = {t!r} s is not four numbers (x, y, theta, omega): {value!r}"
+        ) from None
+    if not all(map(math.isfinite, (x, y, theta, omega))):
+        raise AdapterError(
+            f"the engine's state at t = {t!r} s is not finite: "
+            f"x = {x!r}, y = {y!r}, theta = {theta!r}, omega = {omega!r}"
+        )
+    return x, y, theta, omega
+
+
+def simulate(
+    engine: Engine,
+    problem: Problem,
+    progress: Callable[[float, float], None] | None = None,
+) -> Run:
+    """Runs ``problem`` on ``engine``: `Engine.reset`, then every segment's
+    steps (with `Engine.switch` between segments), `Engine.close` at the
+    end. ``progress(t, end)`` is called now and then (every 1024 steps).
+
+    Raises `AdapterError` for a switching rule the engine does not follow or
+    a state that is not four finite numbers.
+    """
+    if problem.switching not in engine.switching_rules:
+        raise AdapterError(
+            f"the problem asks for {problem.switching} switching; this engine follows "
+            f"{' and '.join(engine.switching_rules)} only"
+        )
+    end = problem.duration
+    started = time.perf_counter()
+    try:
+        raw: list[tuple[float, Any]] = [(0.0, engine.reset(problem))]
+        before: Push | None = None
+        step = engine.step
+        for push in problem.pushes:
+            if before is not None:
+                engine.switch(before, push)
+            before = push
+            n = push.steps(problem.dt, engine.step_rule)
+            h = push.duration / n
+            t0 = push.t_start
+            for j in range(1, n):
+                raw.append((t0 + j * h, step(push, h)))
+                if progress is not None and not j & 1023:
+                    progress(t0 + j * h, end)
+            raw.append((t0 + push.duration, step(push, h)))
+        elapsed = time.perf_counter() - started
+    finally:
+        engine.close()
+    rows = [(t, *_state(s, t)) for t, s in raw]
+    return Run(rows=rows, steps=len(rows) - 1, step_time_s=elapsed)
+
+
+# --------------------------------------------------------------------------
+# Writing an answer
+
+
+def _sampled(problem: Problem, rows: Sequence[tuple[float, ...]]) -> list[tuple[float, ...]]:
+    """The rows at the problem's sample times: the pose interpolated
+    linearly between the step ends around each, ω the one held over the step
+    holding it (at t = 0, the first row's)."""
+    times = [r[0] for r in rows]
+    out = []
+    for t in problem.sample_times():
+        k = bisect.bisect_left(times, t)
+        if k == 0:
+            out.append((t, *rows[0][1:]))
+            continue
+        if k >= len(rows):
+            out.append((t, *rows[-1][1:]))
+            continue
+        a, b = rows[k - 1], rows[k]
+        s = (t - a[0]) / (b[0] - a[0])
+        out.append((t, a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]), a[3] + s * (b[3] - a[3]), b[4]))
+    return out
+
+
+def _csv(rows: Iterable[tuple[float, ...]]) -> str:
+    return "".join(",".join(map(repr, r)) + "\n" for r in rows)
+
+
+def answer(
+    problem: Problem,
+    run: Run,
+    mode: str = "steps",
+    framing: str = "",
+    note: Callable[[str], None] | None = None,
+) -> str:
+    """The CSV answer to ``problem``: header and rows (per step, or per
+    sample for ``mode = "samples"``), then ``framing`` (``"#end\\n"`` in a
+    session). Within the problem's `Limits`: rows per step that would exceed
+    them are written per sample (``note`` says so); if those exceed them too,
+    `AdapterError`."""
+    if mode not in ("steps", "samples"):
+        raise ValueError(f"unknown row mode {mode!r} (steps, samples)")
+    lim = problem.limits
+    head = HEADER + "\n"
+
+    def within(rows: Sequence[tuple[float, ...]]) -> tuple[str | None, str]:
+        """Why ``rows`` exceed the limits (None: they fit), and their text."""
+        if lim.max_rows is not None and len(rows) > lim.max_rows:
+            return f"{len(rows)} rows (the limit is {lim.max_rows})", ""
+        text = _csv(rows)
+        if lim.max_bytes is not None:
+            size = len(head) + len(text.encode()) + len(framing.encode())
+            if size > lim.max_bytes:
+                return f"{size} bytes (the limit is {lim.max_bytes})", ""
+        return None, text
+
+    if mode == "samples":
+        why, text = within(_sampled(problem, run.rows))
+        if why:
+            raise AdapterError(f"the answer exceeds the problem's limits: {why}")
+        return head + text + framing
+    why, text = within(run.rows)
+    if why:
+        samples = _sampled(problem, run.rows)
+        why_samples, text = within(samples)
+        if why_samples:
+            raise AdapterError(
+                f"the answer exceeds the problem's limits: {run.steps} steps would be {why}, "
+                f"and its {len(samples)} sample times still {why_samples}"
+            )
+        if note is not None:
+            note(f"{run.steps} steps would be {why}: writing the {len(samples)} sample times instead")
+    return head + text + framing
+
+
+# --------------------------------------------------------------------------
+# Serving
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+class _Server:
+    """Reads problems, runs them, writes answers."""
+
+    def __init__(self, engine: Engine, out: IO[str], err: IO[str], timing: bool):
+        self.engine = engine
+        self.out = out
+        self.err = err
+        self.timing = timing
+        self.name = _engine_name(engine)
+
+    def say(self, text: str) -> None:
+        self.err.write(f"{self.name}: {text}\n")
+        self.err.flush()
+
+    def progress(self) -> Callable[[float, float], None]:
+        start = time.monotonic()
+        next_at = [start + PROGRESS_EVERY_S]
+
+        def report(t: float, end: float) -> None:
+            now = time.monotonic()
+            if now >= next_at[0]:
+                next_at[0] = now + PROGRESS_EVERY_S
+                self.say(f"t = {t:.4g} of {end:.4g} s ({100 * t / end:.0f} %), {now - start:.1f} s so far")
+
+        return report
+
+    def solve(self, problem: Problem, framing: str) -> str:
+        run = simulate(self.engine, problem, self.progress())
+        if self.timing:
+            self.err.write(f"step_time_s={run.step_time_s!r} steps={run.steps}\n")
+            self.err.flush()
+        return answer(problem, run, self.engine.rows, framing, self.say)
+
+    def failure(self, e: BaseException) -> str:
+        """Reports a failed run on standard error; returns its one-line
+        message."""
+        if isinstance(e, (AdapterError, ProblemError)):
+            message = str(e)
+        else:
+            import traceback
+
+            traceback.print_exception(type(e), e, e.__traceback__, file=self.err)
+            message = f"{type(e).__name__}: {e}"
+        return _one_line(message)
+
+    def one_shot(self, stdin: IO[str]) -> int:
+        try:
+            problem = parse_problem(stdin.read())
+        except ProblemError as e:
+            self.say(f"the problem document on standard input: {e}")
+            return 2
+        try:
+            text = self.solve(problem, "")
+        except Exception as e:  # noqa: BLE001 - every failure is reported
+            self.say(f"the run failed: {self.failure(e)}")
+            return 1
+        self.out.write(text)
+        self.out.flush()
+        return 0
+
+    def session(self, stdin: IO[str]) -> int:
+        number = 0
+        while True:
+            line = stdin.readline()
+            if not line:
+                return 0
+            if not line.strip():
+                continue
+            number += 1
+            try:
+                problem = parse_problem(line)
+                text = self.solve(problem, "#end\n")
+            except ProblemError as e:
+                text = f"#error problem {number}: the document: {_one_line(str(e))}\n"
+                self.say(text[len("#error ") :].rstrip())
+            except Exception as e:  # noqa: BLE001 - every failure is answered
+                text = f"#error problem {number}: {self.failure(e)}\n"
+                self.say(text[len("#error ") :].rstrip())
+            self.out.write(text)
+            self.out.flush()
+
+
+def serve(
+    engine: Engine,
+    session: bool = False,
+    stdin: IO[str] | None = None,
+    stdout: IO[str] | None = None,
+    stderr: IO[str] | None = None,
+    timing: bool = False,
+) -> int:
+    """Serves problems from ``stdin`` on ``engine`` (one-shot, or a session
+    of one document per line), answering on ``stdout``; returns the exit
+    status (see the module docs). The streams default to the process's."""
+    server = _Server(engine, stdout or sys.stdout, stderr or sys.stderr, timing)
+    stdin = stdin or sys.stdin
+    return server.session(stdin) if session else server.one_shot(stdin)
+
+
+def _protocol_stdout() -> IO[str]:
+    """The real standard output for the protocol alone; file descriptor 1
+    (and so anything else that prints) goes to standard error from now on."""
+    try:
+        sys.stdout.flush()
+        fd = os.dup(1)
+        os.dup2(2, 1)
+    except (OSError, ValueError, AttributeError):
+        return sys.stdout  # not a real file (an embedding host): keep it
+    return os.fdopen(fd, "w", encoding="utf-8", newline="\n")
+
+
+def main(engine: Callable[[argparse.Namespace], Engine], argv: Sequence[str] | None = None) -> None:
+    """Runs an adapter process: parses the command line (``--session``,
+    ``--timing`` and the engine's own options, see
+    `Engine.add_arguments`), builds the engine once, serves standard input
+    and exits with the status of `serve`. A bad command line exits 2."""
+    parser = argparse.ArgumentParser(
+        prog=getattr(engine, "name", "") or None,
+        description=(getattr(engine, "__doc__", None) or "").strip().split("\n\n")[0] or None,
+    )
+    parser.add_argument(
+        "--session",
+        action="store_true",
+        help="serve one problem document per line until standard input closes "
+        "(answers framed by #end / #error)",
+    )
+    parser.add_argument(
+        "--timing",
+        action="store_true",
+        help="after each answer print step_time_s=S steps=N on standard error",
+    )
+    add = getattr(engine, "add_arguments", None)
+    if add is not None:
+        add(parser)
+    args = parser.parse_args(argv)
+    out = _protocol_stdout()
+    stdin = open(sys.stdin.fileno(), encoding="utf-8", closefd=False)
+    try:
+        instance = engine(args)
+    except AdapterError as e:
+        sys.stderr.write(f"{parser.prog}: {e}\n")
+        sys.exit(1)
+    try:
+        status = serve(instance, args.session, stdin, out, sys.stderr, args.timing)
+    except BrokenPipeError:
+        status = 1  # pushval stopped reading: nothing more to say
+    except KeyboardInterrupt:
+        status = 130
+    sys.exit(status)
