@@ -4,6 +4,7 @@
 
 pub mod fit;
 pub mod harness;
+pub mod init;
 pub mod output;
 pub mod outside;
 pub mod power;

@@ -3,7 +3,7 @@
 //! Exit codes: 0 every gated tolerance holds, 1 a tolerance failed, 2 unusable
 //! input or an error (nothing is written then).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
@@ -215,6 +215,15 @@ enum Command {
         /// scenario's first gated engine.
         #[arg(long, value_name = "NAME")]
         engine: Option<String>,
+    },
+    /// Start a project in the current folder that gates your own engine:
+    /// pushval.toml (one Python engine), adapter.py (written with the
+    /// adapter kit pushval.adapter, Coulomb forces per support) and
+    /// scenarios/my_engine.toml; `pushval` right after gates it.
+    Init {
+        /// Overwrite files that exist.
+        #[arg(long)]
+        force: bool,
     },
     /// Write what pushval ships inside its binary (the scenarios, the study
     /// files and the protocol's JSON schemas) into OUT/scenarios,
@@ -448,6 +457,7 @@ fn main() -> ExitCode {
             deny_loose,
         }) => validate(files, json, junit, deny_loose),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Init { force }) => pushval::init::cli(Path::new("."), force),
         Some(Command::Shipped { out, force }) => {
             pushval::shipped::write_out(&out, force).map(|files| {
                 println!("wrote {} files under {}", files.len(), out.display());

@@ -35,8 +35,9 @@ Two ways to serve, chosen by one rule pushval relies on:
   document, then end of file. The kit writes the CSV and exits 0; a document
   it cannot read exits 2, a failed run exits 1, both with the reason on
   standard error and nothing on standard output.
-* **session** (the process is started with ``--session``; pushval passes it
-  when the engine's ``pushval.toml`` table says ``session = true``): standard
+* **session** (pushval starts the process with ``PUSHVAL_SESSION=1`` in its
+  environment when the engine's ``pushval.toml`` table says
+  ``session = true``; ``--session`` does the same by hand): standard
   input holds one document per line. Each is answered with the header, the
   rows and a line ``#end``, flushed. A document that cannot be read or a run
   that fails is answered by one line ``#error MESSAGE`` instead (nothing
@@ -889,7 +890,10 @@ def main(engine: Callable[[argparse.Namespace], Engine], argv: Sequence[str] | N
         sys.stderr.write(f"{parser.prog}: {e}\n")
         sys.exit(1)
     try:
-        status = serve(instance, args.session, stdin, out, sys.stderr, args.timing)
+        # pushval starts a session with PUSHVAL_SESSION=1 in the environment
+        # (`session = true` in pushval.toml); --session does the same by hand.
+        session = args.session or os.environ.get("PUSHVAL_SESSION") == "1"
+        status = serve(instance, session, stdin, out, sys.stderr, args.timing)
     except BrokenPipeError:
         status = 1  # pushval stopped reading: nothing more to say
     except KeyboardInterrupt:

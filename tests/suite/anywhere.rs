@@ -99,3 +99,67 @@ fn study_runs_in_an_empty_folder() {
     assert!(stderr.contains("pybullet_contact"), "{stderr}");
     assert!(dir.path().join("s/map.csv").is_file());
 }
+
+/// `pushval init` in an empty folder, then the main job: the init adapter
+/// (Coulomb forces per support, in Python) passes its gate; its trajectory
+/// feeds `fit` and `track`, and `study` maps it. A second `init` refuses to
+/// overwrite, exit 2 naming the file.
+#[test]
+fn init_then_gate_study_fit_and_track_in_an_empty_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = |args: &[&str]| {
+        let out = pushval_in(d).args(args).output().unwrap();
+        let text = format!(
+            "{}\n{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (out.status.code(), text)
+    };
+    let (code, text) = run(&["init"]);
+    assert_eq!(code, Some(0), "{text}");
+    for f in ["pushval.toml", "adapter.py", "scenarios/my_engine.toml"] {
+        assert!(d.join(f).is_file(), "{f}");
+    }
+    let (code, text) = run(&[]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(
+        text.contains("my_engine") && text.contains("PASS"),
+        "{text}"
+    );
+    let (code, text) = run(&["init"]);
+    assert_eq!(code, Some(2), "{text}");
+    assert!(text.contains("pushval.toml: already exists"), "{text}");
+    let (code, text) = run(&["run", "scenarios/my_engine.toml", "--out", "r"]);
+    assert_eq!(code, Some(0), "{text}");
+    let (code, text) = run(&[
+        "fit",
+        "scenarios/my_engine.toml",
+        "--trajectory",
+        "r/trajectory.csv",
+        "--model",
+        "my_engine",
+        "--params",
+        "mu_scale",
+        "--out",
+        "f",
+    ]);
+    assert_eq!(code, Some(0), "{text}");
+    let (code, text) = run(&[
+        "track",
+        "scenarios/my_engine.toml",
+        "--trajectory",
+        "r/trajectory.csv",
+        "--model",
+        "my_engine",
+        "--params",
+        "mu_scale",
+        "--out",
+        "k",
+    ]);
+    assert_eq!(code, Some(0), "{text}");
+    let (code, text) = run(&["study", "my_engine", "--quick", "--out", "s"]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(d.join("s/map.csv").is_file(), "{text}");
+}
