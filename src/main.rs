@@ -326,12 +326,16 @@ fn validate(
         }
     }
     let opts = RunOptions::default();
-    let mut reports: Vec<ScenarioReport> = Vec::new();
-    for sc in &scenarios {
-        let r = run_scenario(sc, &opts)
-            .with_context(|| format!("{}: running the models", sc.path.display()))?;
-        reports.push(r);
-    }
+    // Scenarios are independent: run them side by side (rayon keeps the
+    // order of the table; outside engines share the session pool).
+    use rayon::prelude::*;
+    let reports: Vec<ScenarioReport> = scenarios
+        .par_iter()
+        .map(|sc| {
+            run_scenario(sc, &opts)
+                .with_context(|| format!("{}: running the models", sc.path.display()))
+        })
+        .collect::<anyhow::Result<_>>()?;
     if let Some(path) = &junit {
         output::write_atomic(path, output::junit(&reports).as_bytes())?;
     }
