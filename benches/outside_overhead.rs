@@ -30,13 +30,9 @@
 //! * `engine_run`: `Engine::run` of the outside engine (the process plus
 //!   pushval's document, parse and resample), with `python3` from PATH.
 //!
-//! * `engine_run_once_fixture_resolved`, `engine_run_session_*`: the same
-//!   stepping (`simulate` of pure_python.py) behind the session test adapter
-//!   (`crates/outside/tests/fixtures/session_adapter.py --simulate`), one
-//!   process per run (`--once`) and as a session (`session = true`: one
-//!   process answering every run, started by a warm-up run outside the
-//!   timing). pure_python.py itself reads pushval-problem/1 only, one
-//!   process per run.
+//! * `engine_run_session_*`: pure_python.py as a session (`session = true`:
+//!   one process answering every run, started by a warm-up run outside the
+//!   timing), beside the one-process-per-run rows above.
 //!
 //! The protocol's overhead per run is `engine_run − adapter_stepping`; the
 //! rows `overhead_*` give it and `overhead_share_*` its share of the run.
@@ -89,19 +85,16 @@ fn spec(python: &str) -> Arc<Spec> {
     Arc::new(cfg.engines.into_iter().next().expect("one engine"))
 }
 
-/// The session test adapter wrapping pure_python.py's stepping, as a
-/// session (`session = true`) or one process per run (`--once`).
-fn fixture_spec(python: &str, session: bool) -> Arc<Spec> {
+/// pure_python.py as a session (`session = true`: one process answering
+/// every run, the kit's session mode).
+fn session_spec(python: &str) -> Arc<Spec> {
     let text = format!(
-        "[engine.pure_python_fixture]\ncommand = [{python:?}, \"crates/outside/tests/fixtures/session_adapter.py\", \"--simulate\", \"adapters/python/pure_python.py\"{}]\norder = 1\n{}",
-        if session { "" } else { ", \"--once\"" },
-        if session { "session = true\n" } else { "" }
+        "[engine.pure_python]\ncommand = [{python:?}, \"adapters/python/pure_python.py\"]\norder = 1\nsession = true\n"
     );
     let cfg = Config::from_toml(&text, &root().join("pushval.toml")).expect("a valid engines file");
     Arc::new(cfg.engines.into_iter().next().expect("one engine"))
 }
 
-/// The interpreter `python3` on PATH runs (through a shim or not).
 fn resolved_python() -> String {
     let o = Command::new("python3")
         .args(["-c", "import sys; print(sys.executable)"])
@@ -289,19 +282,9 @@ fn main() {
         run_r,
         format!("OutsideEngine::run (command {py})"),
     );
-    // The same stepping behind the session test adapter: one process per
-    // run, then one session for every run (its start outside the timing).
-    let once = OutsideEngine::new(fixture_spec(&py, false), &options);
-    let once_run = time(runs, || once.run(&problem, DT).unwrap());
-    put(
-        &mut rows,
-        "engine_run_once_fixture_resolved",
-        once_run,
-        format!("OutsideEngine::run, session_adapter.py --simulate pure_python.py --once ({py}): one process per run"),
-    );
     let mut session_rows = Vec::new();
     for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
-        let session = OutsideEngine::new(fixture_spec(python, true), &options);
+        let session = OutsideEngine::new(session_spec(python), &options);
         let warm = session.run(&problem, DT).unwrap();
         assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
         let r = time(runs, || session.run(&problem, DT).unwrap());
@@ -314,7 +297,7 @@ fn main() {
             &mut rows,
             &format!("engine_run_session_{label}"),
             r,
-            format!("OutsideEngine::run, session_adapter.py --simulate pure_python.py as a session ({python}): one process for {} runs, started before the timing", runs + 2),
+            format!("OutsideEngine::run, pure_python.py as a session ({python}): one process for {} runs, started before the timing", runs + 2),
         );
         session_rows.push((format!("session_{label}"), r));
         shutdown_sessions();
@@ -340,7 +323,6 @@ fn main() {
     let mut overheads = vec![
         ("python3_on_path".to_string(), run),
         ("resolved".to_string(), run_r),
-        ("once_fixture_resolved".to_string(), once_run),
     ];
     overheads.extend(session_rows);
     for (label, r) in overheads {
