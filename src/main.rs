@@ -203,8 +203,9 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
-    /// Print the pushval-problem/1 JSON document an outside engine receives
-    /// for this scenario (adapters/pushval-problem-1.schema.json).
+    /// Print the pushval-problem JSON document an outside engine receives
+    /// for this scenario (adapters/pushval-problem-1.schema.json, or -2 with
+    /// --protocol 2).
     Problem {
         file: PathBuf,
         /// The time step written into the document (s); default the
@@ -215,6 +216,10 @@ enum Command {
         /// scenario's first gated engine.
         #[arg(long, value_name = "NAME")]
         engine: Option<String>,
+        /// The protocol version of the document: 1, or 2 (adds the
+        /// switching rule and the output limits).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+        protocol: u8,
     },
     /// Start a project in the current folder that gates your own engine:
     /// pushval.toml (one Python engine), adapter.py (written with the
@@ -410,7 +415,12 @@ fn compare(file: PathBuf, csv: PathBuf) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn problem(file: PathBuf, dt: Option<f64>, engine: Option<String>) -> anyhow::Result<ExitCode> {
+fn problem(
+    file: PathBuf,
+    dt: Option<f64>,
+    engine: Option<String>,
+    protocol: u8,
+) -> anyhow::Result<ExitCode> {
     let sc = pushval::registry::load(&file)?;
     let dt = dt
         .or(sc.engine.dt)
@@ -421,7 +431,13 @@ fn problem(file: PathBuf, dt: Option<f64>, engine: Option<String>) -> anyhow::Re
     let engine = engine
         .or_else(|| sc.gate.first().cloned())
         .unwrap_or_default();
-    let doc = pushval::registry::problem_document(&engine, &sc.problem(), &sc.engine, dt);
+    let problem = sc.problem();
+    let doc = if protocol == 2 {
+        let limits = pushval_outside::Limits::for_problem(&problem, dt);
+        pushval_outside::problem_document_v2(&engine, &problem, &sc.engine, dt, limits)
+    } else {
+        pushval::registry::problem_document(&engine, &problem, &sc.engine, dt)
+    };
     println!("{}", serde_json::to_string_pretty(&doc)?);
     Ok(ExitCode::SUCCESS)
 }
@@ -468,7 +484,12 @@ fn main() -> ExitCode {
                 ExitCode::SUCCESS
             })
         }
-        Some(Command::Problem { file, dt, engine }) => problem(file, dt, engine),
+        Some(Command::Problem {
+            file,
+            dt,
+            engine,
+            protocol,
+        }) => problem(file, dt, engine, protocol),
         Some(Command::Power { out, quick }) => pushval::power::cli(&out, quick),
         Some(Command::Fit {
             file,
