@@ -548,6 +548,27 @@ pub fn read<R: BufRead>(
     })
 }
 
+/// Reads a whole trajectory text and refuses one holding several models
+/// ([`several_models`], listing them all), without keeping its rows: the
+/// check a streaming reader of a file makes before it starts.
+pub fn require_one_model<R: BufRead>(
+    input: R,
+    file: &str,
+    max_rows: usize,
+) -> Result<(), FormatError> {
+    let mut reader = Reader::new(input, file, max_rows).select(Select::All);
+    let mut second_line = 0;
+    while let Some(row) = reader.next_row()? {
+        if second_line == 0 && reader.models().len() > 1 {
+            second_line = row.line;
+        }
+    }
+    match reader.models() {
+        [] | [_] => Ok(()),
+        m => Err(several_models(file, second_line, m)),
+    }
+}
+
 /// Sets every sample's ω from θ over the sample times: second-order finite
 /// differences of θ (taken as written: unwrapped), exact for θ quadratic in
 /// t on any grid.
@@ -724,6 +745,14 @@ mod tests {
         assert_eq!(all.runs.len(), 3);
         assert_eq!(all.select(Some("a")).unwrap().samples.len(), 2);
         let e = all.select(None).unwrap_err();
+        assert_eq!(
+            require_one_model(text.as_bytes(), "f.csv", 100),
+            Err(e.clone())
+        );
+        assert_eq!(
+            require_one_model(&text.as_bytes()[..28], "f.csv", 100),
+            Ok(())
+        );
         assert_eq!(
             e.to_string(),
             "f.csv: line 3: column `model`: the file holds more than one model (a, b, c); choose one with --model NAME"

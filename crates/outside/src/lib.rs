@@ -15,8 +15,9 @@
 //! column of a malformed row. A run past `timeout_s` is killed (with its
 //! process group) and is an error, never a pass.
 //!
-//! It also holds the one CSV reader of pushval's numeric trajectory files
-//! ([`csv`]), which `pushval compare` shares.
+//! The output is read in pushval's one trajectory format
+//! ([`pushval_model::format`], through [`csv`]), the format `compare`, `fit`
+//! and `track` read.
 //!
 //! What it is not: a sandbox. `pushval.toml` is trusted like a build script;
 //! a scenario file can name an outside engine but never define one.
