@@ -507,12 +507,20 @@ fn filter_rates_are_the_models_right_hand_side() {
             let seg = pushval_model::SegmentDynamics::new(&b, &push);
             let omega = 20.0 * (rng.uniform() - 0.5);
             let want = seg.omega_dot(omega);
-            let scale = want.abs().max(seg.max_moment() / seg.inertia_contact() * 1e-3);
+            let scale = want
+                .abs()
+                .max(seg.max_moment() / seg.inertia_contact() * 1e-3);
             let got = md.rates(push.velocity(), omega, &p).omega_dot;
-            assert!((got - want).abs() <= 1e-12 * scale, "rates: {got} vs {want}");
+            assert!(
+                (got - want).abs() <= 1e-12 * scale,
+                "rates: {got} vs {want}"
+            );
             let (q, _) = md.to_q(&p);
             let got = md.rates_q(push.velocity(), omega, &q).omega_dot;
-            assert!((got - want).abs() <= 1e-12 * scale, "rates_q: {got} vs {want}");
+            assert!(
+                (got - want).abs() <= 1e-12 * scale,
+                "rates_q: {got} vs {want}"
+            );
         }
     }
 }
