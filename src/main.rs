@@ -51,9 +51,12 @@ enum Command {
     /// one fails.
     Compare {
         file: PathBuf,
-        /// The outside trajectory: model,t,x,y,theta,omega on the scenario's time grid.
+        /// The outside trajectory (t,x,y,theta; omega, model optional) on the scenario's time grid.
         #[arg(long, value_name = "CSV")]
         trajectory: PathBuf,
+        /// Which run of the CSV's `model` column (default: the only one).
+        #[arg(long, value_name = "NAME")]
+        model: Option<String>,
     },
     /// Sweep dt, speed, friction, supports, aspect ratio and horizon for the
     /// adaptive integrator, RK4 and rapier2d; write DIR/stress.csv and
@@ -115,7 +118,7 @@ enum Command {
     /// parameter is unidentifiable.
     Fit {
         file: PathBuf,
-        /// The trajectory: model,t,x,y,theta,omega on the scenario's time grid.
+        /// The trajectory (t,x,y,theta; omega, model optional) on the scenario's time grid.
         #[arg(long, value_name = "CSV")]
         trajectory: PathBuf,
         /// What to estimate: mu_scale, inertia_cm, center_of_friction, contact.
@@ -152,7 +155,7 @@ enum Command {
     /// not converge or the model does not explain the data.
     Track {
         file: PathBuf,
-        /// The trajectory (t,x,y,theta,omega; model, fx, fy optional), or `-` for standard input.
+        /// The trajectory (t,x,y,theta; omega, model, fx, fy optional), or `-` for standard input.
         #[arg(long, value_name = "CSV|-")]
         trajectory: PathBuf,
         /// What to estimate: mu_scale, center_of_friction, inertia_cm.
@@ -394,12 +397,15 @@ fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn compare(file: PathBuf, csv: PathBuf) -> anyhow::Result<ExitCode> {
+fn compare(file: PathBuf, csv: PathBuf, model: Option<String>) -> anyhow::Result<ExitCode> {
     let sc = pushval::registry::load(&file)?;
-    let outside = pushval::outside::read_csv(&csv)?;
-    let (mut report, comparisons) = pushval::outside::compare_outside(&sc, &outside, &csv)?;
+    let outside = pushval::outside::read_trajectory(&csv, model.as_deref())?;
+    let (mut report, comparisons) = pushval::outside::compare_outside(&sc, &outside)?;
     report.comparisons = comparisons;
     print!("{}", output::table(std::slice::from_ref(&report)));
+    if let Some(note) = outside.omega_note() {
+        println!("{note}");
+    }
     let failed: Vec<_> = report
         .comparisons
         .iter()
@@ -542,7 +548,11 @@ fn main() -> ExitCode {
             print!("{}", pushval::engines_table());
             Ok(ExitCode::SUCCESS)
         }
-        Some(Command::Compare { file, trajectory }) => compare(file, trajectory),
+        Some(Command::Compare {
+            file,
+            trajectory,
+            model,
+        }) => compare(file, trajectory, model),
         Some(Command::Stress { out, quick }) => stress(out, quick),
         Some(Command::Report {
             out,

@@ -16,8 +16,10 @@
 //! NaN or infinity is ever written.
 //!
 //! # `trajectory.csv`
-//! Header `model,t,x,y,theta,omega`; one row per model per sample time; x, y
-//! the centre of mass in the world frame (m), theta unwrapped (rad).
+//! The one trajectory format ([`pushval_model::format`], which `compare`,
+//! `fit` and `track` read): header `model,t,x,y,theta,omega`; one row per
+//! model per sample time; x, y the centre of mass in the world frame (m),
+//! theta unwrapped (rad).
 
 use std::io::Write;
 use std::path::Path;
@@ -221,17 +223,15 @@ pub fn assumption_flags(report: &ScenarioReport) -> Vec<&'static str> {
 
 /// The `trajectory.csv` text.
 pub fn trajectory_csv(report: &ScenarioReport) -> String {
-    let mut s = String::from("model,t,x,y,theta,omega\n");
-    for r in &report.runs {
-        for p in &r.trajectory.samples {
-            // Samples are finite: the models return an error on a blow-up.
-            s.push_str(&format!(
-                "{},{},{},{},{},{}\n",
-                r.name, p.t, p.x, p.y, p.theta, p.omega
-            ));
-        }
-    }
-    s
+    // Samples are finite: the models return an error on a blow-up.
+    let runs: Vec<(&str, &[pushval_model::Sample])> = report
+        .runs
+        .iter()
+        .map(|r| (r.name.as_str(), r.trajectory.samples.as_slice()))
+        .collect();
+    let mut out = Vec::new();
+    pushval_model::format::write(&mut out, &runs).expect("writing to memory");
+    String::from_utf8(out).expect("the format is ASCII")
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a

@@ -2,10 +2,10 @@
 //! model, or a recorded experiment) measured against the analytic model and
 //! the engine with the same figures and tolerances as `validate`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
-use pushval_model::{Sample, Trajectory};
+use pushval_model::{format, Sample, Trajectory};
 use pushval_scenario::Scenario;
 
 use crate::harness::{
@@ -13,114 +13,67 @@ use crate::harness::{
     SteadyRead,
 };
 
-/// The trajectories of an outside CSV file, per value of its `model` column.
+/// One trajectory read from a file in the one trajectory format
+/// ([`pushval_model::format`]).
 #[derive(Debug, Clone)]
 pub struct Outside {
-    pub runs: Vec<(String, Vec<Sample>)>,
+    /// The file.
+    pub file: PathBuf,
+    /// Its `model` field, or the file's name without a `model` column.
+    pub name: String,
+    /// The samples, in time order.
+    pub samples: Vec<Sample>,
+    /// Whether ω came from the file (false: derived from θ).
+    pub omega_read: bool,
 }
 
-/// Reads a CSV in `trajectory.csv`'s columns (`model,t,x,y,theta,omega`, in
-/// any order, extra columns ignored). Parsed by hand: the format is fixed
-/// and numeric, and errors must name the line and the column.
-pub fn read_csv(path: &Path) -> anyhow::Result<Outside> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    let Some((_, header)) = lines.next() else {
-        bail!("{}: the file is empty", path.display());
-    };
-    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
-    let find = |name: &str| {
-        cols.iter().position(|c| *c == name).with_context(|| {
+impl Outside {
+    /// The line saying ω was derived, when it was.
+    pub fn omega_note(&self) -> Option<String> {
+        (!self.omega_read).then(|| {
             format!(
-                "{}: line 1: the header lacks the column `{name}` (need model,t,x,y,theta,omega)",
-                path.display()
+                "note: {}: no `omega` column: omega derived from theta (second-order differences over t)",
+                self.file.display()
             )
         })
-    };
-    let (im, it, ix, iy, ith, iw) = (
-        find("model")?,
-        find("t")?,
-        find("x")?,
-        find("y")?,
-        find("theta")?,
-        find("omega")?,
-    );
-    let mut runs: Vec<(String, Vec<Sample>)> = Vec::new();
-    for (rows, (n, line)) in lines.enumerate() {
-        // The loader's sample cap, per file (a trajectory the scenario
-        // could not ask for is refused before it is held in memory).
-        if rows as f64 >= pushval_scenario::MAX_SAMPLES {
-            bail!(
-                "{}: line {}: more than {:e} data rows (the most samples a scenario may ask for)",
-                path.display(),
-                n + 1,
-                pushval_scenario::MAX_SAMPLES
-            );
-        }
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        if f.len() != cols.len() {
-            bail!(
-                "{}: line {}: {} fields, the header has {}",
-                path.display(),
-                n + 1,
-                f.len(),
-                cols.len()
-            );
-        }
-        let num = |i: usize| -> anyhow::Result<f64> {
-            let v: f64 = f[i].parse().with_context(|| {
-                format!(
-                    "{}: line {}: column `{}`: `{}` is not a number",
-                    path.display(),
-                    n + 1,
-                    cols[i],
-                    f[i]
-                )
-            })?;
-            if !v.is_finite() {
-                bail!(
-                    "{}: line {}: column `{}`: {} is not finite",
-                    path.display(),
-                    n + 1,
-                    cols[i],
-                    v
-                );
-            }
-            Ok(v)
-        };
-        let s = Sample {
-            t: num(it)?,
-            x: num(ix)?,
-            y: num(iy)?,
-            theta: num(ith)?,
-            omega: num(iw)?,
-        };
-        match runs.iter_mut().find(|r| r.0 == f[im]) {
-            Some(r) => r.1.push(s),
-            None => runs.push((f[im].to_string(), vec![s])),
-        }
     }
-    if runs.is_empty() {
-        bail!("{}: no data rows", path.display());
-    }
-    Ok(Outside { runs })
 }
 
-/// Measures every outside trajectory against the dynamic model and rapier2d.
-/// The outside samples must lie on a uniform grid from t = 0; the models are
-/// sampled on the same grid. Returns the report of the reference runs and one
-/// comparison per outside trajectory and reference.
+/// Reads the trajectory `model` of `path` (the only one when `model` is
+/// None; a file holding several needs one named), at most
+/// [`pushval_scenario::MAX_SAMPLES`] data rows.
+pub fn read_trajectory(path: &Path, model: Option<&str>) -> anyhow::Result<Outside> {
+    let file =
+        std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let all = format::read(
+        std::io::BufReader::new(file),
+        &path.display().to_string(),
+        pushval_scenario::MAX_SAMPLES as usize,
+    )?;
+    let run = all.select(model)?;
+    let name = run.model.clone().unwrap_or_else(|| {
+        path.file_name()
+            .map_or_else(|| "outside".into(), |n| n.to_string_lossy().into_owned())
+    });
+    Ok(Outside {
+        file: path.to_path_buf(),
+        name,
+        samples: run.samples.clone(),
+        omega_read: all.omega_read,
+    })
+}
+
+/// Measures the outside trajectory against the dynamic model and the
+/// scenario's gated engines. The outside samples must lie on a uniform grid
+/// from t = 0; the models are sampled on the same grid. Returns the report
+/// of the reference runs and one comparison per reference.
 pub fn compare_outside(
     sc: &Scenario,
     outside: &Outside,
-    file: &Path,
 ) -> anyhow::Result<(ScenarioReport, Vec<Comparison>)> {
+    let file = &outside.file;
     let mut sc = sc.clone();
-    let first = &outside.runs[0].1;
+    let first = &outside.samples;
     if first.len() >= 2 {
         sc.sample_dt = first[1].t - first[0].t;
     }
@@ -142,52 +95,51 @@ pub fn compare_outside(
     let tol = outside_tolerance(&sc, &report);
     let times = sc.problem().sample_times();
     let mut out = Vec::new();
-    for (name, samples) in &outside.runs {
-        if samples.len() != times.len()
-            || samples
-                .iter()
-                .zip(&times)
-                .any(|(s, t)| (s.t - t).abs() > 1e-6 * sc.sample_dt)
-        {
-            bail!(
-                "{}: model `{name}`: t must run from 0 to {} s in steps of {} s ({} samples); got {} samples",
-                file.display(),
-                sc.problem().duration(),
-                sc.sample_dt,
-                times.len(),
-                samples.len()
-            );
-        }
-        if let Some(w) = start_mismatch(&sc, &tol, &report, name, samples) {
-            eprintln!("warning: {}: {w}", file.display());
-        }
-        let tr = Trajectory {
-            model: name.clone(),
-            samples: samples.clone(),
-            ..Default::default()
-        };
-        for run in &report.runs {
-            // Against a gated engine: that engine's tolerances; against the
-            // dynamic model: the loosest of the gated engines'.
-            let own = report
-                .comparisons
-                .iter()
-                .find(|c| c.model == run.name)
-                .and_then(|c| c.tolerance.clone())
-                .unwrap_or_else(|| tol.clone());
-            let mut c = compare_trajectory(
-                &sc,
-                &report.segments,
-                &run.trajectory,
-                name,
-                &tr,
-                SteadyRead::TailMean,
-                Some(&own.value),
-            );
-            c.model = format!("{name} vs {}", run.name);
-            c.tolerance = Some(own);
-            out.push(c);
-        }
+    let (name, samples) = (&outside.name, &outside.samples);
+    if samples.len() != times.len()
+        || samples
+            .iter()
+            .zip(&times)
+            .any(|(s, t)| (s.t - t).abs() > 1e-6 * sc.sample_dt)
+    {
+        bail!(
+            "{}: model `{name}`: t must run from 0 to {} s in steps of {} s ({} samples); got {} samples",
+            file.display(),
+            sc.problem().duration(),
+            sc.sample_dt,
+            times.len(),
+            samples.len()
+        );
+    }
+    if let Some(w) = start_mismatch(&sc, &tol, &report, name, samples) {
+        eprintln!("warning: {}: {w}", file.display());
+    }
+    let tr = Trajectory {
+        model: name.clone(),
+        samples: samples.clone(),
+        ..Default::default()
+    };
+    for run in &report.runs {
+        // Against a gated engine: that engine's tolerances; against the
+        // dynamic model: the loosest of the gated engines'.
+        let own = report
+            .comparisons
+            .iter()
+            .find(|c| c.model == run.name)
+            .and_then(|c| c.tolerance.clone())
+            .unwrap_or_else(|| tol.clone());
+        let mut c = compare_trajectory(
+            &sc,
+            &report.segments,
+            &run.trajectory,
+            name,
+            &tr,
+            SteadyRead::TailMean,
+            Some(&own.value),
+        );
+        c.model = format!("{name} vs {}", run.name);
+        c.tolerance = Some(own);
+        out.push(c);
     }
     Ok((report, out))
 }

@@ -515,7 +515,7 @@ pub fn check_grid(sc: &Scenario, samples: &[Sample]) -> Result<(), String> {
 pub struct Request {
     /// The scenario file.
     pub scenario: PathBuf,
-    /// The trajectory CSV (`trajectory.csv`'s columns).
+    /// The trajectory CSV ([`pushval_model::format`]).
     pub trajectory: PathBuf,
     /// `NAME[,NAME...]` as given.
     pub params: String,
@@ -542,25 +542,11 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
         }
     }
     let csv = &req.trajectory;
-    let outside = crate::outside::read_csv(csv)?;
-    let names: Vec<&str> = outside.runs.iter().map(|r| r.0.as_str()).collect();
-    let samples = match &req.model {
-        Some(m) => match outside.runs.iter().find(|r| &r.0 == m) {
-            Some(r) => &r.1,
-            None => bail!(
-                "{}: no model `{m}` in the `model` column (it has: {})",
-                csv.display(),
-                names.join(", ")
-            ),
-        },
-        None if outside.runs.len() == 1 => &outside.runs[0].1,
-        None => bail!(
-            "{}: {} models in the `model` column ({}); choose one with --model",
-            csv.display(),
-            names.len(),
-            names.join(", ")
-        ),
-    };
+    let outside = crate::outside::read_trajectory(csv, req.model.as_deref())?;
+    if let Some(note) = outside.omega_note() {
+        println!("{note}");
+    }
+    let samples = &outside.samples;
     check_grid(&sc, samples).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
     let model = Parametrised::new(&sc, &params)
         .map_err(|e| anyhow::anyhow!("{}: {e}", req.scenario.display()))?;

@@ -9,13 +9,20 @@
 //! The equations are the model's (DESIGN.md): `I_P ω̇ = Σ r_i × f_i + m v_c ω
 //! (p_c · n_φ)`, `ṗ_cm = R(θ)(v_c n_φ − ω D p_c)`, with the angular momentum
 //! about the contact conserved at switches (`Switching::Impulsive`) or ω kept
-//! (`Continuous`). Integrated here with classical RK4 at a fixed step of at
-//! most `sample_dt / 32`, because the model crate's integrators are built
-//! around the Coulomb friction sum; at ε = 0 this agrees with
-//! `DynamicModel` to 1e-9 m (tests/suite/power.rs), which checks both.
+//! (`Continuous`). The right-hand side is the model crate's
+//! ([`SegmentDynamics`]): at ε = 0 its `omega_dot` itself; at ε > 0 its
+//! inertial term and `I_P` with the blended friction moment in place of the
+//! Coulomb one. That moment is the one sum written here (the model crate has
+//! only the Coulomb law); the test below holds it at ε = 0 to
+//! `SegmentDynamics::friction_moment_at` (random states, 1e-12 relative).
+//! Integrated with classical RK4 at a fixed step of at most
+//! `sample_dt / 32`, because the model crate's integrators are built around
+//! the Coulomb friction sum; at ε = 0 this agrees with `DynamicModel` to
+//! 1e-9 m (tests/suite/power.rs), which checks both.
 
 use pushval_model::{
-    cross, perp, rotate, Problem, Sample, SegmentReport, Switching, Trajectory, Vec2,
+    cross, perp, rotate, Problem, Sample, SegmentDynamics, SegmentReport, Switching, Trajectory,
+    Vec2,
 };
 
 /// State: θ (rad), ω (rad/s), CM position (m).
@@ -41,7 +48,6 @@ impl State {
 /// The problem's body in the terms the law needs.
 struct Law {
     mass: f64,
-    inertia_cm: f64,
     inertia_p: f64,
     contact: Vec2,
     /// (position from the CM, F_i = μ_i N_i, K_i⁻¹ / m as [a, b, c] of a
@@ -71,7 +77,6 @@ impl Law {
             .collect();
         Self {
             mass: m,
-            inertia_cm: i,
             inertia_p: b.inertia_contact(),
             contact: b.contact(),
             supports,
@@ -79,12 +84,14 @@ impl Law {
         }
     }
 
-    fn rhs(&self, s: &State, speed: f64, n: Vec2) -> State {
+    /// The blended law's friction moment about the contact (N m) at ω for
+    /// pusher velocity `speed · n` (object frame).
+    fn friction_moment(&self, omega: f64, speed: f64, n: Vec2) -> f64 {
         let pc = self.contact;
         let mut moment = 0.0;
         for (p, f, k) in &self.supports {
             let r = p - pc;
-            let u = speed * n + s.omega * perp(&r);
+            let u = speed * n + omega * perp(&r);
             let ku = Vec2::new(k[0] * u.x + k[1] * u.y, k[1] * u.x + k[2] * u.y);
             let w = (1.0 - self.eps) * u + self.eps * ku;
             let len = w.norm();
@@ -92,8 +99,18 @@ impl Law {
                 moment += cross(&r, &(-*f / len * w));
             }
         }
-        let wdot = (moment + self.mass * speed * s.omega * pc.dot(&n)) / self.inertia_p;
-        let v = rotate(s.theta, &(speed * n - s.omega * perp(&pc)));
+        moment
+    }
+
+    /// The state's rate in the segment `seg` (pusher velocity `speed · n`).
+    fn rhs(&self, s: &State, seg: &SegmentDynamics, speed: f64, n: Vec2) -> State {
+        let wdot = if self.eps == 0.0 {
+            seg.omega_dot(s.omega)
+        } else {
+            (self.friction_moment(s.omega, speed, n) + seg.inertial_slope() * s.omega)
+                / seg.inertia_contact()
+        };
+        let v = rotate(s.theta, &(speed * n - s.omega * perp(&self.contact)));
         State {
             theta: s.omega,
             omega: wdot,
@@ -113,7 +130,6 @@ impl Law {
 /// The problem's trajectory under the blended law with weight `eps` ∈ [0, 1].
 pub fn simulate(problem: &Problem, eps: f64) -> Trajectory {
     let law = Law::new(problem, eps);
-    let _ = law.inertia_cm;
     let init = problem.initial;
     let mut s = State {
         theta: init.theta,
@@ -142,6 +158,7 @@ pub fn simulate(problem: &Problem, eps: f64) -> Trajectory {
         .enumerate()
     {
         let n = dir(push.phi);
+        let seg = SegmentDynamics::new(&problem.body, push);
         if problem.switching == Switching::Impulsive {
             s.omega = law.jump(s.omega, v_prev, n_prev, push.speed, n);
         }
@@ -157,10 +174,10 @@ pub fn simulate(problem: &Problem, eps: f64) -> Trajectory {
             let steps = (span / (problem.sample_dt / 32.0)).ceil().max(1.0) as usize;
             let h = span / steps as f64;
             for _ in 0..steps {
-                let k1 = law.rhs(s, push.speed, n);
-                let k2 = law.rhs(&s.add(&k1, h / 2.0), push.speed, n);
-                let k3 = law.rhs(&s.add(&k2, h / 2.0), push.speed, n);
-                let k4 = law.rhs(&s.add(&k3, h), push.speed, n);
+                let k1 = law.rhs(s, &seg, push.speed, n);
+                let k2 = law.rhs(&s.add(&k1, h / 2.0), &seg, push.speed, n);
+                let k3 = law.rhs(&s.add(&k2, h / 2.0), &seg, push.speed, n);
+                let k4 = law.rhs(&s.add(&k3, h), &seg, push.speed, n);
                 s.theta += h / 6.0 * (k1.theta + 2.0 * k2.theta + 2.0 * k3.theta + k4.theta);
                 s.omega += h / 6.0 * (k1.omega + 2.0 * k2.omega + 2.0 * k3.omega + k4.omega);
                 s.x += h / 6.0 * (k1.x + 2.0 * k2.x + 2.0 * k3.x + k4.x);
@@ -194,5 +211,80 @@ pub fn simulate(problem: &Problem, eps: f64) -> Trajectory {
         samples,
         segments,
         ..Default::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pushval_model::{Body, Push, Support};
+
+    /// At ε = 0 the blended law is Coulomb's: its friction moment is the
+    /// model's, and the right-hand side is `SegmentDynamics::omega_dot`
+    /// itself; at ε > 0 the inertial term and I_P are still the model's.
+    #[test]
+    fn the_blended_law_at_zero_is_the_models_right_hand_side() {
+        let supports: Vec<Support> = [
+            (-0.1, -0.12, 1.1),
+            (0.13, -0.1, 0.7),
+            (0.1, 0.12, 1.9),
+            (-0.12, 0.09, 0.4),
+        ]
+        .iter()
+        .map(|&(x, y, f)| Support {
+            position: Vec2::new(x, y),
+            friction: f,
+        })
+        .collect();
+        let body = Body::new(1.3, 0.011, Vec2::new(-0.125, -0.03), &supports).unwrap();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let push0 = Push {
+            duration: 1.0,
+            speed: 0.5,
+            phi: 0.3,
+        };
+        let problem = Problem {
+            body: body.clone(),
+            limits: Default::default(),
+            pushes: vec![push0],
+            initial: Default::default(),
+            switching: Switching::Impulsive,
+            sample_dt: 0.01,
+        };
+        for _ in 0..500 {
+            let push = Push {
+                duration: 1.0,
+                speed: 2.0 * uniform(),
+                phi: 6.3 * uniform(),
+            };
+            let seg = SegmentDynamics::new(&body, &push);
+            let n = push.direction();
+            let s = State {
+                theta: 6.0 * uniform(),
+                omega: 30.0 * (uniform() - 0.5),
+                x: 0.0,
+                y: 0.0,
+            };
+            let scale = seg.max_moment();
+            let coulomb = Law::new(&problem, 0.0);
+            let got = coulomb.friction_moment(s.omega, push.speed, n);
+            let want = seg.friction_moment_at(push.speed, s.omega);
+            assert!((got - want).abs() <= 1e-12 * scale, "{got} vs {want}");
+            let r = coulomb.rhs(&s, &seg, push.speed, n);
+            assert_eq!(r.omega, seg.omega_dot(s.omega));
+            let blended = Law::new(&problem, 0.5);
+            let m = blended.friction_moment(s.omega, push.speed, n);
+            let r = blended.rhs(&s, &seg, push.speed, n);
+            let want = (m + seg.inertial_slope() * s.omega) / body.inertia_contact();
+            assert!(
+                (r.omega - want).abs() <= 1e-12 * want.abs().max(scale / body.inertia_contact())
+            );
+        }
     }
 }

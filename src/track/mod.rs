@@ -63,7 +63,7 @@ use anyhow::{bail, Context};
 use pushval_model::track::{
     Ekf, EkfSettings, Estimator, Free, Measurement, TrackError, TrackModel,
 };
-use pushval_model::Vec2;
+use pushval_model::{format, Vec2};
 use pushval_scenario::Scenario;
 use serde_json::{json, Value};
 
@@ -241,45 +241,6 @@ pub fn line(params: &[Param], row: &Row) -> String {
     f.join(",")
 }
 
-/// The columns of the input CSV.
-struct Columns {
-    names: Vec<String>,
-    model: Option<usize>,
-    t: usize,
-    x: usize,
-    y: usize,
-    theta: usize,
-    omega: usize,
-    force: Option<(usize, usize)>,
-}
-
-impl Columns {
-    fn parse(header: &str, src: &str) -> anyhow::Result<Self> {
-        let names: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
-        let find = |n: &str| names.iter().position(|c| c == n);
-        let need = |n: &str| {
-            find(n).with_context(|| {
-                format!("{src}: line 1: the header lacks the column `{n}` (need t,x,y,theta,omega; model, fx, fy optional)")
-            })
-        };
-        let force = match (find("fx"), find("fy")) {
-            (Some(a), Some(b)) => Some((a, b)),
-            (None, None) => None,
-            _ => bail!("{src}: line 1: the header has only one of `fx`, `fy` (both or neither)"),
-        };
-        Ok(Self {
-            model: find("model"),
-            t: need("t")?,
-            x: need("x")?,
-            y: need("y")?,
-            theta: need("theta")?,
-            omega: need("omega")?,
-            force,
-            names,
-        })
-    }
-}
-
 /// What a streamed run produced.
 #[derive(Debug, Clone)]
 pub struct Outcome {
@@ -292,6 +253,9 @@ pub struct Outcome {
     /// The estimate left the finite numbers at this time (the rest of the
     /// input was not read).
     pub diverged: Option<f64>,
+    /// Whether the input had an `omega` column (else the filter estimates
+    /// ω from θ as a state).
+    pub omega_read: bool,
 }
 
 /// Streams `reader` through the filter: one [`Row`] per sample, each
@@ -321,82 +285,51 @@ pub fn stream(
     let origin = sc.center_of_mass;
     let head = header(params);
     writeln!(csv, "{head}")?;
-    let mut buf = String::new();
-    let mut lineno = 0usize;
-    let mut cols: Option<Columns> = None;
-    let mut seen_model: Option<String> = None;
+    let select = match model_name {
+        Some(m) => format::Select::Model(m.to_string()),
+        None => format::Select::One,
+    };
+    let mut rd = format::Reader::new(reader, src, pushval_scenario::MAX_SAMPLES as usize)
+        .select(select)
+        .extra(&["fx", "fy"]);
+    let h = rd.header()?;
+    if h.has("fx") != h.has("fy") {
+        bail!(
+            "{src}: line {}: the header has only one of `fx`, `fy` (both or neither)",
+            h.line
+        );
+    }
+    let omega_read = h.has_omega();
+    if settings.sigma_omega.is_some() && !omega_read {
+        bail!(
+            "{src}: line {}: --sigma-omega needs an `omega` column (without one the filter estimates omega from theta itself; an omega derived from theta would count theta twice)",
+            h.line
+        );
+    }
+    // The input's header is good: the estimate's header goes out.
+    if let Some(e) = echo.as_mut() {
+        writeln!(e, "{head}")?;
+        e.flush()?;
+    }
     let mut out = Outcome {
         rows: Vec::new(),
         episodes: Vec::new(),
         lack_at_end: false,
         diverged: None,
+        omega_read,
     };
     let mut in_episode = false;
-    loop {
-        buf.clear();
-        if reader
-            .read_line(&mut buf)
-            .with_context(|| format!("{src}: reading line {}", lineno + 1))?
-            == 0
-        {
-            break;
-        }
-        lineno += 1;
-        let text = buf.trim();
-        if text.is_empty() {
-            continue;
-        }
-        let Some(c) = &cols else {
-            cols = Some(Columns::parse(text, src)?);
-            // The input's header is good: the estimate's header goes out.
-            if let Some(e) = echo.as_mut() {
-                writeln!(e, "{head}")?;
-                e.flush()?;
-            }
-            continue;
-        };
-        let f: Vec<&str> = text.split(',').map(str::trim).collect();
-        if f.len() != c.names.len() {
-            bail!(
-                "{src}: line {lineno}: {} fields, the header has {}",
-                f.len(),
-                c.names.len()
-            );
-        }
-        if let Some(im) = c.model {
-            let name = f[im];
-            match (model_name, &seen_model) {
-                (Some(want), _) if want != name => continue,
-                (None, Some(first)) if first != name => bail!(
-                    "{src}: line {lineno}: a second model `{name}` in the `model` column (the first was `{first}`); choose one with --model"
-                ),
-                _ => seen_model = Some(name.to_string()),
-            }
-        }
-        let num = |i: usize| -> anyhow::Result<f64> {
-            let v: f64 = f[i].parse().with_context(|| {
-                format!(
-                    "{src}: line {lineno}: column `{}`: `{}` is not a number",
-                    c.names[i], f[i]
-                )
-            })?;
-            if !v.is_finite() {
-                bail!(
-                    "{src}: line {lineno}: column `{}`: {v} is not finite",
-                    c.names[i]
-                );
-            }
-            Ok(v)
-        };
+    while let Some(r) = rd.next_row()? {
+        let lineno = r.line;
         let m = Measurement {
-            t: num(c.t)?,
-            x: num(c.x)?,
-            y: num(c.y)?,
-            theta: num(c.theta)?,
-            omega: Some(num(c.omega)?),
-            force: match c.force {
-                Some((a, b)) => Some(Vec2::new(num(a)?, num(b)?)),
-                None => None,
+            t: r.t,
+            x: r.x,
+            y: r.y,
+            theta: r.theta,
+            omega: r.omega,
+            force: match (r.extra[0], r.extra[1]) {
+                (Some(fx), Some(fy)) => Some(Vec2::new(fx, fy)),
+                _ => None,
             },
         };
         let t0 = thread_cpu_time();
@@ -456,9 +389,6 @@ pub fn stream(
         in_episode = rep.lack_of_fit;
         out.lack_at_end = rep.lack_of_fit;
         out.rows.push(row);
-    }
-    if cols.is_none() {
-        bail!("{src}: the input is empty");
     }
     if out.rows.is_empty() {
         bail!(
@@ -567,6 +497,7 @@ pub fn summary(
             "sigma_position": settings.sigma_position,
             "sigma_theta": settings.sigma_theta,
             "sigma_omega": settings.sigma_omega,
+            "omega": if out.omega_read { "read" } else { "absent: estimated by the filter from theta" },
             "sigma_force": settings.sigma_force,
             "prior_relative": settings.prior,
             "initial_std": settings.initial_std,
@@ -594,6 +525,17 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
         }
     }
     let src = req.trajectory.name();
+    // A file holding several models and no --model is refused before any
+    // row is used, listing every model (standard input can only list the
+    // ones seen when the second arrives).
+    if let (Source::File(p), None) = (&req.trajectory, &req.model) {
+        let f = std::fs::File::open(p).with_context(|| format!("{}: cannot read", p.display()))?;
+        format::require_one_model(
+            std::io::BufReader::new(f),
+            &src,
+            pushval_scenario::MAX_SAMPLES as usize,
+        )?;
+    }
     let mut reader: Box<dyn BufRead> = match &req.trajectory {
         Source::File(p) => Box::new(std::io::BufReader::new(
             std::fs::File::open(p).with_context(|| format!("{}: cannot read", p.display()))?,
@@ -620,6 +562,9 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
         echo,
     )?;
     drop(lock);
+    if !out.omega_read {
+        eprintln!("note: {src}: no `omega` column: the filter estimates omega from theta");
+    }
     let (json, not_converged) = summary(&sc, &params, &req.settings, &out);
     std::fs::create_dir_all(&req.out).with_context(|| format!("creating {}", req.out.display()))?;
     let csv_path = req.out.join("track.csv");

@@ -21,3 +21,4 @@ mod scenarios;
 mod stress;
 mod study;
 mod track;
+mod trajectory_format;

@@ -17,11 +17,14 @@
 //!   a stream of pose samples, and the resultant friction force.
 //! * [`limit_surface`]: the ellipsoidal limit-surface approximation used in
 //!   quasi-static planning (Goyal, Ruina & Papadopoulos; Lynch, Maekawa & Tanie).
+//! * [`format`]: the one trajectory format (`t,x,y,theta[,omega][,model]`),
+//!   its streaming reader and its writer.
 //!
 //! Conventions: SI units, f64, object frame with its origin at the centre of
 //! mass, `D = [[0,−1],[1,0]]`, `a × b = a_x b_y − a_y b_x`.
 //!
-//! This crate does no I/O and depends on no physics engine.
+//! This crate opens no file and runs no process ([`format`] reads and writes
+//! through the caller's `BufRead` / `Write`), and depends on no physics engine.
 #![warn(missing_docs)]
 
 mod arc;
@@ -30,6 +33,7 @@ mod body;
 mod dop853_tables;
 pub mod dynamic;
 mod error;
+pub mod format;
 pub mod integrate;
 pub mod kappa;
 pub mod kinematic;

@@ -470,3 +470,57 @@ fn pusher_force_samples_sharpen_the_estimate() {
         );
     }
 }
+
+/// The filter's right-hand side is a second copy of the model's equations,
+/// kept because the filter needs ∂ω̇/∂ω and ∂ω̇/∂p alongside ω̇ in one pass
+/// over the supports (`SegmentDynamics` gives ω̇ alone). This holds the copy
+/// to the model: at random parameters p (μ scale, centre of friction, I_cm)
+/// and random states, `rates` and `rates_q` give the ω̇ of
+/// `SegmentDynamics` on the body those parameters describe (each support's
+/// friction `support_friction(i, p)`, inertia `p[3]`), to 1e-12 relative.
+#[test]
+fn filter_rates_are_the_models_right_hand_side() {
+    let mut rng = Rng(7, None);
+    for body in [paper_plate(), square(0.25, 1.0, 0.5, 9.81)] {
+        let problem = one_push(body.clone(), 1.0, 0.3, 0.4);
+        let md = TrackModel::new(&problem, &[]).unwrap();
+        let c0 = body.center_of_friction();
+        for _ in 0..200 {
+            let p = [
+                0.5 + rng.uniform(),
+                c0.x + 0.01 * (rng.uniform() - 0.5),
+                c0.y + 0.01 * (rng.uniform() - 0.5),
+                body.inertia_cm() * (0.5 + rng.uniform()),
+            ];
+            let supports: Vec<Support> = (0..md.supports())
+                .map(|i| Support {
+                    position: md.support_position(i),
+                    friction: md.support_friction(i, &p),
+                })
+                .collect();
+            let b = Body::new(body.mass(), p[3], body.contact(), &supports).unwrap();
+            let push = Push {
+                duration: 1.0,
+                speed: 2.0 * rng.uniform(),
+                phi: 6.0 * rng.uniform(),
+            };
+            let seg = pushval_model::SegmentDynamics::new(&b, &push);
+            let omega = 20.0 * (rng.uniform() - 0.5);
+            let want = seg.omega_dot(omega);
+            let scale = want
+                .abs()
+                .max(seg.max_moment() / seg.inertia_contact() * 1e-3);
+            let got = md.rates(push.velocity(), omega, &p).omega_dot;
+            assert!(
+                (got - want).abs() <= 1e-12 * scale,
+                "rates: {got} vs {want}"
+            );
+            let (q, _) = md.to_q(&p);
+            let got = md.rates_q(push.velocity(), omega, &q).omega_dot;
+            assert!(
+                (got - want).abs() <= 1e-12 * scale,
+                "rates_q: {got} vs {want}"
+            );
+        }
+    }
+}

@@ -181,7 +181,7 @@ impl Engine for OutsideEngine {
         let parse_start = Instant::now();
         let text = std::str::from_utf8(&stdout)
             .map_err(|e| fail(format!("wrote standard output that is not UTF-8 ({e})")))?;
-        let rows = csv::read(text, &[], &["t", "x", "y", "theta", "omega"])
+        let rows = csv::read(text)
             .map_err(|e| fail(format!("wrote a malformed row on its standard output: {e}")))?;
         let history = history_from_rows(problem, &rows)
             .map_err(|e| fail(format!("wrote rows that do not cover the run: {e}")))?;
@@ -213,7 +213,7 @@ impl Engine for OutsideEngine {
 /// must start at t = 0, increase strictly and reach the problem's end.
 pub fn history_from_rows(
     problem: &Problem,
-    rows: &[csv::Record<'_>],
+    rows: &[csv::Record],
 ) -> Result<Vec<StepRecord>, String> {
     let end = problem.duration();
     let tol = 1e-9 * end.max(1.0);

@@ -25,8 +25,9 @@
 //! every process the adapter started is ended too, whether it left the
 //! process group (`setsid`) or not (see the `tree` module).
 //!
-//! It also holds the one CSV reader of pushval's numeric trajectory files
-//! ([`csv`]), which `pushval compare` shares.
+//! The output is read in pushval's one trajectory format
+//! ([`pushval_model::format`], through [`csv`]), the format `compare`, `fit`
+//! and `track` read.
 //!
 //! What it is not: a sandbox. `pushval.toml` is trusted like a build script;
 //! a scenario file can name an outside engine but never define one.
