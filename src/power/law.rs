@@ -6,7 +6,7 @@
 //! (the dynamic model); ε = 1 is the direction law of a game engine's capped
 //! per-support friction impulse (`−K⁻¹u`, rapier2d_impulse_disk).
 //!
-//! The equations are the model's (DESIGN.md): `I_P ω̇ = Σ r_i × f_i + m v_c ω
+//! The equations are the model's (docs/architecture.md, "The model"): `I_P ω̇ = Σ r_i × f_i + m v_c ω
 //! (p_c · n_φ)`, `ṗ_cm = R(θ)(v_c n_φ − ω D p_c)`, with the angular momentum
 //! about the contact conserved at switches (`Switching::Impulsive`) or ω kept
 //! (`Continuous`). The right-hand side is the model crate's

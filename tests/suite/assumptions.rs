@@ -194,7 +194,7 @@ fn pushing_into_the_object_is_not_pulling() {
 }
 
 /// Friction moment about the contact plus the inertial term, `I_P ω̇`, written
-/// out from the model's definition (DESIGN.md, "The model"), one support at a time.
+/// out from the model's definition (docs/architecture.md, "The model"), one support at a time.
 fn moment(sc: &Scene, v: f64, phi: f64, w: f64) -> f64 {
     let (a, b) = (sc.a, sc.b);
     let pc = Vec2::new(-a, -b);

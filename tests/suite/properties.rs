@@ -203,8 +203,8 @@ fn cfg(cases: u32) -> ProptestConfig {
 proptest! {
     #![proptest_config(cfg(24))]
 
-    /// Loads proportional to m g: m cancels from the equations (DESIGN.md,
-    /// "Scaling"), so the motion does not depend on it.
+    /// Loads proportional to m g: m cancels from the equations (docs/architecture.md,
+    /// "The model"), so the motion does not depend on it.
     #[test]
     fn motion_does_not_depend_on_mass(s in scene(), k in 0.01..100.0f64) {
         let a = sim(&s, 0.01);

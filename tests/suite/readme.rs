@@ -1,5 +1,5 @@
-//! Every figure in README.md and results/README.md comes from a committed
-//! results file (issue 22, item 6).
+//! Every figure in README.md, docs/*.md and results/README.md comes from a
+//! committed results file (issue 22, item 6).
 //!
 //! A *figure* is a number followed by a unit (ns, µs, ms, s, min, ×, %, m,
 //! mm, µm, rad, mrad, µrad, m/s, rad/s, s/s, kg, N, …), or a range
@@ -12,7 +12,7 @@
 //!
 //! Where it must be traced:
 //!
-//! * README.md: in a results file the README *names beside it*: in the same
+//! * README.md and docs/*.md: in a results file the text *names beside it*: in the same
 //!   paragraph, list item or table row, or in the paragraph that introduces
 //!   the list or table (an SVG stands for the CSV of its data beside it; a
 //!   folder for every text file in it);
@@ -33,44 +33,44 @@ use crate::common::root;
 /// Phrases whose figures are inputs or constants of the code, not results:
 /// (file, phrase, reason). The figure's whole text must lie in the phrase.
 const ALLOWED: &[(&str, &str, &str)] = &[
-    // README.md
+    // README.md and docs/
     (
-        "README.md",
+        "docs/benchmarks.md",
         "paper trajectory (10 s, five segments)",
         "the paper scene's duration: five 2 s segments of scenarios/paper-square-v1.0.toml",
     ),
     (
-        "README.md",
+        "docs/benchmarks.md",
         "1/60 s to 1/1920 s",
         "the time-step ladder of benches/engine_work_precision.rs (a constant of the bench)",
     ),
     (
-        "README.md",
+        "docs/ci-gate.md",
         "(1/60 s halved down to 1e-4 s)",
         "the auto-tolerance ladder, src/harness/tolerance.rs (its first step and floor)",
     ),
     (
-        "README.md",
+        "docs/benchmarks.md",
         "I_cm ±0.5 %, μ ±0.5 %, a 0.5 mm contact offset, a 0.5 mm\ncentre-of-friction shift",
         "the power targets, constants of src/power (also the target column of gate_power.csv)",
     ),
     (
-        "README.md",
+        "docs/benchmarks.md",
         "(noise\n`--sigma-position` 1 mm and `--sigma-theta` 1 mrad by default)",
         "pushval fit's default σ, constants of src/fit",
     ),
     (
-        "README.md",
+        "docs/benchmarks.md",
         "μ within 1 % and I_cm within 2 % at 2σ",
         "the fit study's targets, constants of src/fit_study",
     ),
     (
-        "README.md",
+        "docs/benchmarks.md",
         "κ within 1 %",
         "the κ closed forms' tolerance, a constant of src/report (kappa.csv's columns are per it)",
     ),
     (
-        "README.md",
+        "docs/benchmarks.md",
         "ω(t) at 0.2–1.0 m/s",
         "the pusher speeds of the paper figures (scenario inputs of pushval report)",
     ),
@@ -683,6 +683,26 @@ fn scenario_numbers(root: &Path) -> Pool {
     p.sort()
 }
 
+/// The documents whose figures are checked, each with whether a figure may
+/// be traced anywhere in `results/` (`results/README.md`) or only in a file
+/// named beside it (README.md and every `docs/*.md`).
+fn documents(root: &Path) -> Vec<(String, bool)> {
+    let mut docs: Vec<String> = std::fs::read_dir(root.join("docs"))
+        .map(|d| {
+            d.flatten()
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|x| x == "md"))
+                .map(|p| format!("docs/{}", p.file_name().unwrap().to_string_lossy()))
+                .collect()
+        })
+        .unwrap_or_default();
+    docs.sort();
+    let mut out = vec![("README.md".to_string(), false)];
+    out.extend(docs.into_iter().map(|d| (d, false)));
+    out.push(("results/README.md".to_string(), true));
+    out
+}
+
 #[test]
 fn readme_figures_come_from_results_files() {
     let root = root();
@@ -690,9 +710,9 @@ fn readme_figures_come_from_results_files() {
     let inputs = scenario_numbers(&root);
     let mut bad = Vec::new();
     let mut used = Vec::new();
-    for (readme, anywhere) in [("README.md", false), ("results/README.md", true)] {
-        let text = std::fs::read_to_string(root.join(readme)).unwrap();
-        let (b, u) = untraced(readme, &text, &files, &inputs, ALLOWED, anywhere);
+    for (readme, anywhere) in documents(&root) {
+        let text = std::fs::read_to_string(root.join(&readme)).unwrap();
+        let (b, u) = untraced(&readme, &text, &files, &inputs, ALLOWED, anywhere);
         bad.extend(b);
         used.extend(u);
     }

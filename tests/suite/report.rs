@@ -202,7 +202,7 @@ fn geometry_file(name: &str) -> &'static str {
     }
 }
 
-/// `I_P ω̇` (N m) from the model's definition (DESIGN.md, "The model"), one
+/// `I_P ω̇` (N m) from the model's definition (docs/architecture.md, "The model"), one
 /// support at a time: `Σ (p_i − p_c) × f_i + m v ω (p_c · n_φ)` with
 /// `f_i = −F_i u_i/|u_i|`, `u_i = v n_φ + ω D (p_i − p_c)`; `inertial` false
 /// leaves the friction moment alone (the kinematic model's, at v = 1).

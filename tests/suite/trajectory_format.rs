@@ -1,4 +1,4 @@
-//! The one trajectory format (DESIGN.md, "One trajectory format"): the same
+//! The one trajectory format (docs/architecture.md, "One trajectory format"): the same
 //! trajectory with or without `model`, with or without `omega` and with a
 //! column pushval does not know is accepted alike by `compare`, `fit` and
 //! `track`; a file holding several models needs `--model NAME`; and a bad

@@ -16,7 +16,7 @@
 //! With `F_max = Σ F_i` and `T_max = Σ F_i |p_i|` ([`motor_joint_limits`]).
 //! The pusher holds the contact point `p_c` at `v_c n_φ` (object frame), so
 //! `v_cm = v_c n_φ − ω D p_c`. The moment balance about the contact point
-//! (DESIGN.md, with the friction moment `(0 − p_c) × f + τ`) is
+//! (docs/architecture.md, "The model", with the friction moment `(0 − p_c) × f + τ`) is
 //!
 //! ```text
 //! I_P ω̇ = g(ω) = F_max (v_c c − ω L²) / |v_cm|  −  T_max sgn ω  +  m v_c a ω

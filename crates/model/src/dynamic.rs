@@ -59,7 +59,7 @@ impl SteadyState {
 /// The inertial term `m v_c ω (p_c · n_φ)` of the moment balance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum InertialTerm {
-    /// As derived (DESIGN.md): the moment about the contact point of the
+    /// As derived (docs/architecture.md, "The model"): the moment about the contact point of the
     /// centre of mass's acceleration.
     #[default]
     Derived,
