@@ -252,6 +252,8 @@ pub struct Fit {
     pub unidentifiable: Vec<Param>,
     /// The χ² test of the residuals against the stated noise.
     pub lack_of_fit: LackOfFit,
+    /// Why the fit is degenerate ([`degenerate_reasons`]); empty when not.
+    pub degenerate: Vec<String>,
 }
 
 /// Significance below which the residuals reject the model: 1e-3, so a
@@ -355,6 +357,7 @@ impl Fit {
             "residual": {"position_rms": num(self.position_rms), "theta_rms": num(self.theta_rms)},
             "converged": self.converged,
             "unidentifiable": self.unidentifiable.iter().map(|p| p.name()).collect::<Vec<_>>(),
+            "degenerate": self.degenerate,
             "lack_of_fit": {
                 "test": "chi-squared: whitened residual sum of squares against chi2(3K - n)",
                 "statistic": num(self.lack_of_fit.statistic),
@@ -467,6 +470,7 @@ fn summarise(
         .map(|((p, _), _)| *p)
         .collect();
     unidentifiable.dedup();
+    let degenerate = degenerate_reasons(&slots, &value, &model.file_values());
     Ok(Fit {
         params: model.params().to_vec(),
         value,
@@ -480,7 +484,33 @@ fn summarise(
         fisher,
         unidentifiable,
         lack_of_fit: LackOfFit::new(r.norm_squared(), dof),
+        degenerate,
     })
+}
+
+/// A positive parameter (μ scale, I_cm) at or below this fraction of the
+/// file's value is "near zero": a frictionless or massless explanation, one
+/// no physical plate has.
+pub const NEAR_ZERO: f64 = 0.05;
+
+/// Why a fit explains nothing even where its residuals are small: a
+/// positive parameter (μ scale, I_cm) at or below [`NEAR_ZERO`] of the
+/// file's value or not positive at all (outside its physical bounds).
+/// Empty when the fit is not degenerate. An ill-conditioned Fisher
+/// information is reported on its own, as unidentifiable components
+/// ([`Fit::unidentifiable`], the rules of the module doc).
+pub fn degenerate_reasons(slots: &[(Param, usize)], value: &[f64], file: &[f64]) -> Vec<String> {
+    let mut out = Vec::new();
+    for (((p, _), v), f) in slots.iter().zip(value).zip(file) {
+        if matches!(p, Param::MuScale | Param::InertiaCm) && !(*v > NEAR_ZERO * f.abs()) {
+            out.push(format!(
+                "{} = {v:.3e} is at or below {NEAR_ZERO} x its file value {f:.3e} (a {} plate explains the run; that explains nothing)",
+                p.name(),
+                if *p == Param::MuScale { "frictionless" } else { "massless" }
+            ));
+        }
+    }
+    out
 }
 
 /// Checks that `samples` lie on the scenario's sample grid
@@ -572,6 +602,10 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
             sc.name,
             names_of(&fit.unidentifiable)
         );
+        code = ExitCode::from(1);
+    }
+    for why in &fit.degenerate {
+        eprintln!("FAIL {}: degenerate fit: {why}", req.scenario.display());
         code = ExitCode::from(1);
     }
     let l = &fit.lack_of_fit;

@@ -17,7 +17,9 @@
 //! `T = max(10 e, 1e-6)` in position (m) and θ (rad): **explained** when the
 //! fit's residual rms is within T and within 1 mm / 1 mrad, **not_explained**
 //! when it exceeds T, **undecided** otherwise (the engine's own error is too
-//! large to tell).
+//! large to tell); **degenerate**, whatever the residuals, when a fitted
+//! μ scale or I_cm is near zero ([`crate::fit::degenerate_reasons`]: a
+//! frictionless or massless plate explains nothing).
 
 use pushval_engine::Engine;
 use pushval_model::{DynamicModel, Sample, Simulator};
@@ -34,9 +36,9 @@ pub const THRESHOLD_FACTOR: f64 = 10.0;
 pub const THRESHOLD_CAP: f64 = 1e-3;
 /// The columns of `coulomb_fit.csv` after `schedule`.
 pub const COLUMNS: &str = "dt,mu_scale,mu_scale_std,cof_x,cof_y,inertia_cm,inertia_cm_std,start_position_rms,start_theta_rms,position_rms,theta_rms,engine_error_position,engine_error_theta,converged,fitted";
-/// Values in a fit's row (the columns above less `fitted`, plus the two
-/// flags: centre of friction fitted, I_cm fitted).
-pub const WIDTH: usize = 16;
+/// Values in a fit's row (the columns above less `fitted`, plus three
+/// flags: centre of friction fitted, I_cm fitted, degenerate).
+pub const WIDTH: usize = 17;
 
 fn rms_difference(a: &[Sample], b: &[Sample]) -> [f64; 2] {
     let n = a.len().min(b.len()).max(1) as f64;
@@ -124,7 +126,27 @@ pub fn fit_engine(engine: &dyn Engine, k: usize, study_dt: f64) -> anyhow::Resul
         flag(f.converged),
         flag(set.contains(&Param::CenterOfFriction)),
         flag(set.contains(&Param::InertiaCm)),
+        flag(!f.degenerate.is_empty()),
     ])
+}
+
+/// Why a row is degenerate (empty when it is not): the fitted μ scale or
+/// I_cm near zero ([`crate::fit::degenerate_reasons`]).
+pub fn degenerate_reason(row: &[f64]) -> String {
+    if row[16] != 1.0 {
+        return String::new();
+    }
+    let mut why = Vec::new();
+    if !(row[1] > crate::fit::NEAR_ZERO) {
+        why.push(format!(
+            "mu_scale {:.2e} ~ 0 (a frictionless plate)",
+            row[1]
+        ));
+    }
+    if row[15] == 1.0 {
+        why.push(format!("inertia_cm {:.2e} kg m^2", row[5]));
+    }
+    format!("parameters near zero: {}", why.join(", "))
 }
 
 /// `[position, θ]` thresholds of a row: `max(10 e, 1e-6)`.
@@ -134,6 +156,9 @@ pub fn thresholds(row: &[f64]) -> [f64; 2] {
 
 /// The verdict of a row (see the module doc).
 pub fn verdict(row: &[f64]) -> &'static str {
+    if row[16] == 1.0 {
+        return "degenerate";
+    }
     let t = thresholds(row);
     let rms = [row[9], row[10]];
     if !(rms[0] <= t[0] && rms[1] <= t[1]) {

@@ -205,10 +205,10 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     if plan.setups.len() > 1 {
         w.file("variants.csv", variants.as_bytes())?;
     }
-    let mut fits = format!("schedule,{},verdict\n", fit::COLUMNS);
+    let mut fits = format!("schedule,{},verdict,reason\n", fit::COLUMNS);
     for (t, r) in rows_of(&|t| matches!(t, Task::Fit { .. })) {
         if let Task::Fit { k } = t {
-            let vals: Vec<String> = r.iter().take(fit::WIDTH - 2).map(|v| opt(*v)).collect();
+            let vals: Vec<String> = r.iter().take(fit::WIDTH - 3).map(|v| opt(*v)).collect();
             let fitted = match (r[14] == 1.0, r[15] == 1.0) {
                 (true, true) => "mu_scale center_of_friction inertia_cm",
                 (false, true) => "mu_scale inertia_cm",
@@ -222,9 +222,10 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             };
             let _ = writeln!(
                 fits,
-                "{},{},{fitted},{verdict}",
+                "{},{},{fitted},{verdict},{}",
                 fit::SCHEDULES[k],
-                vals.join(",")
+                vals.join(","),
+                fit::degenerate_reason(r)
             );
         }
     }
@@ -556,7 +557,11 @@ fn readme(
                 sig(num(&r, "mu_scale")),
                 sig(num(&r, "position_rms")),
                 sig(num(&r, "theta_rms")),
-                r["verdict"]
+                if r["verdict"] == "degenerate" {
+                    format!("degenerate: {}", r["reason"])
+                } else {
+                    r["verdict"].to_string()
+                }
             );
         }
     }
