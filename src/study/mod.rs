@@ -24,10 +24,12 @@
 //! array's variables; `--merge` rebuilds exactly the single run's files
 //! ([`crate::report::shard`]).
 
+pub mod creep_law;
 pub mod figure;
 pub mod fit;
 pub mod plate;
 pub mod readme;
+pub mod records;
 pub mod spec;
 
 use std::collections::BTreeMap;
