@@ -16,7 +16,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use pushval::study::creep_law::{markdown, CSV_COLUMNS};
-use pushval_mujoco::creep::{hold_time, measure, CreepCase, CreepRegime, CreepScene, SLIDING_SPEED};
+use pushval_mujoco::creep::{
+    hold_time, measure, CreepCase, CreepRegime, CreepScene, SLIDING_SPEED,
+};
 use pushval_mujoco::{Cone, MujocoSettings};
 
 /// One run of the ladder.
@@ -218,7 +220,7 @@ fn row(c: &Cell) -> Result<String, String> {
 }
 
 fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
-    pushval::output::write_atomic(path, text.as_bytes()).map_err(|e| format!("{e:#}"))
+    pushval::atomic::write_atomic(path, text.as_bytes()).map_err(|e| format!("{e:#}"))
 }
 
 fn run() -> Result<(), String> {

@@ -19,23 +19,15 @@
 //! Header `model,t,x,y,theta,omega`; one row per model per sample time; x, y
 //! the centre of mass in the world frame (m), theta unwrapped (rad).
 
-use std::io::Write;
-use std::path::Path;
-
-use anyhow::Context;
 use pushval_model::{RootKind, Violation};
 use serde_json::{json, Value};
 
 use crate::ScenarioReport;
 
-/// A finite number, or null.
-pub fn num(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
+// `num` and `write_atomic` live in the toolkit (`outdir`, `atomic`); these
+// paths stay for `fit` and `track`, which still name them here.
+pub use crate::atomic::write_atomic;
+pub use crate::outdir::json_num as num;
 
 fn opt(v: Option<f64>) -> Value {
     v.map_or(Value::Null, num)
@@ -194,22 +186,6 @@ pub fn trajectory_csv(report: &ScenarioReport) -> String {
         }
     }
     s
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same folder and a
-/// rename, so a reader never sees a half-written file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
-    tmp.write_all(bytes)
-        .with_context(|| format!("writing {}", path.display()))?;
-    tmp.persist(path)
-        .with_context(|| format!("renaming into {}", path.display()))?;
-    Ok(())
 }
 
 fn fmt_e(v: f64) -> String {

@@ -362,3 +362,13 @@ pub fn from_toml(text: &str, file: &std::path::Path) -> Result<Scenario, Scenari
     check(&sc)?;
     Ok(sc)
 }
+
+/// `./scenarios` when it exists, else the one beside this crate's manifest.
+pub fn default_scenario_dir() -> PathBuf {
+    let local = PathBuf::from("scenarios");
+    if local.is_dir() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+    }
+}

@@ -7,7 +7,7 @@ use std::path::Path;
 use super::plate::{froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
 use super::records::{num, parse, Records};
 use super::{class_name, err, fit, opt, Plan, Task, LOADS, RUN_WIDTH};
-use crate::report::Writer;
+use crate::outdir::Writer;
 
 /// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
 /// within 1e-2 of the law, turns, locked, semi_stable)`.

@@ -175,7 +175,6 @@ impl CreepCase {
     }
 }
 
-
 /// What a creep run measured.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CreepMeasurement {
