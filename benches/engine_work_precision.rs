@@ -161,7 +161,7 @@ fn main() {
         let rows = read_rows(&std::fs::read_to_string(&csv).expect("read the CSV"));
         let mut names: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();
         names.dedup();
-        pushval::output::write_atomic(
+        pushval::atomic::write_atomic(
             &root.join("results/engine_work_precision.svg"),
             figure(&rows, &names).as_bytes(),
         )
@@ -346,9 +346,9 @@ fn main() {
             best.engine, best.dt, best.cpu_per_sim_s, best.run
         ));
     }
-    pushval::output::write_atomic(&csv_path, csv.as_bytes()).expect("write csv");
-    pushval::output::write_atomic(&summary_path, summary.as_bytes()).expect("write summary");
-    pushval::output::write_atomic(
+    pushval::atomic::write_atomic(&csv_path, csv.as_bytes()).expect("write csv");
+    pushval::atomic::write_atomic(&summary_path, summary.as_bytes()).expect("write summary");
+    pushval::atomic::write_atomic(
         &out.join("engine_work_precision.svg"),
         figure(&rows, &names).as_bytes(),
     )
@@ -388,7 +388,7 @@ fn merged(old: Vec<Row>, new: Vec<Row>) -> Vec<Row> {
 /// Log–log figure: steady-ω error (left) and position error (right)
 /// against CPU time per simulated second, one line per engine model.
 fn figure(rows: &[Row], names: &[&str]) -> String {
-    use pushval::report::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
+    use pushval::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
     let panel = |title: &str, ylabel: &str, pick: &dyn Fn(&Row) -> f64| {
         let mut p = Panel::new(
             title,
@@ -430,5 +430,5 @@ fn figure(rows: &[Row], names: &[&str]) -> String {
         ],
         key: None,
     };
-    pushval::report::plot::render(&fig).expect("figure renders")
+    pushval::plot::render(&fig).expect("figure renders")
 }

@@ -350,9 +350,7 @@ fn main() {
         ));
     }
     let path = root().join("results/outside_overhead.csv");
-    let tmp = path.with_extension("csv.tmp");
-    std::fs::write(&tmp, csv_text).unwrap();
-    std::fs::rename(&tmp, &path).unwrap();
+    pushval::atomic::write_atomic(&path, csv_text.as_bytes()).unwrap();
     eprintln!("wrote {}", path.display());
 
     // The in-process parts under criterion (its own statistics and report).

@@ -240,7 +240,7 @@ fn main() {
     }
     let dir = root.join("results");
     std::fs::create_dir_all(&dir).unwrap();
-    pushval::output::write_atomic(&dir.join("skips.csv"), csv.as_bytes()).unwrap();
+    pushval::atomic::write_atomic(&dir.join("skips.csv"), csv.as_bytes()).unwrap();
     print!("{csv}");
 }
 

@@ -102,6 +102,6 @@ fn main() {
     }
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
     std::fs::create_dir_all(&dir).unwrap();
-    pushval::output::write_atomic(&dir.join("support_discretisation.csv"), csv.as_bytes()).unwrap();
+    pushval::atomic::write_atomic(&dir.join("support_discretisation.csv"), csv.as_bytes()).unwrap();
     print!("{csv}");
 }

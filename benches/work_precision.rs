@@ -361,10 +361,10 @@ fn main() {
     }
     let dir = root.join("results");
     std::fs::create_dir_all(&dir).unwrap();
-    pushval::output::write_atomic(&dir.join("work_precision_target.csv"), target.as_bytes())
+    pushval::atomic::write_atomic(&dir.join("work_precision_target.csv"), target.as_bytes())
         .unwrap();
-    pushval::output::write_atomic(&dir.join("work_precision.csv"), csv.as_bytes()).unwrap();
-    pushval::output::write_atomic(&dir.join("work_precision.svg"), figure(&rows).as_bytes())
+    pushval::atomic::write_atomic(&dir.join("work_precision.csv"), csv.as_bytes()).unwrap();
+    pushval::atomic::write_atomic(&dir.join("work_precision.svg"), figure(&rows).as_bytes())
         .unwrap();
     print!("{csv}");
 }
@@ -431,7 +431,7 @@ fn target_comparison(
 /// method (position error left, steady-ω error right). Errors below 1e-12
 /// are round-off and drawn at 1e-12.
 fn figure(rows: &[Row]) -> String {
-    use pushval::report::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
+    use pushval::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
     let shown = [
         ("pushval DOP853", Stroke::Solid),
         ("pushval DP5(4)", Stroke::Solid),
@@ -482,5 +482,5 @@ fn figure(rows: &[Row]) -> String {
         ],
         key: None,
     };
-    pushval::report::plot::render(&fig).expect("figure renders")
+    pushval::plot::render(&fig).expect("figure renders")
 }

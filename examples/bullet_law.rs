@@ -44,10 +44,7 @@ const DURATION: f64 = 6.0;
 const LAW: FrictionModel = FrictionModel::ImpulseRowsDisk;
 
 fn write(path: &Path, text: &str) -> anyhow::Result<()> {
-    let tmp = path.with_extension("csv.tmp");
-    std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("renaming to {}", path.display()))?;
-    Ok(())
+    pushval::atomic::write_atomic(path, text.as_bytes())
 }
 
 fn main() -> anyhow::Result<()> {

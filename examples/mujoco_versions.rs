@@ -91,9 +91,7 @@ fn main() -> anyhow::Result<()> {
         }
     }
     let out = Path::new("results/friction_models/mujoco_versions.csv");
-    let tmp = out.with_extension("csv.tmp");
-    std::fs::write(&tmp, &csv).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, out).with_context(|| format!("renaming to {}", out.display()))?;
+    pushval::atomic::write_atomic(out, csv.as_bytes())?;
     eprintln!("{csv}");
     Ok(())
 }

@@ -69,7 +69,7 @@ pub fn cli(dir: &Path, force: bool) -> anyhow::Result<ExitCode> {
         let parent = p.parent().expect("under dir");
         std::fs::create_dir_all(parent)
             .with_context(|| format!("creating {}", parent.display()))?;
-        crate::output::write_atomic(p, text.as_bytes())?;
+        crate::atomic::write_atomic(p, text.as_bytes())?;
     }
     for (p, _) in &files {
         println!("wrote {}", p.display());

@@ -2,14 +2,20 @@
 //! dynamic model, and writes the contract outputs (`summary.json`,
 //! `trajectory.csv`). The command line in `main.rs` is a thin layer over this.
 
+pub mod atomic;
 pub mod fit;
 pub mod harness;
 pub mod init;
+pub mod inject;
+pub mod outdir;
 pub mod output;
 pub mod outside;
+pub mod parallel;
+pub mod plot;
 pub mod power;
 pub mod registry;
 pub mod report;
+pub mod shard;
 pub mod shipped;
 pub mod stress;
 pub mod study;

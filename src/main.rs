@@ -79,7 +79,7 @@ enum Command {
         quick: bool,
         /// Compute only part K of N of the sweeps into OUT/parts/ (batch schedulers).
         #[arg(long, value_name = "K/N", conflicts_with = "merge")]
-        shard: Option<pushval::report::Shard>,
+        shard: Option<pushval::shard::Shard>,
         /// Build the outputs from the parts in OUT/parts/ instead of computing the sweeps.
         #[arg(long)]
         merge: bool,
@@ -101,7 +101,7 @@ enum Command {
         /// each task's key) into parts/; without it, a Slurm array task
         /// (SLURM_ARRAY_TASK_ID/COUNT) computes its own part.
         #[arg(long, value_name = "[hash:]K/N", conflicts_with = "merge")]
-        shard: Option<pushval::report::Shard>,
+        shard: Option<pushval::shard::Shard>,
         /// Build the outputs from the part files instead of running the engines.
         #[arg(long)]
         merge: bool,
@@ -345,7 +345,7 @@ fn validate(
         })
         .collect::<anyhow::Result<_>>()?;
     if let Some(path) = &junit {
-        output::write_atomic(path, output::junit(&reports).as_bytes())?;
+        pushval::atomic::write_atomic(path, output::junit(&reports).as_bytes())?;
     }
     if as_json {
         let rows: Vec<serde_json::Value> = reports.iter().map(output::summary).collect();
@@ -382,8 +382,8 @@ fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
     let summary = serde_json::to_string_pretty(&output::summary(&report))?;
     let csv = output::trajectory_csv(&report);
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    output::write_atomic(&out.join("trajectory.csv"), csv.as_bytes())?;
-    output::write_atomic(&out.join("summary.json"), summary.as_bytes())?;
+    pushval::atomic::write_atomic(&out.join("trajectory.csv"), csv.as_bytes())?;
+    pushval::atomic::write_atomic(&out.join("summary.json"), summary.as_bytes())?;
     print!("{}", output::table(std::slice::from_ref(&report)));
     println!(
         "wrote {} and {}",

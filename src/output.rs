@@ -21,23 +21,12 @@
 //! model per sample time; x, y the centre of mass in the world frame (m),
 //! theta unwrapped (rad).
 
-use std::io::Write;
-use std::path::Path;
-
-use anyhow::Context;
 use pushval_model::{RootKind, Violation};
 use serde_json::{json, Value};
 
 use crate::ScenarioReport;
 
-/// A finite number, or null.
-pub fn num(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
+use crate::outdir::json_num as num;
 
 fn opt(v: Option<f64>) -> Value {
     v.map_or(Value::Null, num)
@@ -232,22 +221,6 @@ pub fn trajectory_csv(report: &ScenarioReport) -> String {
     let mut out = Vec::new();
     pushval_model::format::write(&mut out, &runs).expect("writing to memory");
     String::from_utf8(out).expect("the format is ASCII")
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same folder and a
-/// rename, so a reader never sees a half-written file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
-    tmp.write_all(bytes)
-        .with_context(|| format!("writing {}", path.display()))?;
-    tmp.persist(path)
-        .with_context(|| format!("renaming into {}", path.display()))?;
-    Ok(())
 }
 
 fn fmt_e(v: f64) -> String {

@@ -63,7 +63,7 @@ pub fn write_out(dir: &Path, force: bool) -> anyhow::Result<Vec<PathBuf>> {
         let parent = p.parent().expect("under dir");
         std::fs::create_dir_all(parent)
             .with_context(|| format!("creating {}", parent.display()))?;
-        crate::output::write_atomic(p, text.as_bytes())?;
+        crate::atomic::write_atomic(p, text.as_bytes())?;
     }
     Ok(files.into_iter().map(|(p, _)| p).collect())
 }
@@ -93,7 +93,7 @@ pub fn materialized(folder: &str) -> anyhow::Result<PathBuf> {
     for (name, text) in rows {
         let p = dir.join(name);
         if std::fs::read_to_string(&p).ok().as_deref() != Some(*text) {
-            crate::output::write_atomic(&p, text.as_bytes())?;
+            crate::atomic::write_atomic(&p, text.as_bytes())?;
         }
     }
     Ok(dir)

@@ -698,10 +698,10 @@ pub fn write_sweep(cases: &[Case], out: &Path) -> anyhow::Result<(Vec<Outcome>, 
     let outcomes = run_grid(cases, None)?;
     let lim = limits(&outcomes);
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    crate::output::write_atomic(&out.join("stress.csv"), csv(&outcomes).as_bytes())?;
-    crate::output::write_atomic(&out.join("stability.csv"), limits_csv(&lim).as_bytes())?;
+    crate::atomic::write_atomic(&out.join("stress.csv"), csv(&outcomes).as_bytes())?;
+    crate::atomic::write_atomic(&out.join("stability.csv"), limits_csv(&lim).as_bytes())?;
     if let Some(svg) = map_figure(&outcomes)? {
-        crate::output::write_atomic(&out.join("stress_map.svg"), svg.as_bytes())?;
+        crate::atomic::write_atomic(&out.join("stress_map.svg"), svg.as_bytes())?;
     }
     Ok((outcomes, lim))
 }
@@ -730,7 +730,7 @@ fn log_edges(v: &[f64]) -> Vec<(f64, f64)> {
 /// sweep, cells over (v_c, dt) coloured ok / degraded / unstable. None when
 /// the outcomes hold no map sweep.
 pub fn map_figure(outcomes: &[Outcome]) -> anyhow::Result<Option<String>> {
-    use crate::report::plot::{Axis, Cell, Figure, Key, Legend, Panel};
+    use crate::plot::{Axis, Cell, Figure, Key, Legend, Panel};
     use plotters::style::RGBColor;
     let map: Vec<&Outcome> = outcomes
         .iter()
@@ -794,5 +794,5 @@ pub fn map_figure(outcomes: &[Outcome]) -> anyhow::Result<Option<String>> {
             ],
         }),
     };
-    crate::report::plot::render(&fig).map(Some)
+    crate::plot::render(&fig).map(Some)
 }

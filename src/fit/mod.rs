@@ -666,7 +666,7 @@ pub fn table(fit: &Fit) -> String {
 pub fn write(fit: &Fit, dir: &Path) -> anyhow::Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let path = dir.join("fit.json");
-    crate::output::write_atomic(
+    crate::atomic::write_atomic(
         &path,
         serde_json::to_string_pretty(&fit.to_json())?.as_bytes(),
     )?;

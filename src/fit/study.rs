@@ -35,8 +35,8 @@ use pushval_model::{Push, Simulator};
 use pushval_scenario::Scenario;
 
 use super::{fisher_at, fit, noise, Param, Parametrised, Settings};
-use crate::output::write_atomic;
-use crate::report::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
+use crate::atomic::write_atomic;
+use crate::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
 /// The stated noise of the study on x and y (m).
 pub const SIGMA_POSITION: f64 = 1e-3;
@@ -1015,7 +1015,7 @@ fn text(study: &Study, o: &Outcome, quick: bool) -> String {
 /// when one does not.
 pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {
     let start = std::time::Instant::now();
-    let o = run(&crate::report::default_scenario_dir(), out, quick)?;
+    let o = run(&crate::registry::default_scenario_dir(), out, quick)?;
     match o.best(true) {
         Some((v, phi, d)) => println!(
             "shortest push (model assumptions holding) for μ within {} % and I_cm within {} % at {}σ: {d:.2} s at {v} m/s, φ = {phi:.4} rad",

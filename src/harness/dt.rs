@@ -150,7 +150,7 @@ impl DtChoice {
 
     /// The record written into the engine's settings in `summary.json`.
     pub fn json(&self) -> serde_json::Value {
-        use crate::output::num;
+        use crate::outdir::json_num as num;
         let rungs: Vec<serde_json::Value> = self
             .rungs
             .iter()

@@ -30,7 +30,9 @@ pub struct RunOptions {
 
 impl Default for RunOptions {
     fn default() -> Self {
-        Self { model_tol: 1e-10 }
+        Self {
+            model_tol: crate::inject::MODEL_TOL,
+        }
     }
 }
 
@@ -450,7 +452,7 @@ pub fn compare_trajectory(
 
 /// The smallest model errors a gated row's tolerances would catch, from
 /// the model's sensitivities: each error is injected at ±[`CATCH_PROBE`]
-/// (relative) into the dynamic model ([`crate::power::inject`]), each gated
+/// (relative) into the dynamic model ([`crate::inject::inject`]), each gated
 /// figure's change divided by the probe is its sensitivity `|∂X/∂p|`, and
 /// `tolerance / |∂X/∂p|` is the error that moves that figure past its
 /// tolerance. Any figure failing fails the row, so the most sensitive
@@ -475,7 +477,9 @@ impl Catches {
     /// The record in summary.json.
     pub fn json(&self) -> serde_json::Value {
         let one = |c: &Option<(f64, &str)>| match c {
-            Some((m, by)) => serde_json::json!({"relative": crate::output::num(*m), "figure": by}),
+            Some((m, by)) => {
+                serde_json::json!({"relative": crate::outdir::json_num(*m), "figure": by})
+            }
             None => serde_json::Value::Null,
         };
         serde_json::json!({
@@ -494,7 +498,7 @@ pub fn catchable(
     reference: &Trajectory,
     tol: &Figures,
 ) -> Catches {
-    use crate::power::{inject, ErrorKind};
+    use crate::inject::{inject, ErrorKind};
     let one = |kind: ErrorKind| -> Option<(f64, &'static str)> {
         // Mean of |ΔX| over the two signs, per figure.
         let mut sens = [0.0f64; 3];

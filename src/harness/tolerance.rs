@@ -86,7 +86,7 @@ pub struct Resolved {
 impl Resolved {
     /// The record written beside the model's figures in summary.json.
     pub fn json(&self) -> serde_json::Value {
-        use crate::output::num;
+        use crate::outdir::json_num as num;
         let f = |x: &Figures| {
             serde_json::json!({
                 "position_max": num(x.position_max),

@@ -3,7 +3,7 @@
 //!
 //! Every sweep cell is one [`Task`]; the list of tasks is fixed by the grid
 //! (`--quick` or full), so a part of it can be computed anywhere and merged
-//! (see [`super::shard`]). Each cell is evaluated from the dynamic model's
+//! (see [`crate::shard`]). Each cell is evaluated from the dynamic model's
 //! steady-state analysis ([`SegmentDynamics`]) and, for the validity map, a
 //! fixed-step RK4 integration of the scalar ODE `I_P ω̇ = G(ω)`. The figures
 //! built from the cells are in [`super::figures`].
@@ -387,7 +387,7 @@ pub fn compute(
     progress: bool,
 ) -> Vec<Vec<f64>> {
     let grids = Grids::new(quick);
-    super::par_rows(&tasks[range], progress, "sweeps", |t| {
+    crate::parallel::par_rows(&tasks[range], progress, "sweeps", |t| {
         eval(geoms, &grids, t)
     })
 }

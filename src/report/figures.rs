@@ -11,11 +11,12 @@ use super::cells::{
     assume_cell, assume_geometry, segment, steady, Geometry, Grids, Task, ASSUME_PHI_LO,
     CONTACT_MU, FORCE_SAMPLES, SCHEDULE_PHIS, SEGMENT_LENGTH,
 };
-use super::plot::{
+use super::readme::Entry;
+use crate::outdir::{num, Csv, Writer};
+use crate::plot::{
     heat_map, Axis, Figure, Legend, MapCell, Panel, Scale, Series, Stroke, BLUE_, DARK, PALETTE,
     PURPLE,
 };
-use super::{num, Csv, Entry, Writer};
 use pushval_model::{kappa, kappa_series, KappaSeries};
 
 /// `(min, max)` of the finite values (`(NaN, NaN)` when there are none).

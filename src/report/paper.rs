@@ -11,9 +11,10 @@ use pushval_model::{
 use pushval_scenario::Scenario;
 use rayon::prelude::*;
 
-use super::plot::{Axis, Figure, Legend, Panel, Series, Stroke, BLUE_, DARK, GREEN_, ORANGE, RED_};
-use super::{num, num10, Csv, Entry, Writer};
+use super::readme::{Entry, KEY_FIGURES};
 use crate::harness::reference_engine;
+use crate::outdir::{num, num10, Csv, Writer};
+use crate::plot::{Axis, Figure, Legend, Panel, Series, Stroke, BLUE_, DARK, GREEN_, ORANGE, RED_};
 
 /// The pusher speeds of the paper's ω(t) figure (m/s).
 pub const SPEEDS: [f64; 5] = [0.2, 0.4, 0.6, 0.8, 1.0];
@@ -427,7 +428,7 @@ fn path_figure(
     );
     Ok(Entry {
         figure: svg_name,
-        data: vec![csv_name, super::KEY_FIGURES.to_string()],
+        data: vec![csv_name, KEY_FIGURES.to_string()],
         text: format!(
             "{title} (Fr = {:.3}): x(t), y(t) and the path of the centre of mass. After {} s the \
              kinematic model ends {:.3} m from the dynamic model (path length {:.1} m); \
@@ -577,7 +578,7 @@ fn mass_figure(light: &Runs, heavy: &Runs, w: &mut Writer) -> anyhow::Result<Ent
     }
     Ok(Entry {
         figure: "mass.svg".into(),
-        data: vec!["mass.csv".into(), super::KEY_FIGURES.into()],
+        data: vec!["mass.csv".into(), KEY_FIGURES.into()],
         text: format!(
             "The paper plate at 1 kg and at 10 kg (inertia and loads scale with the mass), \
              v_c = 1 m/s. Dynamic model: max |Δω| = {dw_model:.1e} rad/s, max |Δposition| = \

@@ -8,8 +8,8 @@ use plotters::style::RGBColor;
 
 use super::err;
 use super::plate::froude;
-use super::readme::{num, parse};
-use crate::report::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, PURPLE};
+use super::records::{num, parse};
+use crate::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, PURPLE};
 
 /// The error classes' lower bounds (dimensionless): class k is
 /// `BOUNDS[k-1] ≤ error < BOUNDS[k]`.

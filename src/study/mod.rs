@@ -22,12 +22,14 @@
 //! The tasks run in parallel (rayon) with a progress bar, and split over
 //! processes or machines: `--shard K/N`, `--shard hash:K/N`, or a Slurm
 //! array's variables; `--merge` rebuilds exactly the single run's files
-//! ([`crate::report::shard`]).
+//! ([`crate::shard`]).
 
+pub mod creep_law;
 pub mod figure;
 pub mod fit;
 pub mod plate;
 pub mod readme;
+pub mod records;
 pub mod spec;
 
 use std::collections::BTreeMap;
@@ -37,8 +39,9 @@ use anyhow::bail;
 use pushval_engine::{rel_err, tail_loads, tail_mean_omega, Engine, EngineOptions, LawClass};
 use pushval_model::{Problem, Push};
 
-use crate::report::shard::{grid_hash, grid_name, Parts, Shard};
-use crate::report::{par_rows, Writer};
+use crate::outdir::Writer;
+use crate::parallel::par_rows;
+use crate::shard::{grid_hash, grid_name, Parts, Shard};
 use plate::{frs, length, paper_plate, phis, speed_of, PHI_TABLE, TABLE_SPEEDS};
 use spec::Spec;
 

@@ -5,30 +5,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::plate::{froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
+use super::records::{num, parse, Records};
 use super::{class_name, err, fit, opt, Plan, Task, LOADS, RUN_WIDTH};
-use crate::report::Writer;
-
-/// One CSV's records, by column name.
-pub type Records = Vec<std::collections::BTreeMap<String, String>>;
-
-/// Parses CSV text with a header row (no quoting: the studies write none).
-pub fn parse(text: &str) -> Records {
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    lines
-        .map(|l| {
-            head.iter()
-                .zip(l.split(','))
-                .map(|(h, v)| (h.to_string(), v.to_string()))
-                .collect()
-        })
-        .collect()
-}
-
-/// The number in column `key` (NaN where blank or absent).
-pub fn num(r: &std::collections::BTreeMap<String, String>, key: &str) -> f64 {
-    r.get(key).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN)
-}
+use crate::outdir::Writer;
 
 /// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
 /// within 1e-2 of the law, turns, locked, semi_stable)`.

@@ -421,7 +421,7 @@ pub fn summary(
     settings: &EkfSettings,
     out: &Outcome,
 ) -> (Value, Vec<String>) {
-    let num = crate::output::num;
+    let num = crate::outdir::json_num;
     let times: Vec<f64> = out.rows.iter().map(|r| r.t).collect();
     let last = out.rows.last().expect("at least one row");
     let mut parameters = serde_json::Map::new();
@@ -568,9 +568,9 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
     let (json, not_converged) = summary(&sc, &params, &req.settings, &out);
     std::fs::create_dir_all(&req.out).with_context(|| format!("creating {}", req.out.display()))?;
     let csv_path = req.out.join("track.csv");
-    crate::output::write_atomic(&csv_path, &csv)?;
+    crate::atomic::write_atomic(&csv_path, &csv)?;
     let json_path = req.out.join("track.json");
-    crate::output::write_atomic(&json_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    crate::atomic::write_atomic(&json_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     eprintln!("wrote {} and {}", csv_path.display(), json_path.display());
     let mut code = ExitCode::SUCCESS;
     if !not_converged.is_empty() {

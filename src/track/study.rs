@@ -34,9 +34,9 @@ use pushval_scenario::Scenario;
 use rayon::prelude::*;
 
 use super::{thread_cpu_time, track_model};
+use crate::atomic::write_atomic;
 use crate::fit::{fisher_at, noise, Param, Parametrised, Settings};
-use crate::output::write_atomic;
-use crate::report::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
+use crate::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
 /// The broad prior of [`Method::EkfBroadPrior`].
 pub const BROAD_PRIOR: [f64; 3] = [0.5, 0.25, 0.5];

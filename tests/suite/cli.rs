@@ -234,3 +234,42 @@ fn compare_warns_when_the_outside_run_starts_differently() {
     );
     assert!(err.contains("from_rest = false"), "{err}");
 }
+
+/// Outputs are readable by the group: a written file gets the mode a newly
+/// created file gets under the user's umask, `0o666 & !umask` (POSIX
+/// `open(O_CREAT)` semantics), not the 0600 of a private temporary file,
+/// and still nothing but the outputs is left in the folder. Two umasks, so
+/// the mode follows the umask rather than being a fixed 0644.
+#[cfg(unix)]
+#[test]
+fn outputs_get_the_umask_mode() {
+    use std::os::unix::fs::PermissionsExt;
+    for (umask, mode) in [("022", 0o644), ("027", 0o640)] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let st = Command::new("sh")
+            .arg("-c")
+            .arg(format!("umask {umask}; exec \"$0\" \"$@\""))
+            .arg(env!("CARGO_BIN_EXE_pushval"))
+            .arg("run")
+            .arg(root().join("scenarios/paper-square-v0.2.toml"))
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        for name in ["summary.json", "trajectory.csv"] {
+            let m = std::fs::metadata(out.join(name))
+                .unwrap()
+                .permissions()
+                .mode()
+                & 0o777;
+            assert_eq!(m, mode, "{name} under umask {umask}: mode {m:o}");
+        }
+        assert_eq!(std::fs::read_dir(&out).unwrap().count(), 2);
+    }
+}

@@ -459,7 +459,7 @@ fn gated_rows_say_their_dt_ladder_verdict_and_what_they_catch() {
     let reference = &r.dynamic().trajectory;
     let figure_at = |scale: f64| {
         let tr =
-            pushval::power::inject(&sc, pushval::power::ErrorKind::InertiaCm, scale * m).unwrap();
+            pushval::inject::inject(&sc, pushval::inject::ErrorKind::InertiaCm, scale * m).unwrap();
         let cmp = pushval::harness::compare_trajectory(
             &sc,
             &r.segments,

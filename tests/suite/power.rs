@@ -1,7 +1,8 @@
 //! `pushval power`: the gate's power against injected model errors, and the
 //! injected models themselves.
 
-use pushval::power::{inject, law, ErrorKind, Gate};
+use pushval::inject::{inject, law, ErrorKind};
+use pushval::power::Gate;
 use pushval_model::{DynamicModel, Simulator};
 use pushval_rapier2d::{idioms, FrictionModel};
 

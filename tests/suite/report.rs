@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use pushval::report::{self, Options, Shard};
+use pushval::report::{self, Options};
+use pushval::shard::Shard;
 use pushval_model::{
     Body, DynamicModel, Initial, KinematicModel, Problem, Push, Simulator, Switching, Vec2,
 };

@@ -754,3 +754,15 @@ fn a_sweep_over_a_count_option_builds_its_engines() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// `results/friction_models/mujoco/creep_law.md` is generated from
+/// `creep_law.csv` beside it (`examples/creep_law.rs`): regenerating it from
+/// the committed CSV gives the committed text, so every number in it comes
+/// from the CSV.
+#[test]
+fn creep_law_section_comes_from_its_csv() {
+    let dir = root().join("results/friction_models/mujoco");
+    let csv = std::fs::read_to_string(dir.join("creep_law.csv")).unwrap();
+    let md = std::fs::read_to_string(dir.join("creep_law.md")).unwrap();
+    assert_eq!(pushval::study::creep_law::markdown(&csv).unwrap(), md);
+}

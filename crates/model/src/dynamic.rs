@@ -15,6 +15,12 @@
 //! is exactly one root and it is stable. For `k > 0` the inertial term
 //! destabilises and roots come in odd numbers inside `|ω| ≤ M / k` with
 //! `M = Σ F_i |r_i|` the largest friction moment; all are found and reported.
+//!
+//! Whole (about 740 lines of code, then its unit tests): one type,
+//! [`SegmentDynamics`], whose methods (ω̇ and its Taylor series, the roots
+//! and their stability, the pusher force) all read the same per-support
+//! sums precomputed by its constructor; split, they would share private
+//! fields across files.
 
 use crate::{cross, perp, Body, Push, Vec2};
 

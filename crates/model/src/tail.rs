@@ -36,6 +36,12 @@
 //! Samples are usually evenly spaced, so [`TailCursor`] advances `P` and `E`
 //! by multiplication instead of calling `exp`/`sin_cos` per sample, and cuts
 //! the sums per block of samples at the last term that still counts.
+//!
+//! Whole (about 690 lines of code, then its unit tests): the series' three
+//! stages (the linearising map, the hand-over rule, the cursor that samples
+//! it) pass one another fixed-size coefficient arrays of the one truncation
+//! order [`ORDER`] and crate-private types; apart, each file would need the
+//! others' internals.
 
 use nalgebra::Complex;
 

@@ -11,6 +11,7 @@ mod checker;
 mod dynamic_model;
 mod rk4;
 mod sampling;
+mod segment;
 
 pub use dynamic_model::{DynamicModel, Integrator};
 

@@ -42,8 +42,6 @@ use std::time::Duration;
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 pub mod creep;
-#[cfg(feature = "mujoco")]
-mod creep_sim;
 mod engine;
 pub mod scene;
 #[cfg(feature = "mujoco")]

@@ -1,15 +1,12 @@
 //! MuJoCo's creep law (`pushval_mujoco::creep`, issue 28 item 3): the closed
-//! form's own limits (no MuJoCo needed), the generated README section against
-//! its CSV, and, with the `mujoco` feature, the closed form against the
+//! form's own limits (no MuJoCo needed) and, with the `mujoco` feature, the closed form against the
 //! engine on a few cells of the ladder (within 5 %). Expected values come
 //! from the closed form's derivation (MuJoCo's regularised constraint
 //! formulation), from limits and from MuJoCo's documented impedance curve,
 //! never from a run's output.
 
 use approx::assert_relative_eq;
-use pushval_mujoco::creep::{
-    creep, impedance, reference, report_markdown, CreepInput, CreepRegime,
-};
+use pushval_mujoco::creep::{creep, impedance, reference, CreepInput, CreepRegime};
 use pushval_mujoco::Cone;
 
 const MU: f64 = 0.5;
@@ -170,18 +167,6 @@ fn pyramidal_creep_follows_its_lifted_edge_branch() {
     let diag = std::f64::consts::FRAC_PI_4;
     assert_eq!(regime(0.70, diag), CreepRegime::Interior);
     assert_eq!(regime(0.71, diag), CreepRegime::Slides);
-}
-
-/// creep_law.md is generated from creep_law.csv: regenerating it from the
-/// committed CSV gives the committed text, so every number in it comes
-/// from the CSV.
-#[test]
-fn creep_readme_section_comes_from_its_csv() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../results/friction_models/mujoco");
-    let csv = std::fs::read_to_string(dir.join("creep_law.csv")).unwrap();
-    let md = std::fs::read_to_string(dir.join("creep_law.md")).unwrap();
-    assert_eq!(report_markdown(&csv).unwrap(), md);
 }
 
 #[cfg(feature = "mujoco")]

@@ -1,7 +1,7 @@
 //! One segment of the dynamic model by an adaptive embedded pair:
 //! Dormand–Prince 5(4) or DOP853, with dense output at the samples.
 
-use super::dynamic_model::{pose_of, Recorder, SegmentRun};
+use super::segment::{pose_of, Recorder, SegmentRun};
 use crate::integrate::{self, State};
 use crate::tail::Tail;
 use crate::ModelError;

@@ -1,7 +1,7 @@
 //! One segment of the dynamic model by classical RK4 at a fixed step,
 //! sampled by cubic Hermite interpolation (kept for benchmarks).
 
-use super::dynamic_model::{pose_of, Recorder, SegmentRun};
+use super::segment::{pose_of, Recorder, SegmentRun};
 use crate::integrate::{self, State};
 use crate::tail::Tail;
 use crate::ModelError;

@@ -3,7 +3,7 @@
 use mujoco_rs::prelude::*;
 use pushval_model::ModelError;
 
-use crate::creep::{CreepCase, CreepMeasurement, CreepScene};
+use super::scene::{CreepCase, CreepMeasurement, CreepScene};
 
 type Data = MjData<Box<MjModel>>;
 

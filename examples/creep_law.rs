@@ -4,7 +4,7 @@
 //!
 //! ```text
 //! eval "$(scripts/setup-mujoco.sh)"
-//! cargo run --release -p pushval-mujoco --features mujoco --example creep_law [-- OUT_DIR]
+//! cargo run --release --features mujoco --example creep_law [-- OUT_DIR]
 //! ```
 //!
 //! OUT_DIR defaults to results/friction_models/mujoco. Files are written to a
@@ -15,9 +15,9 @@ use std::f64::consts::FRAC_PI_4;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use pushval::study::creep_law::{markdown, CSV_COLUMNS};
 use pushval_mujoco::creep::{
-    hold_time, measure, report_markdown, CreepCase, CreepRegime, CreepScene, CSV_COLUMNS,
-    SLIDING_SPEED,
+    hold_time, measure, CreepCase, CreepRegime, CreepScene, SLIDING_SPEED,
 };
 use pushval_mujoco::{Cone, MujocoSettings};
 
@@ -220,9 +220,7 @@ fn row(c: &Cell) -> Result<String, String> {
 }
 
 fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, text).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+    pushval::atomic::write_atomic(path, text.as_bytes()).map_err(|e| format!("{e:#}"))
 }
 
 fn run() -> Result<(), String> {
@@ -234,7 +232,7 @@ fn run() -> Result<(), String> {
     }
     let out: PathBuf = match args.first() {
         Some(a) => PathBuf::from(a),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/friction_models/mujoco"),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("results/friction_models/mujoco"),
     };
     let out = out
         .canonicalize()
@@ -253,7 +251,7 @@ fn run() -> Result<(), String> {
             eprintln!("creep_law: {}/{} runs", i + 1, cells.len());
         }
     }
-    let md = report_markdown(&csv)?;
+    let md = markdown(&csv)?;
     write_atomic(&out.join("creep_law.csv"), &csv)?;
     write_atomic(&out.join("creep_law.md"), &md)?;
     eprintln!(

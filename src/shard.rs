@@ -30,7 +30,7 @@ use std::str::FromStr;
 
 use anyhow::{bail, Context};
 
-use super::num;
+use crate::outdir::num;
 
 /// One part of N of a task list: `K/N` (contiguous) or `hash:K/N` (by the
 /// hash of each task's key), with 1 ≤ K ≤ N.
