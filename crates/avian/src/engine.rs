@@ -4,11 +4,11 @@
 //! are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError, COULOMB,
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, ModelEntry, OptionError, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
+use crate::predict::Avian3dTilt;
 use crate::{Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator, AVAILABLE};
 
 /// The 2-D engine crate and the version this adapter is built against (the
@@ -55,10 +55,30 @@ pub struct Avian2dModel {
 }
 
 /// The `avian3d` model.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Avian3dModel {
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Avian3dSettings,
+    /// The law it follows, built from `settings` by [`Avian3dModel::new`].
+    law: Avian3dTilt,
+}
+
+impl Avian3dModel {
+    /// The model with `settings` and the law of its plate.
+    pub fn new(settings: Avian3dSettings) -> Self {
+        Self {
+            settings,
+            law: Avian3dTilt {
+                plate: (&settings).into(),
+            },
+        }
+    }
+}
+
+impl Default for Avian3dModel {
+    fn default() -> Self {
+        Self::new(Avian3dSettings::default())
+    }
 }
 
 /// The Avian models: the crate's entries in pushval's engine registry.
@@ -90,7 +110,7 @@ pub fn models() -> Vec<ModelEntry> {
                 if let Some(h) = o.non_negative("cm_height")? {
                     settings.cm_height = h;
                 }
-                Ok(Box::new(Avian3dModel { settings }))
+                Ok(Box::new(Avian3dModel::new(settings)))
             },
         },
     ]
@@ -199,7 +219,7 @@ impl Engine for Avian3dModel {
         })
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
-        Some(self)
+        Some(&self.law)
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let r = Avian3dSimulator::new(Avian3dSettings {
@@ -221,33 +241,6 @@ impl Engine for Avian3dModel {
             }),
             trajectory: r.trajectory,
         })
-    }
-}
-
-/// avian3d's contact friction in closed form (`crate::predict`): Coulomb
-/// at every foot with the loads of its soft contacts, coupled to the forces
-/// when the centre of mass is above the floor.
-impl FrictionLaw for Avian3dModel {
-    fn law_name(&self) -> &'static str {
-        "Coulomb along −u at every foot with the soft contacts' loads, load transfer above the floor (pushval_avian::predict)"
-    }
-    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
-        let push = problem.pushes.get(segment)?;
-        let scene = crate::predict::PlateScene::new(problem, &self.settings).ok()?;
-        let (omega, _) = scene.steady(push, 0.0)?;
-        Some(LawSteady {
-            omega,
-            class: LawClass::Turns,
-        })
-    }
-    /// The feet's loads (N) at the steady state: the rest loads of the soft
-    /// contacts (`m g` shared as springs ∝ effective mass: statics for three
-    /// feet) moved by the couple `−h_cm Σ f_i` of the friction
-    /// ([`crate::predict::PlateScene::steady`]).
-    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
-        let push = problem.pushes.get(segment)?;
-        let scene = crate::predict::PlateScene::new(problem, &self.settings).ok()?;
-        scene.steady(push, 0.0).map(|(_, loads)| loads)
     }
 }
 

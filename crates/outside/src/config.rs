@@ -10,7 +10,15 @@ pub const DEFAULT_DT: f64 = 1e-3;
 pub const DEFAULT_TIMEOUT_S: f64 = 120.0;
 
 /// The keys an `[engine.NAME]` table may hold.
-const KEYS: &[&str] = &["command", "order", "dt", "timeout_s", "version", "law"];
+const KEYS: &[&str] = &[
+    "command",
+    "order",
+    "dt",
+    "timeout_s",
+    "version",
+    "law",
+    "law_params",
+];
 
 /// One outside engine as `pushval.toml` declares it.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,6 +45,10 @@ pub struct Spec {
     /// the laws of `pushval::registry::laws`; an unknown name is refused
     /// naming the known ones); None when the file names none.
     pub law: Option<String>,
+    /// The law's parameters (`law_params = { key = value }`: numbers and
+    /// strings), checked against the law when the registry loads the file;
+    /// empty when the file gives none.
+    pub law_params: serde_json::Map<String, serde_json::Value>,
 }
 
 impl Spec {
@@ -262,8 +274,49 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
         Some(toml::Value::String(s)) => Some(s.clone()),
         Some(v) => return Err(err("law", format!("must be a string, got {v}"))),
     };
+    let law_params = match t.get("law_params") {
+        None => serde_json::Map::new(),
+        Some(toml::Value::Table(p)) => {
+            if law.is_none() {
+                return Err(err(
+                    "law_params",
+                    "parameters of no law: set `law` as well".into(),
+                ));
+            }
+            p.iter()
+                .map(|(k, v)| {
+                    let json = match v {
+                        toml::Value::Float(x) => serde_json::Number::from_f64(*x)
+                            .map(serde_json::Value::Number)
+                            .ok_or_else(|| {
+                                err(
+                                    &format!("law_params.{k}"),
+                                    format!("must be finite, got {x}"),
+                                )
+                            })?,
+                        toml::Value::Integer(i) => serde_json::Value::from(*i),
+                        toml::Value::String(s) => serde_json::Value::from(s.as_str()),
+                        other => {
+                            return Err(err(
+                                &format!("law_params.{k}"),
+                                format!("must be a number or a string, got {other}"),
+                            ))
+                        }
+                    };
+                    Ok((k.clone(), json))
+                })
+                .collect::<Result<_, _>>()?
+        }
+        Some(v) => return Err(err(
+            "law_params",
+            format!(
+                "must be a table of the law's parameters, e.g. {{ slip_speed = 0.01 }}, got {v}"
+            ),
+        )),
+    };
     Ok(Spec {
         law,
+        law_params,
         name: name.to_string(),
         command,
         dir: dir.to_path_buf(),

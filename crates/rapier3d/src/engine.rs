@@ -3,12 +3,11 @@
 //! `Simplified`), the plate on ball feet on a ground plane.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady, ModelEntry,
-    OptionError,
+    Engine, EngineCrate, EngineOptions, EngineRun, FrictionLaw, ModelEntry, OptionError,
 };
 use pushval_model::{ModelError, Problem};
 
-use crate::predict::{predict_steady, simplified_locks, Law};
+use crate::predict::{Law, Rapier3dTilt, SceneParams};
 use crate::{ContactFriction, FeetColliders, Rapier3dSettings, Rapier3dSimulator};
 
 /// The engine crate and version this adapter is built against (the
@@ -24,6 +23,8 @@ pub const ENGINE_CRATE: EngineCrate = EngineCrate {
 pub struct Rapier3dModel {
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Rapier3dSettings,
+    /// The law it follows, built from `settings` by [`Rapier3dModel::new`].
+    law: Rapier3dTilt,
 }
 
 fn build(friction: ContactFriction, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionError> {
@@ -48,7 +49,7 @@ fn build(friction: ContactFriction, opts: &EngineOptions) -> Result<Box<dyn Engi
     if let Some(h) = opts.non_negative("push_height")? {
         settings.push_height = h;
     }
-    Ok(Box::new(Rapier3dModel { settings }))
+    Ok(Box::new(Rapier3dModel::new(settings)))
 }
 
 /// The rapier3d models: the crate's entries in pushval's engine registry.
@@ -99,7 +100,7 @@ impl Engine for Rapier3dModel {
         &["feet", "cm_height", "push_height"]
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
-        Some(self)
+        Some(&self.law)
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = Rapier3dSettings {
@@ -153,46 +154,15 @@ impl Rapier3dModel {
     }
 }
 
-/// rapier3d's contact friction in closed form (`crate::predict`), with the
-/// normal loads coupled to the forces by the tilting balance.
-impl FrictionLaw for Rapier3dModel {
-    fn law_name(&self) -> &'static str {
-        match self.predict_law() {
-            Law::SimplifiedOneManifold => {
-                "Simplified on one manifold: disk at the friction centre plus a twist limit, loads from the tilting balance (pushval_rapier3d::predict)"
-            }
-            _ => {
-                "per-contact impulse along −K⁻¹u capped at μN, loads from the tilting balance (pushval_rapier3d::predict)"
-            }
-        }
-    }
-    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
-        let push = problem.pushes.get(segment)?;
-        let scene = self.settings.scene(problem).ok()?;
-        let law = self.predict_law();
-        let pred = predict_steady(&scene, push, law, true).ok()?;
-        let locked = law == Law::SimplifiedOneManifold && {
-            let body = scene.body(&pred.loads).ok()?;
-            simplified_locks(&scene.points, &pred.loads, scene.mu[0], &body, push)
+impl Rapier3dModel {
+    /// The model with `settings` and the law they give
+    /// ([`Rapier3dModel::predict_law`] on the settings' scene).
+    pub fn new(settings: Rapier3dSettings) -> Self {
+        let mut m = Self {
+            settings,
+            law: Rapier3dTilt::contact_disk(SceneParams::from(&settings)),
         };
-        Some(LawSteady {
-            omega: pred.omega,
-            class: if locked {
-                LawClass::Locked
-            } else {
-                LawClass::Turns
-            },
-        })
-    }
-    /// The feet's loads (N) at the steady state: `m g` shared as springs ∝
-    /// normal effective mass (statics for three feet), moved by the tilting
-    /// moment `h_push f_c − h_cm m a_cm`; a foot whose load would be negative
-    /// lifts off and carries 0 ([`crate::predict::predict_steady`]).
-    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
-        let push = problem.pushes.get(segment)?;
-        let scene = self.settings.scene(problem).ok()?;
-        predict_steady(&scene, push, self.predict_law(), true)
-            .ok()
-            .map(|p| p.loads)
+        m.law.law = m.predict_law();
+        m
     }
 }
