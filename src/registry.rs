@@ -40,13 +40,38 @@ pub fn laws() -> Vec<(&'static str, Arc<dyn FrictionLaw>)> {
         .collect()
 }
 
-/// The catalogue law called `name` with `params`: None for an unknown
-/// name, an error naming the key for a parameter it refuses.
-fn law(
-    name: &str,
-    params: &serde_json::Map<String, serde_json::Value>,
-) -> Option<Result<Arc<dyn FrictionLaw>, pushval_laws::ParamError>> {
-    pushval_laws::law_entry(name).map(|e| e.build(params).map(Arc::from))
+/// The law an outside engine declares (`law = "NAME"` and `law_params`
+/// in its `pushval.toml` table), built from the catalogue: None when it
+/// declares none; an unknown name is an error naming `engine.NAME.law` and
+/// listing the known laws, a parameter the law refuses one naming
+/// `engine.NAME.law_params.KEY`.
+pub fn outside_law(
+    spec: &Spec,
+) -> Result<Option<Arc<dyn FrictionLaw>>, pushval_outside::ConfigError> {
+    let Some(name) = spec.law.as_deref() else {
+        return Ok(None);
+    };
+    let err = |key: String, problem: String| pushval_outside::ConfigError {
+        file: spec.file.clone(),
+        key,
+        problem,
+    };
+    let Some(entry) = pushval_laws::law_entry(name) else {
+        let known: Vec<&str> = pushval_laws::catalog().iter().map(|e| e.name).collect();
+        return Err(err(
+            format!("engine.{}.law", spec.name),
+            format!("unknown law \"{name}\"; known: {}", known.join(", ")),
+        ));
+    };
+    entry
+        .build(&spec.law_params)
+        .map(|l| Some(Arc::from(l)))
+        .map_err(|e| {
+            err(
+                format!("engine.{}.law_params.{}", spec.name, e.key),
+                e.problem,
+            )
+        })
 }
 
 /// The file outside engines are declared in when `--engines` names none:
@@ -86,27 +111,7 @@ pub fn use_engines_file(file: Option<&Path>) -> Result<(), pushval_outside::Conf
                     problem: "this name is already a built-in model; choose another".into(),
                 });
             }
-            if let Some(l) = spec.law.as_deref() {
-                match law(l, &spec.law_params) {
-                    None => {
-                        let known: Vec<&str> =
-                            pushval_laws::catalog().iter().map(|e| e.name).collect();
-                        return Err(pushval_outside::ConfigError {
-                            file: c.file.clone(),
-                            key: format!("engine.{}.law", spec.name),
-                            problem: format!("unknown law \"{l}\"; known: {}", known.join(", ")),
-                        });
-                    }
-                    Some(Err(e)) => {
-                        return Err(pushval_outside::ConfigError {
-                            file: c.file.clone(),
-                            key: format!("engine.{}.law_params.{}", spec.name, e.key),
-                            problem: e.problem,
-                        });
-                    }
-                    Some(Ok(_)) => {}
-                }
-            }
+            outside_law(spec)?;
         }
         Some(c)
     } else {
@@ -159,12 +164,8 @@ impl Entry {
         match &self.build {
             Builder::Crate(b) => b(options),
             Builder::Outside(spec) => Ok(Box::new(
-                OutsideEngine::new(spec.clone(), options).with_law(
-                    spec.law
-                        .as_deref()
-                        .and_then(|l| law(l, &spec.law_params))
-                        .and_then(Result::ok),
-                ),
+                OutsideEngine::new(spec.clone(), options)
+                    .with_law(outside_law(spec).ok().flatten()),
             )),
         }
     }

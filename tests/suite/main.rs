@@ -11,6 +11,7 @@ mod engines;
 mod fit;
 mod gate;
 mod kappa;
+mod laws;
 mod outside;
 mod power;
 mod properties;

@@ -307,12 +307,14 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
                 })
                 .collect::<Result<_, _>>()?
         }
-        Some(v) => return Err(err(
-            "law_params",
-            format!(
+        Some(v) => {
+            return Err(err(
+                "law_params",
+                format!(
                 "must be a table of the law's parameters, e.g. {{ slip_speed = 0.01 }}, got {v}"
             ),
-        )),
+            ))
+        }
     };
     Ok(Spec {
         law,
