@@ -540,19 +540,22 @@ mod tests {
 
     /// Parameters reach the law: with the slip speed far below every
     /// support's slip (≳ 0.1 m/s here) the regularised laws are Coulomb's
-    /// (the limit v_s → 0), with the default 0.01 m/s they are not exactly.
+    /// (the limit v_s → 0); with v_s = 1 m/s, above every slip, the force is
+    /// well below μN at every support and ω is not Coulomb's.
     #[test]
     fn parameters_reach_the_law() {
         let p = plate_problem();
         let star = crate::coulomb_steady(&p, 0).unwrap();
         for name in ["regularised_linear", "regularised_tanh"] {
             let e = law_entry(name).unwrap();
-            let mut m = Map::new();
-            m.insert("slip_speed".into(), Value::from(1e-9));
-            let sharp = e.build(&m).unwrap().steady(&p, 0, 1e-3).unwrap().omega;
-            let soft = e.default_law().steady(&p, 0, 1e-3).unwrap().omega;
+            let omega = |v_s: f64| {
+                let mut m = Map::new();
+                m.insert("slip_speed".into(), Value::from(v_s));
+                e.build(&m).unwrap().steady(&p, 0, 1e-3).unwrap().omega
+            };
+            let (sharp, soft) = (omega(1e-9), omega(1.0));
             assert!((sharp - star).abs() < 1e-8, "{name}: {sharp} vs {star}");
-            assert!((soft - star).abs() > 1e-6, "{name}: {soft} vs {star}");
+            assert!((soft - star).abs() > 1e-3 * star.abs(), "{name}: {soft} vs {star}");
         }
     }
 }
