@@ -112,6 +112,13 @@ enum Command {
     /// List every engine model: crate, engine version, order, whether it can
     /// be gated and whether this build has it.
     Engines,
+    /// List every friction law in closed form: its name, the engines that
+    /// declare it, its parameters with defaults, where its loads come from.
+    Laws {
+        /// Print the catalogue as JSON instead.
+        #[arg(long)]
+        json: bool,
+    },
     /// Estimate parameters of the scenario (μ scale, I_cm, centre of
     /// friction, contact offset) from a trajectory by Levenberg–Marquardt;
     /// write DIR/fit.json. Exit 1 when the fit does not converge or a
@@ -546,6 +553,14 @@ fn main() -> ExitCode {
         Some(Command::TrackStudy { out, quick }) => pushval::track::study::cli(&out, quick),
         Some(Command::Engines) => {
             print!("{}", pushval::engines_table());
+            Ok(ExitCode::SUCCESS)
+        }
+        Some(Command::Laws { json }) => {
+            if json {
+                println!("{:#}", pushval::registry::laws_json());
+            } else {
+                print!("{}", pushval::registry::laws_table());
+            }
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Compare {

@@ -31,21 +31,47 @@ pub const ENGINE_CRATES: &[fn() -> Vec<ModelEntry>] = &[
 ];
 
 /// The friction laws an outside engine may declare (`law = "NAME"` in
-/// `pushval.toml`): Coulomb's, and the rapier2d idioms' closed forms.
+/// `pushval.toml`), with their default parameters: every law of
+/// [`pushval_laws::catalog`].
 pub fn laws() -> Vec<(&'static str, Arc<dyn FrictionLaw>)> {
-    let mut out: Vec<(&'static str, Arc<dyn FrictionLaw>)> =
-        vec![("coulomb", Arc::new(pushval_engine::COULOMB))];
-    out.extend(
-        pushval_rapier2d::laws()
-            .into_iter()
-            .map(|(n, l)| (n, Arc::from(l))),
-    );
-    out
+    pushval_laws::catalog()
+        .into_iter()
+        .map(|e| (e.name, Arc::from(e.default_law())))
+        .collect()
 }
 
-/// The law called `name`, if [`laws`] has it.
-fn law(name: &str) -> Option<Arc<dyn FrictionLaw>> {
-    laws().into_iter().find(|(n, _)| *n == name).map(|(_, l)| l)
+/// The law an outside engine declares (`law = "NAME"` and `law_params`
+/// in its `pushval.toml` table), built from the catalogue: None when it
+/// declares none; an unknown name is an error naming `engine.NAME.law` and
+/// listing the known laws, a parameter the law refuses one naming
+/// `engine.NAME.law_params.KEY`.
+pub fn outside_law(
+    spec: &Spec,
+) -> Result<Option<Arc<dyn FrictionLaw>>, pushval_outside::ConfigError> {
+    let Some(name) = spec.law.as_deref() else {
+        return Ok(None);
+    };
+    let err = |key: String, problem: String| pushval_outside::ConfigError {
+        file: spec.file.clone(),
+        key,
+        problem,
+    };
+    let Some(entry) = pushval_laws::law_entry(name) else {
+        let known: Vec<&str> = pushval_laws::catalog().iter().map(|e| e.name).collect();
+        return Err(err(
+            format!("engine.{}.law", spec.name),
+            format!("unknown law \"{name}\"; known: {}", known.join(", ")),
+        ));
+    };
+    entry
+        .build(&spec.law_params)
+        .map(|l| Some(Arc::from(l)))
+        .map_err(|e| {
+            err(
+                format!("engine.{}.law_params.{}", spec.name, e.key),
+                e.problem,
+            )
+        })
 }
 
 /// The file outside engines are declared in when `--engines` names none:
@@ -109,14 +135,7 @@ pub fn use_engines_file(file: Option<&Path>) -> Result<(), pushval_outside::Conf
                     problem: "this name is already a built-in model; choose another".into(),
                 });
             }
-            if let Some(l) = spec.law.as_deref().filter(|l| law(l).is_none()) {
-                let known: Vec<&str> = laws().iter().map(|(n, _)| *n).collect();
-                return Err(pushval_outside::ConfigError {
-                    file: c.file.clone(),
-                    key: format!("engine.{}.law", spec.name),
-                    problem: format!("unknown law \"{l}\"; known: {}", known.join(", ")),
-                });
-            }
+            outside_law(spec)?;
         }
         Some(c)
     } else {
@@ -170,7 +189,7 @@ impl Entry {
             Builder::Crate(b) => b(options),
             Builder::Outside(spec) => Ok(Box::new(
                 OutsideEngine::new(spec.clone(), options)
-                    .with_law(spec.law.as_deref().and_then(law)),
+                    .with_law(outside_law(spec).ok().flatten()),
             )),
         }
     }
@@ -400,4 +419,112 @@ pub fn default_scenario_dir() -> PathBuf {
         .find(|d| d.is_dir())
         .or_else(|| crate::shipped::materialized("scenarios").ok())
         .unwrap_or_else(|| PathBuf::from("scenarios"))
+}
+
+/// The engines that declare the catalogue law `entry`: its compiled-in
+/// models, then the outside engines of the loaded `pushval.toml` that name it.
+fn declaring(entry: &pushval_laws::LawEntry) -> Vec<String> {
+    let mut out: Vec<String> = entry.engines.iter().map(|e| e.to_string()).collect();
+    if let Some(Outside {
+        config: Some(c), ..
+    }) = OUTSIDE.read().expect("not poisoned").as_ref()
+    {
+        out.extend(
+            c.engines
+                .iter()
+                .filter(|s| s.law.as_deref() == Some(entry.name))
+                .map(|s| s.name.clone()),
+        );
+    }
+    out
+}
+
+/// A parameter's default as `pushval laws` shows it (`0.01 m/s`, `"welded"`).
+fn param_text(p: &pushval_laws::ParamSpec) -> String {
+    let default = match (&p.default, p.kind) {
+        (serde_json::Value::String(s), pushval_laws::ParamKind::Choice(all)) => {
+            format!("{s} (of {})", all.join("|"))
+        }
+        (v, _) => v.to_string(),
+    };
+    if p.unit.is_empty() {
+        format!("{}={default}", p.name)
+    } else {
+        format!("{}={default} {}", p.name, p.unit)
+    }
+}
+
+/// The `pushval laws` table: one row per catalogue law (name, the engines
+/// that declare it, its parameters with defaults, where its loads come
+/// from), each followed by its one-sentence description.
+pub fn laws_table() -> String {
+    let catalog = pushval_laws::catalog();
+    let rows: Vec<[String; 4]> = catalog
+        .iter()
+        .map(|e| {
+            let engines = declaring(e);
+            let params: Vec<String> = e.params.iter().map(param_text).collect();
+            [
+                e.name.to_string(),
+                if engines.is_empty() {
+                    "-".into()
+                } else {
+                    engines.join(",")
+                },
+                if params.is_empty() {
+                    "-".into()
+                } else {
+                    params.join(", ")
+                },
+                e.loads.as_str().to_string(),
+            ]
+        })
+        .collect();
+    let header = ["law", "engines", "parameters (defaults)", "loads"];
+    let mut width = header.map(|h| h.chars().count());
+    for r in &rows {
+        for (w, c) in width.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |cells: &[String]| {
+        let mut s = String::new();
+        for (c, w) in cells.iter().zip(width) {
+            s.push_str(c);
+            s.push_str(&" ".repeat(w - c.chars().count() + 2));
+        }
+        s.trim_end().to_string() + "\n"
+    };
+    let mut out = line(&header.map(String::from));
+    for (r, e) in rows.iter().zip(&catalog) {
+        out.push_str(&line(r));
+        out.push_str(&format!("    {}\n", e.about));
+    }
+    out.push_str(
+        "\nloads: problem = the problem's support loads (its statics); law = the law's own prediction from the problem's geometry and mass.\nAn engine in pushval.toml declares one with law = \"NAME\" and, optionally, law_params = { key = value }.\n",
+    );
+    out
+}
+
+/// `pushval laws --json`: an array with one object per catalogue law:
+/// `name`, `engines`, `params` (`name`, `default`, `unit`, `meaning`),
+/// `loads` and `about`.
+pub fn laws_json() -> serde_json::Value {
+    pushval_laws::catalog()
+        .iter()
+        .map(|e| {
+            serde_json::json!({
+                "name": e.name,
+                "engines": declaring(e),
+                "params": e.params.iter().map(|p| serde_json::json!({
+                    "name": p.name,
+                    "default": p.default,
+                    "unit": p.unit,
+                    "meaning": p.meaning,
+                })).collect::<Vec<_>>(),
+                "loads": e.loads.as_str(),
+                "about": e.about,
+            })
+        })
+        .collect()
 }

@@ -12,6 +12,7 @@ mod engines;
 mod fit;
 mod gate;
 mod kappa;
+mod laws;
 mod outside;
 mod power;
 mod properties;

@@ -4,11 +4,12 @@
 //! are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
-    ModelEntry, OptionError, OptionKeys, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
+use crate::predict::Avian3dTilt;
 use crate::{Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator, AVAILABLE};
 
 /// The 2-D engine crate and the version this adapter is built against (the
@@ -86,6 +87,8 @@ pub struct Avian3dModel {
     info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Avian3dSettings,
+    /// The law it follows, built from `settings` by [`Avian3dModel::new`].
+    law: Avian3dTilt,
 }
 
 impl Avian3dModel {
@@ -102,7 +105,13 @@ impl Avian3dModel {
         )
         .with_options(OptionKeys::Listed(&["substeps", "cm_height"]))
         .with_availability(availability());
-        Self { info, settings }
+        Self {
+            info,
+            settings,
+            law: Avian3dTilt {
+                plate: (&settings).into(),
+            },
+        }
     }
 }
 
@@ -205,7 +214,7 @@ impl Engine for Avian3dModel {
         })
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
-        Some(self)
+        Some(&self.law)
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         let r = Avian3dSimulator::new(Avian3dSettings {
@@ -227,33 +236,6 @@ impl Engine for Avian3dModel {
             }),
             trajectory: r.trajectory,
         })
-    }
-}
-
-/// avian3d's contact friction in closed form (`crate::predict`): Coulomb
-/// at every foot with the loads of its soft contacts, coupled to the forces
-/// when the centre of mass is above the floor.
-impl FrictionLaw for Avian3dModel {
-    fn law_name(&self) -> &'static str {
-        "Coulomb along −u at every foot with the soft contacts' loads, load transfer above the floor (pushval_avian::predict)"
-    }
-    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
-        let push = problem.pushes.get(segment)?;
-        let scene = crate::predict::PlateScene::new(problem, &self.settings).ok()?;
-        let (omega, _) = scene.steady(push, 0.0)?;
-        Some(LawSteady {
-            omega,
-            class: LawClass::Turns,
-        })
-    }
-    /// The feet's loads (N) at the steady state: the rest loads of the soft
-    /// contacts (`m g` shared as springs ∝ effective mass: statics for three
-    /// feet) moved by the couple `−h_cm Σ f_i` of the friction
-    /// ([`crate::predict::PlateScene::steady`]).
-    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
-        let push = problem.pushes.get(segment)?;
-        let scene = crate::predict::PlateScene::new(problem, &self.settings).ok()?;
-        scene.steady(push, 0.0).map(|(_, loads)| loads)
     }
 }
 

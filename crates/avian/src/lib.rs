@@ -36,7 +36,8 @@ use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 pub mod clock;
 mod engine;
-pub mod predict;
+/// The `avian3d` plate's law in closed form (it lives in `pushval-laws`).
+pub use pushval_laws::avian as predict;
 #[cfg(feature = "avian")]
 mod world2d;
 #[cfg(feature = "avian")]
@@ -258,6 +259,17 @@ impl Default for Avian3dSettings {
             plate_thickness: 0.005,
             gravity: 9.81,
             settle_time: 0.3,
+        }
+    }
+}
+
+/// The settings' plain parameters of the closed forms' plate.
+impl From<&Avian3dSettings> for predict::PlateParams {
+    fn from(s: &Avian3dSettings) -> Self {
+        Self {
+            plate_thickness: s.plate_thickness,
+            gravity: s.gravity,
+            cm_height: s.cm_height,
         }
     }
 }

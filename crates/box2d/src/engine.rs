@@ -3,11 +3,12 @@
 //! friction idiom, informational).
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
-    ModelEntry, OptionError, OptionKeys, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
+use crate::predict::Box2dMotorJoint;
 use crate::{Box2dSettings, Box2dSimulator, Friction};
 
 /// The engine crate and version this adapter is built against (the `boxdd`
@@ -129,7 +130,7 @@ impl Engine for Box2dModel {
     fn law(&self) -> Option<&dyn FrictionLaw> {
         match self.settings.friction {
             Friction::Coulomb => Some(&COULOMB),
-            Friction::MotorJoint => Some(self),
+            Friction::MotorJoint => Some(&Box2dMotorJoint),
         }
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
@@ -147,26 +148,6 @@ impl Engine for Box2dModel {
                 "steps": r.steps,
             }),
             trajectory: r.trajectory,
-        })
-    }
-}
-
-/// The motor joint's closed form (`crate::predict`): force capped at
-/// `Σ F_i`, torque at `Σ F_i |p_i|`, each on its own.
-impl FrictionLaw for Box2dModel {
-    fn law_name(&self) -> &'static str {
-        "motor joint to the ground: force and torque capped apart (pushval_box2d::predict)"
-    }
-    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
-        let push = problem.pushes.get(segment)?;
-        let s = crate::predict::motor_joint_steady(&problem.body, push, 0.0)?;
-        Some(LawSteady {
-            omega: s.omega,
-            class: if s.locked {
-                LawClass::Locked
-            } else {
-                LawClass::Turns
-            },
         })
     }
 }

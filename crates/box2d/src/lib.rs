@@ -37,7 +37,8 @@ use std::time::Duration;
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 pub mod engine;
-pub mod predict;
+/// The motor joint's closed form (it lives in `pushval-laws`).
+pub use pushval_laws::box2d as predict;
 mod world;
 
 pub use engine::{models, Box2dModel, ENGINE_CRATE};

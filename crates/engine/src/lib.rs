@@ -20,12 +20,13 @@ use std::time::Duration;
 
 use pushval_model::{ModelError, Problem, Trajectory};
 
-mod law;
 mod options;
 mod resample;
 
-pub use law::{coulomb_steady, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB};
 pub use options::{EngineOptions, OptionError, SceneFrame};
+/// The friction laws in closed form live in `pushval-laws`; re-exported so
+/// that `pushval_engine::FrictionLaw` and its companions keep their paths.
+pub use pushval_laws::{coulomb_steady, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB};
 pub use resample::{
     resample, sample, segment_reports, step_tail_omega, tail_mean_omega, trajectory_from_steps,
     StepRecord,

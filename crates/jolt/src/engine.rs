@@ -4,11 +4,11 @@
 //! listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
-    ModelEntry, OptionError,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry, OptionError,
 };
 use pushval_model::{ModelError, Problem};
 
+use crate::predict::{JoltBox, JoltFeet};
 use crate::{JoltSettings, JoltSimulator, Scene, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the
@@ -92,7 +92,10 @@ impl Engine for JoltModel {
         &self.info
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
-        Some(self)
+        match self.settings.scene {
+            Scene::Box => Some(&JoltBox),
+            Scene::Feet => Some(&JoltFeet),
+        }
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = JoltSettings {
@@ -137,43 +140,5 @@ impl Engine for JoltModel {
             diagnostics,
             trajectory: r.trajectory,
         })
-    }
-}
-
-impl FrictionLaw for JoltModel {
-    fn law_name(&self) -> &'static str {
-        match self.settings.scene {
-            Scene::Box => {
-                "one manifold: a friction disc of radius μΣN at the corners' unweighted mean, rows along the world axes (effective-mass direction), and a twist row clamped to μΣ dᵢNᵢ (pushval_jolt::predict)"
-            }
-            Scene::Feet => {
-                "a friction disc of radius μN per foot, rows along the world axes (effective-mass direction, yaw-dependent), no twist row (pushval_jolt::predict)"
-            }
-        }
-    }
-    /// From ω = 0 at yaw 0, with the problem's loads (`F_i = μ_i N_i`; the
-    /// engine's own split of four feet's loads is undetermined and may
-    /// differ: crates/jolt/README.md). `jolt_box`'s law does not depend on
-    /// the yaw: its root or lock; `jolt_feet`'s does: the mean ω over the
-    /// last fifth of the segment of the law's reduced dynamics, at the
-    /// engine's step.
-    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
-        use crate::predict::{at_rest, steady_omega, tail_omega, AtRest, Direction, Law};
-        let push = problem.pushes.get(segment)?;
-        let body = &problem.body;
-        let law = match self.settings.scene {
-            Scene::Box => Law::jolt_box(body, None, Direction::EffectiveMass),
-            Scene::Feet => Law::jolt_feet(body, None, Direction::EffectiveMass),
-        };
-        let class = match at_rest(&law, body, push, 0.0) {
-            AtRest::Locked => LawClass::Locked,
-            AtRest::Turns => LawClass::Turns,
-        };
-        let omega = if law.depends_on_yaw() {
-            tail_omega(&law, body, push, push.duration, (0.0, 0.0), dt.min(1e-3))
-        } else {
-            steady_omega(&law, body, push)
-        };
-        Some(LawSteady { omega, class })
     }
 }

@@ -43,7 +43,8 @@ use std::time::{Duration, Instant};
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 mod engine;
-pub mod predict;
+/// Jolt's friction law in closed form (it lives in `pushval-laws`).
+pub use pushval_laws::jolt as predict;
 #[cfg(feature = "jolt")]
 #[allow(unsafe_code)]
 mod sys;

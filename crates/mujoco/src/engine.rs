@@ -4,11 +4,12 @@
 //! available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
-    ModelEntry, OptionError, OptionKeys, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
+use crate::theory::MujocoElliptic;
 use crate::{Cone, MujocoSettings, MujocoSimulator, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the
@@ -25,11 +26,13 @@ pub struct MujocoModel {
     info: EngineInfo,
     /// The settings of a run (its `timestep` is replaced by the run's dt).
     pub settings: MujocoSettings,
+    /// The elliptic cone's law, built from `settings` by [`MujocoModel::new`].
+    law: MujocoElliptic,
 }
 
 impl MujocoModel {
-    /// The model of `settings`' friction cone.
-    pub fn new(settings: MujocoSettings) -> Self {
+    /// What the model of `settings` is.
+    fn info_of(settings: &MujocoSettings) -> EngineInfo {
         let (name, description) = match settings.cone {
             Cone::Pyramidal => (
                 "mujoco_pyramidal",
@@ -59,7 +62,7 @@ impl MujocoModel {
                     .into(),
             )
         });
-        Self { info, settings }
+        info
     }
 }
 
@@ -119,7 +122,7 @@ impl Engine for MujocoModel {
     /// has no closed form of ω here.
     fn law(&self) -> Option<&dyn FrictionLaw> {
         match self.settings.cone {
-            Cone::Elliptic => Some(self),
+            Cone::Elliptic => Some(&self.law),
             Cone::Pyramidal => None,
         }
     }
@@ -146,54 +149,22 @@ impl Engine for MujocoModel {
 }
 
 impl MujocoModel {
+    /// The model with `settings` and the elliptic cone's law at its heights.
+    pub fn new(settings: MujocoSettings) -> Self {
+        Self {
+            info: Self::info_of(&settings),
+            settings,
+            law: MujocoElliptic {
+                cm_height: settings.cm_height,
+                push_height: settings.push_height,
+                gravity: settings.gravity,
+            },
+        }
+    }
+
     /// Whether the centre of mass or the pusher is above the floor (the
     /// push then moves load between the feet).
     pub fn raised(&self) -> bool {
-        self.settings.cm_height != 0.0 || self.settings.push_height != 0.0
-    }
-}
-
-/// The elliptic cone with a raised centre of mass or pusher: Coulomb at
-/// every foot with the feet calibrated at rest (`μ_i = F_i / N_i`) and the
-/// loads of the quasi-static tilting balance, spread by the least-norm rule
-/// ([`crate::theory::calibrated_load_transfer`]). At both heights 0 the
-/// loads are the rest loads and the steady state is [`COULOMB`]'s.
-impl FrictionLaw for MujocoModel {
-    fn law_name(&self) -> &'static str {
-        "Coulomb at every foot (elliptic cone) with the loads of the tilting balance (pushval_mujoco::theory::calibrated_load_transfer)"
-    }
-    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
-        if !self.raised() {
-            return COULOMB.steady(problem, segment, dt);
-        }
-        let (omega, _) = self.transfer(problem, segment)?;
-        Some(LawSteady {
-            omega,
-            class: if omega == 0.0 {
-                LawClass::Locked
-            } else {
-                LawClass::Turns
-            },
-        })
-    }
-    /// The feet's loads (N) in the steady state, least-norm split of the
-    /// weight `m g` at rest plus the transfer; a negative load means the
-    /// foot would lift (the scene's assumptions fail there).
-    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
-        self.transfer(problem, segment).map(|(_, loads)| loads)
-    }
-}
-
-impl MujocoModel {
-    fn transfer(&self, problem: &Problem, segment: usize) -> Option<(f64, Vec<f64>)> {
-        let push = problem.pushes.get(segment)?;
-        let s = &self.settings;
-        crate::theory::calibrated_load_transfer(
-            &problem.body,
-            push,
-            problem.body.mass() * s.gravity,
-            s.cm_height,
-            s.push_height,
-        )
+        self.law.raised()
     }
 }

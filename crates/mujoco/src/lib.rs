@@ -46,7 +46,8 @@ mod engine;
 pub mod scene;
 #[cfg(feature = "mujoco")]
 mod sim;
-pub mod theory;
+/// The closed forms of MuJoCo's friction (they live in `pushval-laws`).
+pub use pushval_laws::mujoco as theory;
 
 pub use engine::{models, MujocoModel, ENGINE_CRATE};
 

@@ -17,6 +17,7 @@ const KEYS: &[&str] = &[
     "timeout_s",
     "version",
     "law",
+    "law_params",
     "protocol",
     "session",
 ];
@@ -56,6 +57,10 @@ pub struct Spec {
     /// document per line in, each answer ended by `#end` or `#error
     /// MESSAGE`; default false (one process per run).
     pub session: bool,
+    /// The law's parameters (`law_params = { key = value }`: numbers and
+    /// strings), checked against the law when the registry loads the file;
+    /// empty when the file gives none.
+    pub law_params: serde_json::Map<String, serde_json::Value>,
 }
 
 impl Spec {
@@ -281,6 +286,48 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
         Some(toml::Value::String(s)) => Some(s.clone()),
         Some(v) => return Err(err("law", format!("must be a string, got {v}"))),
     };
+    let law_params = match t.get("law_params") {
+        None => serde_json::Map::new(),
+        Some(toml::Value::Table(p)) => {
+            if law.is_none() {
+                return Err(err(
+                    "law_params",
+                    "parameters of no law: set `law` as well".into(),
+                ));
+            }
+            p.iter()
+                .map(|(k, v)| {
+                    let json = match v {
+                        toml::Value::Float(x) => serde_json::Number::from_f64(*x)
+                            .map(serde_json::Value::Number)
+                            .ok_or_else(|| {
+                                err(
+                                    &format!("law_params.{k}"),
+                                    format!("must be finite, got {x}"),
+                                )
+                            })?,
+                        toml::Value::Integer(i) => serde_json::Value::from(*i),
+                        toml::Value::String(s) => serde_json::Value::from(s.as_str()),
+                        other => {
+                            return Err(err(
+                                &format!("law_params.{k}"),
+                                format!("must be a number or a string, got {other}"),
+                            ))
+                        }
+                    };
+                    Ok((k.clone(), json))
+                })
+                .collect::<Result<_, _>>()?
+        }
+        Some(v) => {
+            return Err(err(
+                "law_params",
+                format!(
+                "must be a table of the law's parameters, e.g. {{ slip_speed = 0.01 }}, got {v}"
+            ),
+            ))
+        }
+    };
     let session = match t.get("session") {
         None => false,
         Some(toml::Value::Boolean(b)) => *b,
@@ -305,6 +352,7 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
     }
     Ok(Spec {
         law,
+        law_params,
         protocol,
         session,
         name: name.to_string(),

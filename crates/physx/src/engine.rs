@@ -4,16 +4,12 @@
 //! `physx` feature they are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
-    ModelEntry, OptionError, OptionKeys,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
-use pushval_model::{Body, Support};
-
-use crate::predict::{
-    at_rest, lock_moments, pgs_rest_loads, rest_moments, steady_from_rest, AtRest,
-};
+use crate::predict::PhysxClamp;
 use crate::{FootContacts, FrictionType, PhysxSettings, PhysxSimulator, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the `physx`
@@ -33,11 +29,13 @@ pub struct PhysxModel {
     info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: PhysxSettings,
+    /// The law it follows, built from `settings` by [`PhysxModel::new`].
+    law: PhysxClamp,
 }
 
 impl PhysxModel {
-    /// The model of `settings`' friction type.
-    pub fn new(settings: PhysxSettings) -> Self {
+    /// What the model of `settings` is.
+    fn info_of(settings: &PhysxSettings) -> EngineInfo {
         let description = match settings.friction {
             FrictionType::Patch => {
                 "plate on sphere feet on a ground plane, PhysX 5 PGS, patch friction (ePATCH)"
@@ -72,7 +70,7 @@ impl PhysxModel {
         } else {
             Err("build with --features physx (needs clang++: apt-get install clang)".into())
         });
-        Self { info, settings }
+        info
     }
 }
 
@@ -123,7 +121,7 @@ impl Engine for PhysxModel {
         &self.info
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
-        Some(self)
+        Some(&self.law)
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = PhysxSettings {
@@ -165,96 +163,25 @@ impl Engine for PhysxModel {
     }
 }
 
-/// PhysX's friction rows in closed form (`crate::predict`), capped by the
-/// friction PhysX gives the feet at rest (`μ̄ N_i`, N_i the PGS split of
-/// [`pgs_rest_loads`]): the law of the friction type on welded or separate
-/// feet, the class of ω = 0 from the
-/// lock (`|M₀| ≤ H`) and hold (`|M₀| ≤ S`) criteria, and the steady ω a run
-/// from rest reaches. PhysX's contact order is taken as the supports' order
-/// (on the paper plate it gives feet 0 and 2 the `t0` rows, as PhysX does).
-impl FrictionLaw for PhysxModel {
-    fn law_name(&self) -> &'static str {
-        match (self.settings.contacts, self.settings.friction) {
-            (FootContacts::Welded, FrictionType::Patch) => {
-                "one welded patch: t0/t1 rows at two anchors, each capped at half of μΣN (pushval_physx::predict)"
-            }
-            (FootContacts::Welded, FrictionType::OneDirectional) => {
-                "one welded patch: one row per foot, t0 and t1 alternating, cap μN (pushval_physx::predict)"
-            }
-            (FootContacts::Separate, FrictionType::OneDirectional) => {
-                "a t0 row per foot along the centre of mass's velocity, cap μN (pushval_physx::predict)"
-            }
-            _ => "a t0 and a t1 row per foot, each capped at μN: a box (pushval_physx::predict)",
+impl PhysxModel {
+    /// The model with `settings` and the law of its friction type and feet
+    /// ([`PhysxClamp`]).
+    pub fn new(settings: PhysxSettings) -> Self {
+        Self {
+            info: Self::info_of(&settings),
+            settings,
+            law: PhysxClamp {
+                friction: settings.friction,
+                contacts: settings.contacts,
+                plate_thickness: settings.plate_thickness,
+                gravity: settings.gravity,
+            },
         }
     }
-    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
-        let push = problem.pushes.get(segment)?;
-        let body = &self.engine_body(problem)?;
-        let points: Vec<[f64; 2]> = body
-            .supports()
-            .map(|s| [s.position.x, s.position.y])
-            .collect();
-        let order: Vec<usize> = (0..points.len()).collect();
-        let law = self
-            .settings
-            .friction
-            .law(self.settings.contacts, &order, &points);
-        let class = match at_rest(body, push, law) {
-            AtRest::Locked => LawClass::Locked,
-            AtRest::Turns => LawClass::Turns,
-            AtRest::SemiStable => {
-                let (moment, lock) = lock_moments(body, push, law);
-                LawClass::SemiStable {
-                    moment,
-                    lock,
-                    hold: rest_moments(body, push, law).1,
-                }
-            }
-        };
-        Some(LawSteady {
-            omega: steady_from_rest(body, push, law).omega,
-            class,
-        })
-    }
-    /// PhysX's loads at rest ([`pgs_rest_loads`]: the PGS split of `m g`
-    /// over the feet, in the supports' order). The centre of mass and the
-    /// pusher are on the floor's plane, so the push moves no load.
-    fn loads(&self, problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
-        Some(self.rest_loads(problem))
-    }
-}
 
-impl PhysxModel {
     /// The closed form of PhysX's rest loads for `problem` (N, support
-    /// order; [`pgs_rest_loads`] with the scene's mass, tilt inertia and
-    /// gravity, contacts visited in the supports' order).
+    /// order; [`PhysxClamp::rest_loads`]).
     pub fn rest_loads(&self, problem: &Problem) -> Vec<f64> {
-        let body = &problem.body;
-        let s = &self.settings;
-        let points: Vec<[f64; 2]> = body
-            .supports()
-            .map(|p| [p.position.x, p.position.y])
-            .collect();
-        let order: Vec<usize> = (0..points.len()).collect();
-        let t = s.plate_thickness;
-        let tilt = 0.5 * body.inertia_cm() + body.mass() * t * t / 12.0;
-        pgs_rest_loads(&points, body.mass(), tilt, body.mass() * s.gravity, &order)
-    }
-
-    /// The body the law's rows see: every foot's cap `μ̄ N_i` with PhysX's
-    /// one coefficient `μ̄ = Σ F_i / (m g)` and its rest loads
-    /// ([`Self::rest_loads`]), as the engine has them.
-    fn engine_body(&self, problem: &Problem) -> Option<Body> {
-        let body = &problem.body;
-        let mu = body.total_friction() / (body.mass() * self.settings.gravity);
-        let supports: Vec<Support> = body
-            .supports()
-            .zip(self.rest_loads(problem))
-            .map(|(s, n)| Support {
-                position: s.position,
-                friction: mu * n,
-            })
-            .collect();
-        Body::new(body.mass(), body.inertia_cm(), body.contact(), &supports).ok()
+        self.law.rest_loads(problem)
     }
 }

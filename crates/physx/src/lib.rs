@@ -67,7 +67,9 @@ use std::time::{Duration, Instant};
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 mod engine;
-pub mod predict;
+/// PhysX's friction laws in closed form (they live in `pushval-laws`).
+pub use pushval_laws::physx as predict;
+pub use pushval_laws::physx::{FootContacts, FrictionType};
 #[cfg(feature = "physx")]
 #[allow(unsafe_code)]
 mod sys;
@@ -82,129 +84,6 @@ pub const AVAILABLE: bool = cfg!(feature = "physx");
 /// The message of the error a build without the `physx` feature returns.
 pub const UNAVAILABLE: &str =
     "pushval was built without the `physx` feature (needs clang++: apt-get install clang)";
-
-/// PhysX's friction types (`PxFrictionType`, set per scene). PhysX 5.1.3
-/// (physx-sys 0.11.5) has exactly these three; `eONE_DIRECTIONAL` and
-/// `eTWO_DIRECTIONAL` were deprecated in later 5.x releases (5.4) and only
-/// patch friction remains there.
-///
-/// Every friction patch takes the same two axes: `t0`, the direction of the
-/// body's **centre-of-mass** velocity in the ground plane (the relative
-/// linear velocity of the two bodies, not the contact point's), and
-/// `t1 = n × t0`. Each row is a separate 1-D constraint clamped to `±cap`:
-/// a box, not a disk. What a patch is depends on [`FootContacts`]; the laws
-/// are in [`predict`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum FrictionType {
-    /// `ePATCH` (PhysX's default): per contact patch, up to two friction
-    /// anchors (contact points; the second the farthest from the first), each
-    /// with a `t0` and a `t1` row capped by the patch's `μ_d Σλ_n` once
-    /// `μ_s Σλ_n` is passed, halved when there are two anchors (the material
-    /// flag `eIMPROVED_PATCH_FRICTION`, on by default). Solved with the
-    /// normals in the last three position iterations and in the velocity
-    /// iterations.
-    #[default]
-    Patch,
-    /// `eTWO_DIRECTIONAL`: per contact point a `t0` and a `t1` row, each
-    /// capped by the point's `μ_s λ_n`; solved after all normal iterations.
-    TwoDirectional,
-    /// `eONE_DIRECTIONAL`: per contact point **one** row, alternating `t0`,
-    /// `t1`, `t0`, … from point to point within a patch, capped by the point's
-    /// `μ_s λ_n`; a one-point patch always gets `t0`.
-    OneDirectional,
-}
-
-impl FrictionType {
-    /// `"patch"`, `"two_directional"` or `"one_directional"`.
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            FrictionType::Patch => "patch",
-            FrictionType::TwoDirectional => "two_directional",
-            FrictionType::OneDirectional => "one_directional",
-        }
-    }
-
-    /// PhysX's name: `"ePATCH"`, `"eTWO_DIRECTIONAL"`, `"eONE_DIRECTIONAL"`.
-    pub fn physx_name(&self) -> &'static str {
-        match self {
-            FrictionType::Patch => "ePATCH",
-            FrictionType::TwoDirectional => "eTWO_DIRECTIONAL",
-            FrictionType::OneDirectional => "eONE_DIRECTIONAL",
-        }
-    }
-
-    /// The engine model's name: `physx_patch`, `physx_two_directional`,
-    /// `physx_one_directional`.
-    pub fn model_name(&self) -> &'static str {
-        match self {
-            FrictionType::Patch => "physx_patch",
-            FrictionType::TwoDirectional => "physx_two_directional",
-            FrictionType::OneDirectional => "physx_one_directional",
-        }
-    }
-
-    /// The friction law of this type on feet at `points` (m, object frame)
-    /// whose contacts PhysX orders as `order` (support indices; the order
-    /// matters only for welded feet, see [`predict`]; on the paper plate
-    /// PhysX's order gives feet 0 and 2 the `t0` rows).
-    pub fn law(
-        &self,
-        contacts: FootContacts,
-        order: &[usize],
-        points: &[[f64; 2]],
-    ) -> predict::Law {
-        use predict::Law;
-        match (contacts, self) {
-            (_, FrictionType::TwoDirectional) | (FootContacts::Separate, FrictionType::Patch) => {
-                Law::Box
-            }
-            (FootContacts::Separate, FrictionType::OneDirectional) => Law::Line,
-            (FootContacts::Welded, FrictionType::OneDirectional) => {
-                Law::Alternating(predict::alternating_mask(order))
-            }
-            (FootContacts::Welded, FrictionType::Patch) => {
-                let (a, b) = predict::patch_anchors(points, order);
-                Law::Anchors(a, b)
-            }
-        }
-    }
-
-    /// All three, patch first.
-    pub const ALL: [FrictionType; 3] = [
-        FrictionType::Patch,
-        FrictionType::TwoDirectional,
-        FrictionType::OneDirectional,
-    ];
-}
-
-/// How the feet's contacts with the ground reach PhysX's solver.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum FootContacts {
-    /// PhysX's default: every foot is its own shape and its own contact pair,
-    /// but the solver **welds** all contact pairs between the same two bodies
-    /// into one constraint (`DyDynamics.cpp`, "constraint welding", always
-    /// on) and groups its points into patches by normal and friction
-    /// coefficient: the feet on the floor become **one patch** of n points.
-    #[default]
-    Welded,
-    /// Every foot's pair is marked `eMODIFY_CONTACTS` (no callback modifies
-    /// anything), which PhysX never welds: **one patch per foot**, of one
-    /// point.
-    Separate,
-}
-
-impl FootContacts {
-    /// `"welded"` or `"separate"`.
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            FootContacts::Welded => "welded",
-            FootContacts::Separate => "separate",
-        }
-    }
-
-    /// Both, welded first.
-    pub const ALL: [FootContacts; 2] = [FootContacts::Welded, FootContacts::Separate];
-}
 
 /// How PhysX runs a problem.
 #[derive(Debug, Clone, Copy, PartialEq)]

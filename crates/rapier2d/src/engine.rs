@@ -2,8 +2,11 @@
 //! Coulomb forces, gated by default) and the four 2-D friction idioms.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
-    ModelEntry, OptionError, OptionKeys, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys, COULOMB,
+};
+use pushval_laws::idioms::{
+    ImpulseBox, ImpulseDisk, RegularisedLinear, RegularisedTanh, RowsDisk, DEFAULT_SLIP_SPEED,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -19,7 +22,7 @@ pub const ENGINE_CRATE: EngineCrate = EngineCrate {
 
 /// Slip speed (m/s) below which the regularised idioms go linear / tanh
 /// (see results/friction_models/).
-const IDIOM_SLIP_SPEED: f64 = 0.01;
+const IDIOM_SLIP_SPEED: f64 = DEFAULT_SLIP_SPEED;
 
 /// One rapier2d model: a friction law and the scenario's engine settings.
 #[derive(Debug, Clone, PartialEq)]
@@ -222,7 +225,8 @@ impl Engine for Rapier2dModel {
     fn law(&self) -> Option<&dyn FrictionLaw> {
         match self.settings.friction_model {
             FrictionModel::Coulomb => Some(&COULOMB),
-            _ => Some(self),
+            // The idiom with its parameters is the law (`crate::idioms`).
+            _ => Some(&self.settings.friction_model),
         }
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
@@ -246,89 +250,18 @@ impl Engine for Rapier2dModel {
     }
 }
 
-/// The idioms' laws by name, for engines outside pushval that declare one
-/// (`law = "NAME"` in `pushval.toml`): each evaluates the closed form of
-/// [`crate::idioms`] with the idiom's default slip speed.
+/// The idioms' laws by name, with the idioms' default slip speed: the
+/// entries of `pushval_laws::catalog()` these models' laws come from.
 pub fn laws() -> Vec<(&'static str, Box<dyn FrictionLaw>)> {
-    [
-        ("impulse_disk", FrictionModel::ImpulseDisk),
-        ("impulse_box", FrictionModel::ImpulseBox),
-        ("impulse_rows_disk", FrictionModel::ImpulseRowsDisk),
+    let slip_speed = IDIOM_SLIP_SPEED;
+    vec![
+        ("impulse_disk", Box::new(ImpulseDisk)),
+        ("impulse_box", Box::new(ImpulseBox)),
+        ("impulse_rows_disk", Box::new(RowsDisk)),
         (
             "regularised_linear",
-            FrictionModel::RegularisedLinear {
-                slip_speed: IDIOM_SLIP_SPEED,
-            },
+            Box::new(RegularisedLinear { slip_speed }),
         ),
-        (
-            "regularised_tanh",
-            FrictionModel::RegularisedTanh {
-                slip_speed: IDIOM_SLIP_SPEED,
-            },
-        ),
+        ("regularised_tanh", Box::new(RegularisedTanh { slip_speed })),
     ]
-    .into_iter()
-    .map(|(name, friction_model)| {
-        let law: Box<dyn FrictionLaw> = Box::new(Rapier2dModel::new(
-            name,
-            "a friction law of crate::idioms",
-            EngineSettings {
-                friction_model,
-                ..EngineSettings::default()
-            },
-        ));
-        (name, law)
-    })
-    .collect()
-}
-
-/// Angles per turn of the box idiom's period mean.
-const BOX_ANGLES: usize = 360;
-
-/// The idioms' closed forms (`crate::idioms`): the moment balance with the
-/// idiom's support law substituted; for the box, the period mean over the
-/// object's angle, and a lock where the frozen root changes sign.
-impl FrictionLaw for Rapier2dModel {
-    fn law_name(&self) -> &'static str {
-        match self.settings.friction_model {
-            FrictionModel::ImpulseBox => {
-                "stopping impulse capped per world axis; mean ω over a turn, locked where ω*(θ) changes sign (pushval_rapier2d::idioms)"
-            }
-            FrictionModel::ImpulseDisk => {
-                "stopping impulse −K⁻¹u capped in length at μNΔt (pushval_rapier2d::idioms)"
-            }
-            FrictionModel::ImpulseRowsDisk => {
-                "stopping impulse solved per world axis, the pair scaled onto the disk μNΔt; mean ω over a turn (pushval_rapier2d::idioms)"
-            }
-            FrictionModel::Coulomb => {
-                "Coulomb at every support (the analytic model, pushval_model::SegmentDynamics)"
-            }
-            _ => "Coulomb regularised below the slip speed (pushval_rapier2d::idioms)",
-        }
-    }
-    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
-        let model = self.settings.friction_model;
-        let push = problem.pushes.get(segment)?;
-        let body = &problem.body;
-        if model.is_isotropic() {
-            let omega = crate::idioms::predicted_steady_omega(model, body, push, dt, 0.0, 0.0)?;
-            return Some(LawSteady {
-                omega,
-                class: LawClass::Turns,
-            });
-        }
-        match crate::idioms::predicted_mean_omega(model, body, push, dt, BOX_ANGLES) {
-            Some(omega) => Some(LawSteady {
-                omega,
-                class: LawClass::Turns,
-            }),
-            None => crate::idioms::lock_angles(model, body, push, dt, BOX_ANGLES)
-                .iter()
-                .any(|&(_, stable)| stable)
-                .then_some(LawSteady {
-                    omega: 0.0,
-                    class: LawClass::Locked,
-                }),
-        }
-    }
 }

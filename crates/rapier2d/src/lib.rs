@@ -35,7 +35,9 @@ pub mod engine;
 mod f32_engine;
 /// The f64 build of the engine adapter (`rapier2d-f64`).
 mod f64_engine;
-pub mod idioms;
+/// The 2-D friction idioms and their closed forms (they live in
+/// `pushval-laws`).
+pub use pushval_laws::idioms;
 
 pub use engine::{laws, models, Rapier2dModel, ENGINE_CRATE};
 pub use idioms::FrictionModel;

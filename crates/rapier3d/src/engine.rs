@@ -3,12 +3,12 @@
 //! `Simplified`), the plate on ball feet on a ground plane.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, LawClass, LawSteady,
-    ModelEntry, OptionError, OptionKeys,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
-use crate::predict::{predict_steady, simplified_locks, Law};
+use crate::predict::{Law, Rapier3dTilt, SceneParams};
 use crate::{ContactFriction, FeetColliders, Rapier3dSettings, Rapier3dSimulator};
 
 /// The engine crate and version this adapter is built against (the
@@ -25,11 +25,13 @@ pub struct Rapier3dModel {
     info: EngineInfo,
     /// The settings of a run (its `dt` is replaced by the run's).
     pub settings: Rapier3dSettings,
+    /// The law it follows, built from `settings` by [`Rapier3dModel::new`].
+    law: Rapier3dTilt,
 }
 
 impl Rapier3dModel {
-    /// The model of `settings`' contact friction.
-    pub fn new(settings: Rapier3dSettings) -> Self {
+    /// What the model of `settings` is.
+    fn info_of(settings: &Rapier3dSettings) -> EngineInfo {
         let (name, description) = match settings.friction {
             ContactFriction::Coulomb => (
                 "rapier3d",
@@ -50,7 +52,7 @@ impl Rapier3dModel {
             settings.dt,
         )
         .with_options(OptionKeys::Listed(&["feet", "cm_height", "push_height"]));
-        Self { info, settings }
+        info
     }
 }
 
@@ -98,7 +100,7 @@ impl Engine for Rapier3dModel {
         &self.info
     }
     fn law(&self) -> Option<&dyn FrictionLaw> {
-        Some(self)
+        Some(&self.law)
     }
     fn settings(&self, dt: f64) -> serde_json::Value {
         let s = Rapier3dSettings {
@@ -152,46 +154,16 @@ impl Rapier3dModel {
     }
 }
 
-/// rapier3d's contact friction in closed form (`crate::predict`), with the
-/// normal loads coupled to the forces by the tilting balance.
-impl FrictionLaw for Rapier3dModel {
-    fn law_name(&self) -> &'static str {
-        match self.predict_law() {
-            Law::SimplifiedOneManifold => {
-                "Simplified on one manifold: disk at the friction centre plus a twist limit, loads from the tilting balance (pushval_rapier3d::predict)"
-            }
-            _ => {
-                "per-contact impulse along −K⁻¹u capped at μN, loads from the tilting balance (pushval_rapier3d::predict)"
-            }
-        }
-    }
-    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
-        let push = problem.pushes.get(segment)?;
-        let scene = self.settings.scene(problem).ok()?;
-        let law = self.predict_law();
-        let pred = predict_steady(&scene, push, law, true).ok()?;
-        let locked = law == Law::SimplifiedOneManifold && {
-            let body = scene.body(&pred.loads).ok()?;
-            simplified_locks(&scene.points, &pred.loads, scene.mu[0], &body, push)
+impl Rapier3dModel {
+    /// The model with `settings` and the law they give
+    /// ([`Rapier3dModel::predict_law`] on the settings' scene).
+    pub fn new(settings: Rapier3dSettings) -> Self {
+        let mut m = Self {
+            info: Self::info_of(&settings),
+            settings,
+            law: Rapier3dTilt::contact_disk(SceneParams::from(&settings)),
         };
-        Some(LawSteady {
-            omega: pred.omega,
-            class: if locked {
-                LawClass::Locked
-            } else {
-                LawClass::Turns
-            },
-        })
-    }
-    /// The feet's loads (N) at the steady state: `m g` shared as springs ∝
-    /// normal effective mass (statics for three feet), moved by the tilting
-    /// moment `h_push f_c − h_cm m a_cm`; a foot whose load would be negative
-    /// lifts off and carries 0 ([`crate::predict::predict_steady`]).
-    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
-        let push = problem.pushes.get(segment)?;
-        let scene = self.settings.scene(problem).ok()?;
-        predict_steady(&scene, push, self.predict_law(), true)
-            .ok()
-            .map(|p| p.loads)
+        m.law.law = m.predict_law();
+        m
     }
 }

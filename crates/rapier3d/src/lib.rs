@@ -63,7 +63,8 @@ use std::time::{Duration, Instant};
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 mod engine;
-pub mod predict;
+/// The 3-D scene's closed forms (they live in `pushval-laws`).
+pub use pushval_laws::rapier3d as predict;
 mod world;
 
 pub use engine::{models, Rapier3dModel, ENGINE_CRATE};
@@ -232,6 +233,19 @@ impl Rapier3dSettings {
     /// rest loads, see the crate docs).
     pub fn scene(&self, problem: &Problem) -> Result<predict::Scene, ModelError> {
         world::scene_of(problem, self)
+    }
+}
+
+/// The settings' plain parameters of the prediction scene.
+impl From<&Rapier3dSettings> for predict::SceneParams {
+    fn from(s: &Rapier3dSettings) -> Self {
+        Self {
+            cm_height: s.cm_height,
+            push_height: s.push_height,
+            plate_thickness: s.plate_thickness,
+            gravity: s.gravity,
+            compound_feet: s.feet == FeetColliders::Compound,
+        }
     }
 }
 

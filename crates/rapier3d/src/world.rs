@@ -6,7 +6,7 @@ use pushval_engine::StepRecord;
 use pushval_model::{ModelError, Problem, SolverStats, Trajectory};
 use rapier3d_f64::prelude::*;
 
-use crate::predict::{tilt_inertia, Scene};
+use crate::predict::{Scene, SceneParams};
 use crate::{ContactFriction, FeetColliders, Rapier3dRun, Rapier3dSettings, Step3d};
 
 /// Natural frequency (Hz) of the pusher joint's softness: rigid at every
@@ -20,59 +20,10 @@ const GROUND_HALF: f64 = 1.0e3;
 /// Fraction of a segment's steps, at its end, over which tail means are taken.
 const TAIL: f64 = 0.2;
 
-/// The prediction scene of `problem` (μ_i from the rest loads).
+/// The prediction scene of `problem` (μ_i from the rest loads): the law
+/// crate's [`Scene::of`] with the settings' plain parameters.
 pub(crate) fn scene_of(problem: &Problem, s: &Rapier3dSettings) -> Result<Scene, ModelError> {
-    let body = &problem.body;
-    let tilt = tilt_inertia(body.inertia_cm(), body.mass(), s.plate_thickness);
-    let mut scene = Scene {
-        points: body
-            .supports()
-            .map(|p| [p.position.x, p.position.y])
-            .collect(),
-        mu: vec![0.0; body.len()],
-        mass: body.mass(),
-        inertia_z: body.inertia_cm(),
-        ixx: tilt,
-        iyy: tilt,
-        gravity: s.gravity,
-        contact: [body.contact().x, body.contact().y],
-        cm_height: s.cm_height,
-        push_height: s.push_height,
-    };
-    let rest = scene.rest_loads();
-    for (i, sup) in body.supports().enumerate() {
-        if sup.friction == 0.0 {
-            continue;
-        }
-        if !(rest[i] > 0.0) {
-            return Err(ModelError::Parameter {
-                name: "rapier3d rest load of a support with friction (supports must surround the centre of mass)",
-                requirement: "> 0",
-                value: rest[i],
-            });
-        }
-        scene.mu[i] = sup.friction / rest[i];
-    }
-    if s.feet == FeetColliders::Compound {
-        if body.len() > 4 {
-            return Err(ModelError::Parameter {
-                name: "rapier3d compound feet: number of supports (rapier keeps at most 4 points of a contact cluster; use FeetColliders::Separate)",
-                requirement: "<= 4",
-                value: body.len() as f64,
-            });
-        }
-        let mu0 = scene.mu[0];
-        for &mu in &scene.mu {
-            if (mu - mu0).abs() > 1e-9 * mu0.abs().max(1e-300) {
-                return Err(ModelError::Parameter {
-                    name: "rapier3d compound feet: friction coefficient of a support (one collider has one coefficient; use FeetColliders::Separate)",
-                    requirement: "equal to the first support's",
-                    value: mu,
-                });
-            }
-        }
-    }
-    Ok(scene)
+    Scene::of(problem, &SceneParams::from(s))
 }
 
 fn v3(x: f64, y: f64, z: f64) -> Vector {

@@ -107,7 +107,6 @@ fn run(m: &dyn Engine, p: &Problem) -> (Vec<f64>, Vec<f64>) {
 /// each foot of the square plate.
 #[test]
 fn law_loads_on_the_floor_are_the_rest_loads() {
-    use pushval_engine::FrictionLaw;
     use pushval_rapier3d::{ContactFriction, Rapier3dModel, Rapier3dSettings};
     for friction in [ContactFriction::Coulomb, ContactFriction::Simplified] {
         let m = Rapier3dModel::new(Rapier3dSettings {
@@ -116,6 +115,7 @@ fn law_loads_on_the_floor_are_the_rest_loads() {
             push_height: 0.0,
             ..Default::default()
         });
+        let m = m.law().unwrap();
         let t = problem(triangle(), 0.5, 2.5);
         let loads = m.loads(&t, 0, 1e-3).unwrap();
         for ((n, e), s) in loads.iter().zip(statics3(G)).zip(t.body.supports()) {

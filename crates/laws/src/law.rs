@@ -4,9 +4,9 @@
 //!
 //! An engine whose friction is not Coulomb's at every support (a capped
 //! joint, per-axis rows, a twist limit, …) declares the law it follows
-//! through [`crate::Engine::law`]; `pushval study MODEL` compares the engine
-//! with it and with Coulomb. An engine that applies Coulomb's law returns
-//! [`COULOMB`], an engine with no closed form returns `None`.
+//! through `pushval_engine::Engine::law`; `pushval study MODEL` compares the
+//! engine with it and with Coulomb. An engine that applies Coulomb's law
+//! returns [`COULOMB`], an engine with no closed form returns `None`.
 
 use pushval_model::{Problem, SegmentDynamics};
 

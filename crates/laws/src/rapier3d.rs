@@ -32,7 +32,39 @@
 //! Units: SI (m, kg, N, N m, rad/s); positions in the object frame relative to
 //! the centre of mass.
 
-use pushval_model::{cross, Body, ModelError, Push, SegmentDynamics, Support, Vec2};
+use pushval_model::{cross, Body, ModelError, Problem, Push, SegmentDynamics, Support, Vec2};
+
+use crate::{FrictionLaw, LawClass, LawSteady};
+
+/// The plain parameters of the 3-D scene the predictions need (the rapier3d
+/// adapter's settings convert into them). Defaults are the adapter's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneParams {
+    /// Height of the centre of mass above the ground (m); default `0.01`.
+    pub cm_height: f64,
+    /// Height of the pusher joint above the ground (m); default `0.01`.
+    pub push_height: f64,
+    /// Plate thickness (m) for the tilt inertias; default `0.005`.
+    pub plate_thickness: f64,
+    /// Gravity (m/s²); default `9.81`.
+    pub gravity: f64,
+    /// All feet in one collider, one contact manifold (rapier's compound
+    /// feet); default `true`. It then holds at most 4 points and one
+    /// friction coefficient.
+    pub compound_feet: bool,
+}
+
+impl Default for SceneParams {
+    fn default() -> Self {
+        Self {
+            cm_height: 0.01,
+            push_height: 0.01,
+            plate_thickness: 0.005,
+            gravity: 9.81,
+            compound_feet: true,
+        }
+    }
+}
 
 /// Tilt-axis inertia (kg m²) of a thin plate of thickness `thickness` (m)
 /// whose vertical-axis inertia is `inertia_z` (kg m²): the perpendicular-axis
@@ -133,6 +165,64 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The prediction scene of `problem` under the scene parameters `s`
+    /// (μ_i from the rest loads). Errors when a support with friction
+    /// carries no load at rest, or compound feet have more than 4 points or
+    /// unequal coefficients.
+    pub fn of(problem: &Problem, s: &SceneParams) -> Result<Scene, ModelError> {
+        let body = &problem.body;
+        let tilt = tilt_inertia(body.inertia_cm(), body.mass(), s.plate_thickness);
+        let mut scene = Scene {
+            points: body
+                .supports()
+                .map(|p| [p.position.x, p.position.y])
+                .collect(),
+            mu: vec![0.0; body.len()],
+            mass: body.mass(),
+            inertia_z: body.inertia_cm(),
+            ixx: tilt,
+            iyy: tilt,
+            gravity: s.gravity,
+            contact: [body.contact().x, body.contact().y],
+            cm_height: s.cm_height,
+            push_height: s.push_height,
+        };
+        let rest = scene.rest_loads();
+        for (i, sup) in body.supports().enumerate() {
+            if sup.friction == 0.0 {
+                continue;
+            }
+            if !(rest[i] > 0.0) {
+                return Err(ModelError::Parameter {
+                    name: "rapier3d rest load of a support with friction (supports must surround the centre of mass)",
+                    requirement: "> 0",
+                    value: rest[i],
+                });
+            }
+            scene.mu[i] = sup.friction / rest[i];
+        }
+        if s.compound_feet {
+            if body.len() > 4 {
+                return Err(ModelError::Parameter {
+                    name: "rapier3d compound feet: number of supports (rapier keeps at most 4 points of a contact cluster; use FeetColliders::Separate)",
+                    requirement: "<= 4",
+                    value: body.len() as f64,
+                });
+            }
+            let mu0 = scene.mu[0];
+            for &mu in &scene.mu {
+                if (mu - mu0).abs() > 1e-9 * mu0.abs().max(1e-300) {
+                    return Err(ModelError::Parameter {
+                        name: "rapier3d compound feet: friction coefficient of a support (one collider has one coefficient; use FeetColliders::Separate)",
+                        requirement: "equal to the first support's",
+                        value: mu,
+                    });
+                }
+            }
+        }
+        Ok(scene)
+    }
+
     /// The spring stiffnesses of [`distribute`] (∝ normal effective mass).
     pub fn stiffness(&self) -> Vec<f64> {
         self.points
@@ -485,4 +575,81 @@ pub fn effective_mass_steady(scene: &Scene, loads: &[f64], push: &Push) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+/// rapier3d's contact friction in closed form, with the normal loads
+/// coupled to the forces by the tilting balance: [`Law::EffectiveMassDisk`]
+/// (rapier's per-contact solve, the `rapier3d` model) or
+/// [`Law::SimplifiedOneManifold`] (`rapier3d_simplified` on compound feet).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rapier3dTilt {
+    /// The contact law ([`Law::Coulomb`] is the analytic model's with the
+    /// tilting balance's loads).
+    pub law: Law,
+    /// The scene.
+    pub scene: SceneParams,
+}
+
+impl Rapier3dTilt {
+    /// Every contact along `−K⁻¹u`, capped at `μN`.
+    pub fn contact_disk(scene: SceneParams) -> Self {
+        Self {
+            law: Law::EffectiveMassDisk,
+            scene,
+        }
+    }
+
+    /// `Simplified` friction on one manifold: a disc at the friction centre
+    /// and a twist limit (the feet are compound).
+    pub fn simplified_twist(scene: SceneParams) -> Self {
+        Self {
+            law: Law::SimplifiedOneManifold,
+            scene: SceneParams {
+                compound_feet: true,
+                ..scene
+            },
+        }
+    }
+}
+
+impl FrictionLaw for Rapier3dTilt {
+    fn law_name(&self) -> &'static str {
+        match self.law {
+            Law::SimplifiedOneManifold => {
+                "Simplified on one manifold: disk at the friction centre plus a twist limit, loads from the tilting balance (pushval_rapier3d::predict)"
+            }
+            _ => {
+                "per-contact impulse along −K⁻¹u capped at μN, loads from the tilting balance (pushval_rapier3d::predict)"
+            }
+        }
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let scene = Scene::of(problem, &self.scene).ok()?;
+        let law = self.law;
+        let pred = predict_steady(&scene, push, law, true).ok()?;
+        let locked = law == Law::SimplifiedOneManifold && {
+            let body = scene.body(&pred.loads).ok()?;
+            simplified_locks(&scene.points, &pred.loads, scene.mu[0], &body, push)
+        };
+        Some(LawSteady {
+            omega: pred.omega,
+            class: if locked {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
+        })
+    }
+    /// The feet's loads (N) at the steady state: `m g` shared as springs ∝
+    /// normal effective mass (statics for three feet), moved by the tilting
+    /// moment `h_push f_c − h_cm m a_cm`; a foot whose load would be negative
+    /// lifts off and carries 0 ([`predict_steady`]).
+    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        let push = problem.pushes.get(segment)?;
+        let scene = Scene::of(problem, &self.scene).ok()?;
+        predict_steady(&scene, push, self.law, true)
+            .ok()
+            .map(|p| p.loads)
+    }
 }

@@ -48,7 +48,9 @@
 //! translational friction acts at the load-weighted centre `Σ λ_i p_i /
 //! Σ λ_i`, Jolt's at the plain mean `c` ([`averaging_bias`]).
 
-use pushval_model::{cross, perp, rotate, Body, Push, Vec2};
+use pushval_model::{cross, perp, rotate, Body, Problem, Push, Vec2};
+
+use crate::{FrictionLaw, LawClass, LawSteady};
 
 /// One contact manifold as Jolt's solver has it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -419,4 +421,57 @@ pub fn averaging_bias(points: &[Vec2], loads: &[f64]) -> Vec2 {
 pub fn friction_slip_angle(f: Vec2, u: Vec2) -> f64 {
     let a = -u;
     cross(&a, &f).atan2(a.dot(&f))
+}
+
+/// `jolt_box`'s law ([`Law::jolt_box`] with the problem's loads, rows along
+/// the effective-mass direction): yaw-independent, its root or its lock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct JoltBox;
+
+/// `jolt_feet`'s law ([`Law::jolt_feet`] with the problem's loads, rows
+/// along the effective-mass direction): yaw-dependent, the mean ω over the
+/// last fifth of the segment of the law's reduced dynamics ([`tail_omega`])
+/// at the run's step (at most 1 ms).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct JoltFeet;
+
+/// From ω = 0 at yaw 0, with the problem's loads (`F_i = μ_i N_i`; the
+/// engine's own split of four feet's loads is undetermined and may differ:
+/// crates/jolt/README.md).
+fn jolt_steady(feet: bool, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+    let push = problem.pushes.get(segment)?;
+    let body = &problem.body;
+    let law = if feet {
+        Law::jolt_feet(body, None, Direction::EffectiveMass)
+    } else {
+        Law::jolt_box(body, None, Direction::EffectiveMass)
+    };
+    let class = match at_rest(&law, body, push, 0.0) {
+        AtRest::Locked => LawClass::Locked,
+        AtRest::Turns => LawClass::Turns,
+    };
+    let omega = if law.depends_on_yaw() {
+        tail_omega(&law, body, push, push.duration, (0.0, 0.0), dt.min(1e-3))
+    } else {
+        steady_omega(&law, body, push)
+    };
+    Some(LawSteady { omega, class })
+}
+
+impl FrictionLaw for JoltBox {
+    fn law_name(&self) -> &'static str {
+        "one manifold: a friction disc of radius μΣN at the corners' unweighted mean, rows along the world axes (effective-mass direction), and a twist row clamped to μΣ dᵢNᵢ (pushval_jolt::predict)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+        jolt_steady(false, problem, segment, dt)
+    }
+}
+
+impl FrictionLaw for JoltFeet {
+    fn law_name(&self) -> &'static str {
+        "a friction disc of radius μN per foot, rows along the world axes (effective-mass direction, yaw-dependent), no twist row (pushval_jolt::predict)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+        jolt_steady(true, problem, segment, dt)
+    }
 }

@@ -10,8 +10,8 @@
 //!   constraint, unless a pair's contacts are modifiable; its points are then
 //!   grouped into patches by normal and friction coefficient. Feet with one
 //!   coefficient on a flat floor are one patch of n points
-//!   ([`FootContacts::Welded`](crate::FootContacts)); unwelded, each foot is
-//!   a patch of one point ([`FootContacts::Separate`](crate::FootContacts)).
+//!   ([`FootContacts::Welded`]); unwelded, each foot is
+//!   a patch of one point ([`FootContacts::Separate`]).
 //! * **Axes** (`DyContactPrep.cpp` for `ePATCH`, `DyContactPrepPF.cpp` for
 //!   the others). Every patch takes `t0` from the relative *linear* velocity
 //!   of the two bodies projected on the contact plane — for a body on static
@@ -50,7 +50,126 @@
 //! `t1` row, turns. On feet close to the centre of mass the lock fails and
 //! every law has an ordinary root.
 
-use pushval_model::{cross, perp, Body, Push, Vec2};
+use pushval_model::{cross, perp, Body, Problem, Push, Support, Vec2};
+
+use crate::{FrictionLaw, LawClass, LawSteady};
+
+/// PhysX's friction types (`PxFrictionType`, set per scene). PhysX 5.1.3
+/// (physx-sys 0.11.5) has exactly these three; `eONE_DIRECTIONAL` and
+/// `eTWO_DIRECTIONAL` were deprecated in later 5.x releases (5.4) and only
+/// patch friction remains there.
+///
+/// Every friction patch takes the same two axes: `t0`, the direction of the
+/// body's **centre-of-mass** velocity in the ground plane (the relative
+/// linear velocity of the two bodies, not the contact point's), and
+/// `t1 = n × t0`. Each row is a separate 1-D constraint clamped to `±cap`:
+/// a box, not a disk. What a patch is depends on [`FootContacts`]; the laws
+/// are in this module.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum FrictionType {
+    /// `ePATCH` (PhysX's default): per contact patch, up to two friction
+    /// anchors (contact points; the second the farthest from the first), each
+    /// with a `t0` and a `t1` row capped by the patch's `μ_d Σλ_n` once
+    /// `μ_s Σλ_n` is passed, halved when there are two anchors (the material
+    /// flag `eIMPROVED_PATCH_FRICTION`, on by default). Solved with the
+    /// normals in the last three position iterations and in the velocity
+    /// iterations.
+    #[default]
+    Patch,
+    /// `eTWO_DIRECTIONAL`: per contact point a `t0` and a `t1` row, each
+    /// capped by the point's `μ_s λ_n`; solved after all normal iterations.
+    TwoDirectional,
+    /// `eONE_DIRECTIONAL`: per contact point **one** row, alternating `t0`,
+    /// `t1`, `t0`, … from point to point within a patch, capped by the point's
+    /// `μ_s λ_n`; a one-point patch always gets `t0`.
+    OneDirectional,
+}
+
+impl FrictionType {
+    /// `"patch"`, `"two_directional"` or `"one_directional"`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            FrictionType::Patch => "patch",
+            FrictionType::TwoDirectional => "two_directional",
+            FrictionType::OneDirectional => "one_directional",
+        }
+    }
+
+    /// PhysX's name: `"ePATCH"`, `"eTWO_DIRECTIONAL"`, `"eONE_DIRECTIONAL"`.
+    pub fn physx_name(&self) -> &'static str {
+        match self {
+            FrictionType::Patch => "ePATCH",
+            FrictionType::TwoDirectional => "eTWO_DIRECTIONAL",
+            FrictionType::OneDirectional => "eONE_DIRECTIONAL",
+        }
+    }
+
+    /// The engine model's name: `physx_patch`, `physx_two_directional`,
+    /// `physx_one_directional`.
+    pub fn model_name(&self) -> &'static str {
+        match self {
+            FrictionType::Patch => "physx_patch",
+            FrictionType::TwoDirectional => "physx_two_directional",
+            FrictionType::OneDirectional => "physx_one_directional",
+        }
+    }
+
+    /// The friction law of this type on feet at `points` (m, object frame)
+    /// whose contacts PhysX orders as `order` (support indices; the order
+    /// matters only for welded feet, see the module docs; on the paper plate
+    /// PhysX's order gives feet 0 and 2 the `t0` rows).
+    pub fn law(&self, contacts: FootContacts, order: &[usize], points: &[[f64; 2]]) -> Law {
+        match (contacts, self) {
+            (_, FrictionType::TwoDirectional) | (FootContacts::Separate, FrictionType::Patch) => {
+                Law::Box
+            }
+            (FootContacts::Separate, FrictionType::OneDirectional) => Law::Line,
+            (FootContacts::Welded, FrictionType::OneDirectional) => {
+                Law::Alternating(alternating_mask(order))
+            }
+            (FootContacts::Welded, FrictionType::Patch) => {
+                let (a, b) = patch_anchors(points, order);
+                Law::Anchors(a, b)
+            }
+        }
+    }
+
+    /// All three, patch first.
+    pub const ALL: [FrictionType; 3] = [
+        FrictionType::Patch,
+        FrictionType::TwoDirectional,
+        FrictionType::OneDirectional,
+    ];
+}
+
+/// How the feet's contacts with the ground reach PhysX's solver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum FootContacts {
+    /// PhysX's default: every foot is its own shape and its own contact pair,
+    /// but the solver **welds** all contact pairs between the same two bodies
+    /// into one constraint (`DyDynamics.cpp`, "constraint welding", always
+    /// on) and groups its points into patches by normal and friction
+    /// coefficient: the feet on the floor become **one patch** of n points.
+    #[default]
+    Welded,
+    /// Every foot's pair is marked `eMODIFY_CONTACTS` (no callback modifies
+    /// anything), which PhysX never welds: **one patch per foot**, of one
+    /// point.
+    Separate,
+}
+
+impl FootContacts {
+    /// `"welded"` or `"separate"`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            FootContacts::Welded => "welded",
+            FootContacts::Separate => "separate",
+        }
+    }
+
+    /// Both, welded first.
+    pub const ALL: [FootContacts; 2] = [FootContacts::Welded, FootContacts::Separate];
+}
 
 /// A support-friction law (see the module docs). The caps come from the
 /// body's support friction magnitudes `F_i`.
@@ -465,5 +584,125 @@ pub fn steady_omega(body: &Body, push: &Push, law: Law, omega0: f64) -> Steady {
     Steady {
         omega: 0.5 * (lo + hi),
         sticks: jump > 1e-9 * scale,
+    }
+}
+
+/// PhysX's friction rows in closed form, capped by the friction PhysX gives
+/// the feet at rest (`μ̄ N_i`, N_i the PGS split of [`pgs_rest_loads`]): the
+/// law of the friction type on welded or separate feet, the class of ω = 0
+/// from the lock (`|M₀| ≤ H`) and hold (`|M₀| ≤ S`) criteria, and the steady
+/// ω a run from rest reaches. PhysX's contact order is taken as the
+/// supports' order (on the paper plate it gives feet 0 and 2 the `t0` rows,
+/// as PhysX does).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhysxClamp {
+    /// The scene's friction type.
+    pub friction: FrictionType,
+    /// How the feet's contacts reach the solver; default welded.
+    pub contacts: FootContacts,
+    /// Plate thickness (m) for the tilt inertia of the rest loads; default
+    /// `0.005`.
+    pub plate_thickness: f64,
+    /// Gravity (m/s²); default 9.81.
+    pub gravity: f64,
+}
+
+impl PhysxClamp {
+    /// The law of `friction` with the PhysX adapter's defaults (welded feet,
+    /// 5 mm plate, g = 9.81 m/s²).
+    pub fn new(friction: FrictionType) -> Self {
+        Self {
+            friction,
+            contacts: FootContacts::Welded,
+            plate_thickness: 0.005,
+            gravity: 9.81,
+        }
+    }
+
+    /// The closed form of PhysX's rest loads for `problem` (N, support
+    /// order; [`pgs_rest_loads`] with the scene's mass, tilt inertia and
+    /// gravity, contacts visited in the supports' order).
+    pub fn rest_loads(&self, problem: &Problem) -> Vec<f64> {
+        let body = &problem.body;
+        let points: Vec<[f64; 2]> = body
+            .supports()
+            .map(|p| [p.position.x, p.position.y])
+            .collect();
+        let order: Vec<usize> = (0..points.len()).collect();
+        let t = self.plate_thickness;
+        let tilt = 0.5 * body.inertia_cm() + body.mass() * t * t / 12.0;
+        pgs_rest_loads(
+            &points,
+            body.mass(),
+            tilt,
+            body.mass() * self.gravity,
+            &order,
+        )
+    }
+
+    /// The body the law's rows see: every foot's cap `μ̄ N_i` with PhysX's
+    /// one coefficient `μ̄ = Σ F_i / (m g)` and its rest loads
+    /// ([`Self::rest_loads`]), as the engine has them.
+    fn engine_body(&self, problem: &Problem) -> Option<Body> {
+        let body = &problem.body;
+        let mu = body.total_friction() / (body.mass() * self.gravity);
+        let supports: Vec<Support> = body
+            .supports()
+            .zip(self.rest_loads(problem))
+            .map(|(s, n)| Support {
+                position: s.position,
+                friction: mu * n,
+            })
+            .collect();
+        Body::new(body.mass(), body.inertia_cm(), body.contact(), &supports).ok()
+    }
+}
+
+impl FrictionLaw for PhysxClamp {
+    fn law_name(&self) -> &'static str {
+        match (self.contacts, self.friction) {
+            (FootContacts::Welded, FrictionType::Patch) => {
+                "one welded patch: t0/t1 rows at two anchors, each capped at half of μΣN (pushval_physx::predict)"
+            }
+            (FootContacts::Welded, FrictionType::OneDirectional) => {
+                "one welded patch: one row per foot, t0 and t1 alternating, cap μN (pushval_physx::predict)"
+            }
+            (FootContacts::Separate, FrictionType::OneDirectional) => {
+                "a t0 row per foot along the centre of mass's velocity, cap μN (pushval_physx::predict)"
+            }
+            _ => "a t0 and a t1 row per foot, each capped at μN: a box (pushval_physx::predict)",
+        }
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let body = &self.engine_body(problem)?;
+        let points: Vec<[f64; 2]> = body
+            .supports()
+            .map(|s| [s.position.x, s.position.y])
+            .collect();
+        let order: Vec<usize> = (0..points.len()).collect();
+        let law = self.friction.law(self.contacts, &order, &points);
+        let class = match at_rest(body, push, law) {
+            AtRest::Locked => LawClass::Locked,
+            AtRest::Turns => LawClass::Turns,
+            AtRest::SemiStable => {
+                let (moment, lock) = lock_moments(body, push, law);
+                LawClass::SemiStable {
+                    moment,
+                    lock,
+                    hold: rest_moments(body, push, law).1,
+                }
+            }
+        };
+        Some(LawSteady {
+            omega: steady_from_rest(body, push, law).omega,
+            class,
+        })
+    }
+    /// PhysX's loads at rest ([`pgs_rest_loads`]: the PGS split of `m g`
+    /// over the feet, in the supports' order). The centre of mass and the
+    /// pusher are on the floor's plane, so the push moves no load.
+    fn loads(&self, problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        Some(self.rest_loads(problem))
     }
 }

@@ -56,7 +56,31 @@
 
 use pushval_model::{Body, ModelError, Problem, Push, SegmentDynamics, Support, Vec2};
 
-use crate::Avian3dSettings;
+use crate::{FrictionLaw, LawClass, LawSteady};
+
+/// The plain parameters of the `avian3d` scene the closed forms need (the
+/// adapter's `Avian3dSettings` convert into them). Defaults are the
+/// adapter's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlateParams {
+    /// Plate thickness (m) for the tilt inertia; default `0.005`.
+    pub plate_thickness: f64,
+    /// Gravity (m/s²); default 9.81.
+    pub gravity: f64,
+    /// Height of the centre of mass (and of the pinned point) above the
+    /// floor (m, ≥ 0); default 0.
+    pub cm_height: f64,
+}
+
+impl Default for PlateParams {
+    fn default() -> Self {
+        Self {
+            plate_thickness: 0.005,
+            gravity: 9.81,
+            cm_height: 0.0,
+        }
+    }
+}
 
 /// Tilt inertia of a thin plate (kg m²): `I_cm/2 + m t²/12`, each horizontal
 /// axis (perpendicular-axis theorem for the plate's area, plus its
@@ -89,10 +113,12 @@ pub struct PlateScene {
 }
 
 impl PlateScene {
-    /// The scene the adapter builds for `problem` under `settings`, with the
-    /// μ_i it would calibrate if the rest loads are [`Self::rest_loads`].
-    /// Errors when a support with friction would carry no load at rest.
-    pub fn new(problem: &Problem, settings: &Avian3dSettings) -> Result<Self, ModelError> {
+    /// The scene the adapter builds for `problem` under `settings` (the
+    /// adapter's settings or [`PlateParams`]), with the μ_i it would
+    /// calibrate if the rest loads are [`Self::rest_loads`]. Errors when a
+    /// support with friction would carry no load at rest.
+    pub fn new(problem: &Problem, settings: impl Into<PlateParams>) -> Result<Self, ModelError> {
+        let settings: PlateParams = settings.into();
         let body = &problem.body;
         let mut scene = Self {
             mass: body.mass(),
@@ -250,6 +276,39 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
         x[r] = (b[r] - s) / a[r][r];
     }
     Some(x)
+}
+
+/// avian3d's contact friction in closed form: Coulomb along −u at every
+/// foot with the loads of its soft contacts, coupled to the forces when the
+/// centre of mass is above the floor ([`PlateScene::steady`] from ω = 0).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Avian3dTilt {
+    /// The scene's parameters.
+    pub plate: PlateParams,
+}
+
+impl FrictionLaw for Avian3dTilt {
+    fn law_name(&self) -> &'static str {
+        "Coulomb along −u at every foot with the soft contacts' loads, load transfer above the floor (pushval_avian::predict)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let scene = PlateScene::new(problem, self.plate).ok()?;
+        let (omega, _) = scene.steady(push, 0.0)?;
+        Some(LawSteady {
+            omega,
+            class: LawClass::Turns,
+        })
+    }
+    /// The feet's loads (N) at the steady state: the rest loads of the soft
+    /// contacts (`m g` shared as springs ∝ effective mass: statics for three
+    /// feet) moved by the couple `−h_cm Σ f_i` of the friction
+    /// ([`PlateScene::steady`]).
+    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        let push = problem.pushes.get(segment)?;
+        let scene = PlateScene::new(problem, self.plate).ok()?;
+        scene.steady(push, 0.0).map(|(_, loads)| loads)
+    }
 }
 
 #[cfg(test)]

@@ -1,7 +1,14 @@
 //! Closed forms that explain where MuJoCo departs from the Coulomb model
-//! (no MuJoCo needed; they use only `pushval-model`).
+//! (no MuJoCo needed; they use only `pushval-model`), and the law of its
+//! elliptic cone with load transfer ([`MujocoElliptic`]).
+//!
+//! [`FrictionLaw`] here is a *support-force* law (the force on one support
+//! for its slip); the steady-state interface all engines' laws answer is
+//! [`crate::FrictionLaw`].
 
-use pushval_model::{cross, Body, Push, SegmentDynamics, Vec2};
+use pushval_model::{cross, Body, Problem, Push, SegmentDynamics, Vec2};
+
+use crate::{LawClass, LawSteady, COULOMB};
 
 /// A support-friction law: the force (N, object frame) on support `i`
 /// sliding with velocity `u` (m/s, object frame), given its Coulomb
@@ -243,4 +250,74 @@ pub fn steady_omega_load_transfer(
         w = w_new;
     }
     Some((w, loads))
+}
+
+/// MuJoCo's elliptic cone: Coulomb at every foot with the feet calibrated at
+/// rest (`μ_i = F_i / N_i`) and the loads of the quasi-static tilting
+/// balance when the centre of mass or the pusher is above the floor, spread
+/// by the least-norm rule ([`calibrated_load_transfer`]). At both heights 0
+/// the loads are the rest loads and the steady state is [`COULOMB`]'s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MujocoElliptic {
+    /// Height of the centre of mass above the floor (m, ≥ 0); default 0.
+    pub cm_height: f64,
+    /// Height of the pusher above the floor (m, ≥ 0); default 0.
+    pub push_height: f64,
+    /// Gravity (m/s²); default 9.81.
+    pub gravity: f64,
+}
+
+impl Default for MujocoElliptic {
+    fn default() -> Self {
+        Self {
+            cm_height: 0.0,
+            push_height: 0.0,
+            gravity: 9.81,
+        }
+    }
+}
+
+impl MujocoElliptic {
+    /// Whether the centre of mass or the pusher is above the floor (the
+    /// push then moves load between the feet).
+    pub fn raised(&self) -> bool {
+        self.cm_height != 0.0 || self.push_height != 0.0
+    }
+
+    fn transfer(&self, problem: &Problem, segment: usize) -> Option<(f64, Vec<f64>)> {
+        let push = problem.pushes.get(segment)?;
+        calibrated_load_transfer(
+            &problem.body,
+            push,
+            problem.body.mass() * self.gravity,
+            self.cm_height,
+            self.push_height,
+        )
+    }
+}
+
+impl crate::FrictionLaw for MujocoElliptic {
+    fn law_name(&self) -> &'static str {
+        "Coulomb at every foot (elliptic cone) with the loads of the tilting balance (pushval_mujoco::theory::calibrated_load_transfer)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+        if !self.raised() {
+            return COULOMB.steady(problem, segment, dt);
+        }
+        let (omega, _) = self.transfer(problem, segment)?;
+        Some(LawSteady {
+            omega,
+            class: if omega == 0.0 {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
+        })
+    }
+    /// The feet's loads (N) in the steady state, least-norm split of the
+    /// weight `m g` at rest plus the transfer; a negative load means the
+    /// foot would lift (the scene's assumptions fail there).
+    fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        self.transfer(problem, segment).map(|(_, loads)| loads)
+    }
 }

@@ -36,8 +36,8 @@
 //!   Coulomb below a slip speed `v_s` replaced by `−F u/v_s`, or
 //!   `−F tanh(|u|/v_s) u/|u|` everywhere (smooth simulators).
 //!
-//! The adapter evaluates these laws explicitly, once per step, with the
-//! support velocity of [`crate::FrictionVelocity`] and `Δt` the segment's
+//! The rapier2d adapter evaluates these laws explicitly, once per step, with
+//! the support velocity of its `FrictionVelocity` mode and `Δt` the segment's
 //! nominal step; so the engine integrates (to second order in the default
 //! leapfrog mode) the analytic model with the law substituted, and
 //! [`predicted_steady_omega`] — the root of that modified moment balance —
@@ -47,7 +47,19 @@
 //! [`predicted_mean_omega`] gives the quasi-steady period mean
 //! `1/⟨1/ω*(θ)⟩_θ` of a body that keeps turning.
 
-use pushval_model::{cross, rotate, Body, ModelError, Push, Vec2};
+//!
+//! As laws ([`crate::FrictionLaw`]): [`FrictionModel`] itself (the idiom with
+//! its parameters), and one value per idiom for the catalogue:
+//! [`ImpulseDisk`], [`ImpulseBox`], [`RowsDisk`] (Bullet's rows on the disc),
+//! [`RegularisedLinear`], [`RegularisedTanh`].
+
+use pushval_model::{cross, rotate, Body, ModelError, Problem, Push, Vec2};
+
+use crate::{FrictionLaw, LawClass, LawSteady, COULOMB};
+
+/// The regularised idioms' default slip speed (m/s; see
+/// results/friction_models/).
+pub const DEFAULT_SLIP_SPEED: f64 = 0.01;
 
 /// Sliding speeds (m/s) at or below this give no friction force.
 const MIN_SLIDING_SPEED: f64 = 1e-12;
@@ -462,3 +474,141 @@ pub fn stop_gain(model: FrictionModel, body: &Body, dt: f64, theta: f64) -> Opti
     }
     Some(gamma)
 }
+
+/// Angles per turn of the per-axis laws' period mean.
+const BOX_ANGLES: usize = 360;
+
+/// The idioms' closed forms: the moment balance with the idiom's support law
+/// substituted; for the per-axis laws, the period mean over the object's
+/// angle, and a lock where the frozen root changes sign.
+/// [`FrictionModel::Coulomb`] is [`COULOMB`].
+impl FrictionLaw for FrictionModel {
+    fn law_name(&self) -> &'static str {
+        match self {
+            FrictionModel::ImpulseBox => {
+                "stopping impulse capped per world axis; mean ω over a turn, locked where ω*(θ) changes sign (pushval_rapier2d::idioms)"
+            }
+            FrictionModel::ImpulseDisk => {
+                "stopping impulse −K⁻¹u capped in length at μNΔt (pushval_rapier2d::idioms)"
+            }
+            FrictionModel::ImpulseRowsDisk => {
+                "stopping impulse solved per world axis, the pair scaled onto the disk μNΔt; mean ω over a turn (pushval_rapier2d::idioms)"
+            }
+            FrictionModel::Coulomb => COULOMB.law_name(),
+            _ => "Coulomb regularised below the slip speed (pushval_rapier2d::idioms)",
+        }
+    }
+    fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+        let model = *self;
+        if model == FrictionModel::Coulomb {
+            return COULOMB.steady(problem, segment, dt);
+        }
+        let push = problem.pushes.get(segment)?;
+        let body = &problem.body;
+        if model.is_isotropic() {
+            let omega = predicted_steady_omega(model, body, push, dt, 0.0, 0.0)?;
+            return Some(LawSteady {
+                omega,
+                class: LawClass::Turns,
+            });
+        }
+        match predicted_mean_omega(model, body, push, dt, BOX_ANGLES) {
+            Some(omega) => Some(LawSteady {
+                omega,
+                class: LawClass::Turns,
+            }),
+            None => lock_angles(model, body, push, dt, BOX_ANGLES)
+                .iter()
+                .any(|&(_, stable)| stable)
+                .then_some(LawSteady {
+                    omega: 0.0,
+                    class: LawClass::Locked,
+                }),
+        }
+    }
+}
+
+/// One law value per idiom, each the [`FrictionModel`] it names.
+macro_rules! idiom_law {
+    ($(#[$doc:meta])* $name:ident, $model:expr) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub struct $name;
+
+        impl $name {
+            /// The idiom as a [`FrictionModel`].
+            pub fn model(&self) -> FrictionModel {
+                $model
+            }
+        }
+
+        idiom_law!(@law $name);
+    };
+    ($(#[$doc:meta])* $name:ident { slip_speed }, $model:path) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub struct $name {
+            /// The slip speed `v_s` (m/s, > 0; default [`DEFAULT_SLIP_SPEED`]).
+            pub slip_speed: f64,
+        }
+
+        impl $name {
+            /// The idiom as a [`FrictionModel`].
+            pub fn model(&self) -> FrictionModel {
+                $model {
+                    slip_speed: self.slip_speed,
+                }
+            }
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self {
+                    slip_speed: DEFAULT_SLIP_SPEED,
+                }
+            }
+        }
+
+        idiom_law!(@law $name);
+    };
+    (@law $name:ident) => {
+        impl FrictionLaw for $name {
+            fn law_name(&self) -> &'static str {
+                self.model().law_name()
+            }
+            fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
+                self.model().steady(problem, segment, dt)
+            }
+        }
+    };
+}
+
+idiom_law!(
+    /// The friction joint of Box2D and Chipmunk at every support:
+    /// [`FrictionModel::ImpulseDisk`].
+    ImpulseDisk,
+    FrictionModel::ImpulseDisk
+);
+idiom_law!(
+    /// The stopping impulse capped per world axis (rapier's joint motors,
+    /// pyramid friction): [`FrictionModel::ImpulseBox`].
+    ImpulseBox,
+    FrictionModel::ImpulseBox
+);
+idiom_law!(
+    /// Bullet's two friction rows per contact scaled back onto the disc
+    /// `μ N Δt` (PyBullet): [`FrictionModel::ImpulseRowsDisk`].
+    RowsDisk,
+    FrictionModel::ImpulseRowsDisk
+);
+idiom_law!(
+    /// Coulomb made linear below the slip speed:
+    /// [`FrictionModel::RegularisedLinear`].
+    RegularisedLinear { slip_speed },
+    FrictionModel::RegularisedLinear
+);
+idiom_law!(
+    /// Coulomb smoothed by `tanh(|u|/v_s)`: [`FrictionModel::RegularisedTanh`].
+    RegularisedTanh { slip_speed },
+    FrictionModel::RegularisedTanh
+);

@@ -50,7 +50,9 @@
 //! Units: SI (m, kg, N, N m, rad/s); positions in the object frame relative
 //! to the centre of mass.
 
-use pushval_model::{cross, Body, Push};
+use pushval_model::{cross, Body, Problem, Push};
+
+use crate::{FrictionLaw, LawClass, LawSteady};
 
 /// The motor joint's caps for a body: `F_max = Σ F_i` (N), the total sliding
 /// friction (`μ m g` for one μ), and `T_max = Σ F_i |p_i|` (N m), the
@@ -247,4 +249,28 @@ pub fn motor_joint_steady(body: &Body, push: &Push, omega0: f64) -> Option<Motor
         h *= 2.0;
     }
     None
+}
+
+/// Box2D's motor joint to the ground as a law: force capped at `Σ F_i`,
+/// torque at `Σ F_i |p_i|`, each on its own ([`motor_joint_steady`] from
+/// ω = 0). The caps come from the problem's support friction; no parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Box2dMotorJoint;
+
+impl FrictionLaw for Box2dMotorJoint {
+    fn law_name(&self) -> &'static str {
+        "motor joint to the ground: force and torque capped apart (pushval_box2d::predict)"
+    }
+    fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let s = motor_joint_steady(&problem.body, push, 0.0)?;
+        Some(LawSteady {
+            omega: s.omega,
+            class: if s.locked {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
+        })
+    }
 }
