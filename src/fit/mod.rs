@@ -672,3 +672,30 @@ pub fn write(fit: &Fit, dir: &Path) -> anyhow::Result<PathBuf> {
     )?;
     Ok(path)
 }
+
+#[cfg(test)]
+mod degenerate_tests {
+    use super::*;
+
+    /// The locked-plate case: a fit that drives the friction scale and the
+    /// inertia to ~0 explains a plate that does not turn by a plate without
+    /// friction or mass; both are named. A fit at physical values (μ scale
+    /// 0.84, I_cm at 90 % of the file's) is not degenerate, nor is one just
+    /// above the threshold.
+    #[test]
+    fn parameters_near_zero_are_degenerate() {
+        let slots = [(Param::InertiaCm, 0), (Param::MuScale, 0)];
+        let file = [0.0104, 1.0];
+        let why = degenerate_reasons(&slots, &[2.1e-9, 2.5e-9], &file);
+        assert_eq!(why.len(), 2, "{why:?}");
+        assert!(why[0].contains("inertia_cm") && why[0].contains("massless"));
+        assert!(why[1].contains("mu_scale") && why[1].contains("frictionless"));
+        assert!(degenerate_reasons(&slots, &[0.9 * 0.0104, 0.84], &file).is_empty());
+        assert!(degenerate_reasons(&slots, &[0.0104, 1.01 * NEAR_ZERO], &file).is_empty());
+        // Negative (outside the physical bounds) and NaN are degenerate too.
+        assert_eq!(
+            degenerate_reasons(&slots, &[-1e-3, f64::NAN], &file).len(),
+            2
+        );
+    }
+}

@@ -181,6 +181,7 @@ fn cli_recovers_scaled_mu_and_inertia_from_the_exact_paper_trajectory() {
     );
     assert_eq!(j["converged"], true);
     assert_eq!(j["unidentifiable"], serde_json::json!([]));
+    assert_eq!(j["degenerate"], serde_json::json!([]));
     // The contract's keys, and a 2 × 2 covariance.
     let keys: Vec<&str> = j.as_object().unwrap().keys().map(|k| k.as_str()).collect();
     assert_eq!(
@@ -188,6 +189,7 @@ fn cli_recovers_scaled_mu_and_inertia_from_the_exact_paper_trajectory() {
         [
             "converged",
             "covariance",
+            "degenerate",
             "lack_of_fit",
             "parameters",
             "residual",
