@@ -388,14 +388,16 @@ fn merged(old: Vec<Row>, new: Vec<Row>) -> Vec<Row> {
 /// Log–log figure: steady-ω error (left) and position error (right)
 /// against CPU time per simulated second, one line per engine model.
 fn figure(rows: &[Row], names: &[&str]) -> String {
-    use pushval::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
-    let panel = |title: &str, ylabel: &str, pick: &dyn Fn(&Row) -> f64| {
+    use pushval::plot::{family_styles, Axis, Figure, Legend, Panel, Series, Stroke, GREY};
+    // One colour per engine family, its members by dash or marker.
+    let styles = family_styles(names);
+    let panel = |title: &str, ylabel: &str, pick: &dyn Fn(&Row) -> f64, target: Option<f64>| {
         let mut p = Panel::new(
             title,
             Axis::log("CPU time per simulated second (s/s)"),
             Axis::log(ylabel),
         )
-        .legend(Legend::LowerRight);
+        .legend(Legend::Outside);
         for (k, name) in names.iter().enumerate() {
             let mut pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -404,28 +406,37 @@ fn figure(rows: &[Row], names: &[&str]) -> String {
                 .filter(|p| p.1.is_finite())
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let stroke = if k < PALETTE.len() {
-                Stroke::Solid
-            } else {
-                Stroke::Dashed
-            };
-            p = p.series(Series::new(*name, PALETTE[k % PALETTE.len()], stroke).points(pts));
+            let (color, stroke) = styles[k];
+            p = p.series(Series::new(*name, color, stroke).points(pts));
+        }
+        if let Some(t) = target {
+            // The summary's target, across the cost range of the data.
+            let xs = rows.iter().map(|r| r.cpu_per_sim_s).filter(|x| *x > 0.0);
+            let (lo, hi) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+            if lo < hi {
+                p = p.series(
+                    Series::new(format!("target {t:.0e}"), GREY, Stroke::Dashed)
+                        .points(vec![(lo, t), (hi, t)]),
+                );
+            }
         }
         p
     };
     let fig = Figure {
-        size: (1400, 620),
+        size: (1700, 720),
         cols: 2,
         panels: vec![
             panel(
                 "Engines: steady-ω error against cost (paper plate, 0.5 m/s, 6 s)",
                 "relative steady-ω error vs the dynamic model",
                 &|r| r.omega_rel,
+                Some(TARGET),
             ),
             panel(
                 "Engines: position error against cost",
                 "max CM position error vs the dynamic model (m)",
                 &|r| r.position,
+                None,
             ),
         ],
         key: None,

@@ -108,6 +108,9 @@ pub enum Legend {
     LowerRight,
     LowerLeft,
     None,
+    /// In a column beside the panels (the figure's key area), one entry per
+    /// label over every such panel: nothing is drawn over the data.
+    Outside,
 }
 
 /// One chart.
@@ -160,10 +163,15 @@ impl Panel {
 }
 
 /// Colour classes drawn as a key beside a map.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Key {
     pub title: String,
+    /// Filled swatches.
     pub entries: Vec<(String, RGBColor)>,
+    /// Outlined swatches (a map's cell edges), after the filled ones.
+    pub outlined: Vec<(String, RGBColor)>,
+    /// Lines of text under the swatches (what the colours measure).
+    pub notes: Vec<String>,
 }
 
 /// A figure: panels on a grid of `cols` columns, optionally a colour key on
@@ -236,9 +244,9 @@ impl Scale {
     /// A key for the scale: for [`Scale::Log10`] one entry per decade from
     /// `lo` to `hi` (the ends read ≤ and ≥), for [`Scale::Classes`] the
     /// classes with `labels`; then `notes` (e.g. what a cell's mark means),
-    /// drawn with white swatches.
+    /// as lines of text.
     pub fn key(&self, title: &str, labels: &[&str], notes: &[String]) -> Key {
-        let mut entries: Vec<(String, RGBColor)> = match self {
+        let entries: Vec<(String, RGBColor)> = match self {
             Scale::Classes(colors) => labels
                 .iter()
                 .zip(colors)
@@ -260,10 +268,11 @@ impl Scale {
                     .collect()
             }
         };
-        entries.extend(notes.iter().map(|n| (n.clone(), WHITE)));
         Key {
             title: title.to_string(),
             entries,
+            outlined: Vec::new(),
+            notes: notes.to_vec(),
         }
     }
 }
@@ -387,8 +396,18 @@ pub fn render(fig: &Figure) -> anyhow::Result<String> {
     {
         let root = SVGBackend::with_string(&mut buf, fig.size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
-        let (main, key_area) = if fig.key.is_some() {
-            let (a, b) = root.split_horizontally(fig.size.0.saturating_sub(230));
+        // Series of the panels whose legend is outside, one per label.
+        let mut outside: Vec<&Series> = Vec::new();
+        for p in fig.panels.iter().filter(|p| p.legend == Legend::Outside) {
+            for s in p.series.iter().filter(|s| !s.label.is_empty()) {
+                if !outside.iter().any(|o| o.label == s.label) {
+                    outside.push(s);
+                }
+            }
+        }
+        let width = if outside.is_empty() { 230 } else { 300 };
+        let (main, key_area) = if fig.key.is_some() || !outside.is_empty() {
+            let (a, b) = root.split_horizontally(fig.size.0.saturating_sub(width));
             (a, Some(b))
         } else {
             (root.clone(), None)
@@ -398,8 +417,9 @@ pub fn render(fig: &Figure) -> anyhow::Result<String> {
         for (area, p) in areas.iter().zip(&fig.panels) {
             panel(area, p).map_err(|e| anyhow!("panel '{}': {e:#}", p.title))?;
         }
-        if let (Some(k), Some(a)) = (&fig.key, key_area) {
-            key(&a, k).map_err(|e| anyhow!("{e:?}"))?;
+        if let Some(a) = key_area {
+            let empty = Key::default();
+            key(&a, fig.key.as_ref().unwrap_or(&empty), &outside).map_err(|e| anyhow!("{e:?}"))?;
         }
         root.present().map_err(|e| anyhow!("{e:?}"))?;
     }
@@ -409,20 +429,106 @@ pub fn render(fig: &Figure) -> anyhow::Result<String> {
 fn key<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     k: &Key,
+    series: &[&Series],
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let title = (FONT, 17).into_font().color(&BLACK);
     let text = (FONT, 15).into_font().color(&BLACK);
-    area.draw(&Text::new(k.title.clone(), (10, 60), title))?;
-    for (i, (label, color)) in k.entries.iter().enumerate() {
-        let y = 95 + 32 * i as i32;
+    let small = (FONT, 13).into_font().color(&BLACK);
+    let mut y = 60;
+    if !k.title.is_empty() {
+        area.draw(&Text::new(k.title.clone(), (10, y), title.clone()))?;
+        y += 35;
+    }
+    for (label, color) in &k.entries {
         area.draw(&Rectangle::new([(12, y), (36, y + 20)], color.filled()))?;
         area.draw(&Rectangle::new(
             [(12, y), (36, y + 20)],
             BLACK.stroke_width(1),
         ))?;
         area.draw(&Text::new(label.clone(), (44, y + 3), text.clone()))?;
+        y += 32;
+    }
+    for (label, color) in &k.outlined {
+        // A thick edge: the colour filled, a white inset over it (the SVG
+        // backend writes no stroke width for rectangles).
+        area.draw(&Rectangle::new([(12, y), (36, y + 20)], color.filled()))?;
+        area.draw(&Rectangle::new([(15, y + 3), (33, y + 17)], WHITE.filled()))?;
+        area.draw(&Text::new(label.clone(), (44, y + 3), text.clone()))?;
+        y += 32;
+    }
+    for note in &k.notes {
+        area.draw(&Text::new(note.clone(), (12, y + 3), small.clone()))?;
+        y += 22;
+    }
+    if !series.is_empty() {
+        y += 10;
+        for s in series {
+            let style = ShapeStyle {
+                color: s.color.to_rgba(),
+                filled: false,
+                stroke_width: s.width,
+            };
+            let yc = y + 9;
+            match s.stroke {
+                Stroke::Solid => area.draw(&PathElement::new(vec![(10, yc), (40, yc)], style))?,
+                Stroke::Dashed => {
+                    for x in [10, 23] {
+                        area.draw(&PathElement::new(vec![(x, yc), (x + 8, yc)], style))?;
+                    }
+                }
+                Stroke::Dotted => {
+                    for x in (10..40).step_by(6) {
+                        area.draw(&PathElement::new(vec![(x, yc), (x + 2, yc)], style))?;
+                    }
+                }
+                Stroke::Dots => {
+                    for x in [14, 25, 36] {
+                        area.draw(&Circle::new((x, yc), 3, s.color.filled()))?;
+                    }
+                }
+            }
+            area.draw(&Text::new(s.label.clone(), (48, y + 1), small.clone()))?;
+            y += 21;
+        }
     }
     Ok(())
+}
+
+/// A colour per family and a stroke per member: `names` grouped by the part
+/// before the first `_` or `[` (the engine: `rapier2d`, `jolt`, …), each
+/// family one colour of [`PALETTE`], its members told apart by
+/// [`Stroke::Solid`], [`Stroke::Dashed`], [`Stroke::Dotted`] and
+/// [`Stroke::Dots`] in turn (then the next palette colour).
+pub fn family_styles(names: &[&str]) -> Vec<(RGBColor, Stroke)> {
+    const STROKES: [Stroke; 4] = [Stroke::Solid, Stroke::Dashed, Stroke::Dotted, Stroke::Dots];
+    let family = |n: &str| n.split(['_', '[']).next().unwrap_or(n).to_string();
+    let mut families: Vec<String> = Vec::new();
+    let mut members: Vec<usize> = Vec::new();
+    let mut colour_of: Vec<usize> = Vec::new();
+    let mut next_colour = 0;
+    names
+        .iter()
+        .map(|n| {
+            let f = family(n);
+            let i = families.iter().position(|g| *g == f).unwrap_or_else(|| {
+                families.push(f);
+                members.push(0);
+                colour_of.push(next_colour);
+                next_colour += 1;
+                families.len() - 1
+            });
+            let m = members[i];
+            members[i] += 1;
+            if m > 0 && m % STROKES.len() == 0 {
+                colour_of[i] = next_colour;
+                next_colour += 1;
+            }
+            (
+                PALETTE[colour_of[i] % PALETTE.len()],
+                STROKES[m % STROKES.len()],
+            )
+        })
+        .collect()
 }
 
 fn panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> anyhow::Result<()>
@@ -584,7 +690,7 @@ where
         Legend::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
         Legend::LowerRight => Some(SeriesLabelPosition::LowerRight),
         Legend::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
-        Legend::None => None,
+        Legend::None | Legend::Outside => None,
     };
     if let (true, Some(pos)) = (labelled, pos) {
         chart
@@ -597,4 +703,38 @@ where
             .map_err(err)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Members of a family share a colour and differ in stroke; families
+    /// differ in colour; a fifth member moves to the next colour.
+    #[test]
+    fn family_styles_tell_families_by_colour_and_members_by_stroke() {
+        let names = [
+            "rapier2d[leapfrog]",
+            "box2d",
+            "rapier2d[body]",
+            "jolt_box",
+            "jolt_feet",
+            "rapier2d[a]",
+            "rapier2d[b]",
+            "rapier2d[c]",
+        ];
+        let s = family_styles(&names);
+        assert_eq!(s[0].0, s[2].0);
+        assert_ne!(s[0].1, s[2].1);
+        assert_eq!(s[3].0, s[4].0);
+        assert_ne!(s[3].1, s[4].1);
+        assert_ne!(s[0].0, s[1].0);
+        assert_ne!(s[1].0, s[3].0);
+        // Every (colour, stroke) pair is distinct.
+        for i in 0..s.len() {
+            for j in 0..i {
+                assert!(s[i] != s[j], "{} and {} look the same", names[i], names[j]);
+            }
+        }
+    }
 }

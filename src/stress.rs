@@ -792,6 +792,7 @@ pub fn map_figure(outcomes: &[Outcome]) -> anyhow::Result<Option<String>> {
                 ("degraded".into(), degraded),
                 ("unstable (blew up)".into(), unstable),
             ],
+            ..Default::default()
         }),
     };
     crate::plot::render(&fig).map(Some)

@@ -21,7 +21,7 @@ use pushval_scenario::Scenario;
 use crate::harness::{
     compare_trajectory, run_scenario, Figures, Resolved, RunOptions, SegmentInfo, SteadyRead,
 };
-use crate::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
+use crate::plot::{Axis, Figure, Legend, Panel, Series, Stroke};
 
 use crate::inject::inject;
 pub use crate::inject::ErrorKind;
@@ -393,10 +393,11 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
     {
         let mut p = Panel::new(
             format!("{} ({})", kind.name(), kind.unit()),
-            Axis::lin("scenario #"),
+            Axis::lin("scenario # (key on the right)"),
             Axis::log("smallest magnitude caught"),
         )
-        .legend(Legend::UpperRight);
+        .legend(Legend::Outside);
+        let styles = crate::plot::family_styles(&engines);
         for (k, e) in engines.iter().enumerate() {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -406,12 +407,14 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
                     r.both().map(|m| (i, m))
                 })
                 .collect();
-            p = p.series(Series::new(*e, PALETTE[k % PALETTE.len()], Stroke::Dots).points(pts));
+            // Markers only (a scenario is a category, not a curve), one
+            // colour per engine family.
+            p = p.series(Series::new(*e, styles[k].0, Stroke::Dots).points(pts));
         }
         if let Some(t) = kind.target() {
             let n = scenarios.len().max(2) as f64 - 1.0;
             p = p.series(
-                Series::new("target", crate::plot::GREY, Stroke::Dashed)
+                Series::new("target (power goal)", crate::plot::GREY, Stroke::Dashed)
                     .points(vec![(0.0, t), (n, t)]),
             );
         }
@@ -423,11 +426,12 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
         panels,
         key: Some(crate::plot::Key {
             title: "scenario #".into(),
-            entries: scenarios
+            notes: scenarios
                 .iter()
                 .enumerate()
-                .map(|(i, s)| (format!("{i}: {s}"), crate::plot::GREY))
+                .map(|(i, s)| format!("{i}: {s}"))
                 .collect(),
+            ..Default::default()
         }),
     })
 }

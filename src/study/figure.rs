@@ -9,7 +9,7 @@ use plotters::style::RGBColor;
 use super::err;
 use super::plate::froude;
 use super::records::{num, parse};
-use crate::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, PURPLE};
+use crate::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, GREY, PURPLE};
 
 /// The error classes' lower bounds (dimensionless): class k is
 /// `BOUNDS[k-1] ≤ error < BOUNDS[k]`.
@@ -117,14 +117,21 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
         "≥ 1e-1",
     ];
     let notes = [
-        "black edge: law locks".to_string(),
-        "purple edge: semi-stable".to_string(),
-        "grey: undefined".to_string(),
+        "relative steady-ω error".to_string(),
+        "|ω_engine − ω_ref| / |ω_ref|,".to_string(),
+        "ref: Coulomb (left), the".to_string(),
+        "engine's law (right)".to_string(),
+    ];
+    let mut key = scale.key("error", &labels, &notes);
+    key.entries.push(("undefined".to_string(), GREY));
+    key.outlined = vec![
+        ("law locks".to_string(), DARK),
+        ("law semi-stable".to_string(), PURPLE),
     ];
     Ok(Figure {
         size: (1500, 640),
         cols: 2,
         panels: vec![left, right],
-        key: Some(scale.key("error", &labels, &notes)),
+        key: Some(key),
     })
 }
