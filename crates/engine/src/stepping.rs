@@ -8,22 +8,24 @@
 //! * **Schedule.** Each segment of duration `T` is cut into
 //!   `n = ceil(T / dt)` equal steps of `h = T / n` (a relative `1e-12` off
 //!   the quotient, so that a whole number of steps is not rounded up); the
-//!   last step of a segment ends exactly at the segment's end time.
+//!   last step of a segment ends exactly at the segment's end time
+//!   ([`StepClock`] says how the others' end times are computed).
 //! * **Pusher.** Before every step the pusher is re-pinned on the object's
 //!   contact point and moves at the commanded contact velocity `v_c R(ψ)
 //!   n_φ`, ψ the heading [`PlateWorld::heading`] gives (by default the yaw at
 //!   mid-step, `θ + ω h/2`).
-//! * **Checks.** After every step the position and ω must be finite
-//!   ([`ModelError::NonFinite`] otherwise).
+//! * **Checks.** After every step the state must be finite
+//!   ([`PlateWorld::finite`]; [`ModelError::NonFinite`] otherwise).
 //! * **Records.** Every step is one [`PlateStep`] (pose at its end, ω over
 //!   it, height and tilt), after an initial record at t = 0.
-//! * **Tails.** Per segment, over its steps from index `floor(0.8 n)` on
-//!   ([`TAIL`]): the time-weighted means of ω, of ω² (its spread), of each
-//!   support's normal load and friction force, and each support's smallest
-//!   slip speed. Over the run's last fifth (the steps whose middle is past
-//!   it), each support's time-weighted mean load.
+//! * **Tails.** Per segment, over its last fifth of steps ([`TAIL`],
+//!   [`TailSteps`]): the means ([`TailWeight`]: time-weighted by default) of
+//!   ω, of ω² (its spread), of each support's normal load and friction
+//!   force, and each support's smallest slip speed. Over the run's last fifth
+//!   (the steps whose middle is past it), each support's time-weighted mean
+//!   load.
 //! * **Extremes.** The largest tilt, the largest vertical displacement of the
-//!   centre of mass from its height at the start, the largest pusher drift
+//!   centre of mass from the height it is given, the largest pusher drift
 //!   (after the first step), and each support's smallest load.
 //!
 //! The arithmetic is written once here, in a fixed order, so that every
@@ -141,7 +143,7 @@ pub trait PlateWorld {
 
     /// The object after a step; `prev` is the reading before it (to unwrap
     /// the yaw).
-    fn state(&self, prev: &Self::State) -> Self::State;
+    fn state(&mut self, prev: &Self::State) -> Self::State;
 
     /// Each support's forces over the last step of length `h`, or None where
     /// the engine reads none.
@@ -150,6 +152,16 @@ pub trait PlateWorld {
         state: &Self::State,
         h: f64,
     ) -> Result<Option<SupportForces>, ModelError>;
+
+    /// Whether a state is usable: by default its position and ω are finite.
+    fn finite(&self, state: &Self::State) -> bool {
+        let p = self.plate(state);
+        p.x.is_finite() && p.y.is_finite() && p.z.is_finite() && p.omega.is_finite()
+    }
+
+    /// Called after every step once the state is checked, for what the
+    /// engine records itself. Nothing by default.
+    fn after_step(&mut self, _state: &Self::State) {}
 
     /// Horizontal slip speed (m/s) of support `i` after the step, where the
     /// engine gives it (read in the segment tails only). None by default.
@@ -163,9 +175,44 @@ pub trait PlateWorld {
         Ok(())
     }
 
-    /// Called at the end of every segment with the length of its tail (s).
-    /// Nothing by default.
-    fn end_segment(&mut self, _tail_time: f64) {}
+    /// Called at the end of every segment (time `t`, s) with the total
+    /// weight of its tail (its length in s, or its number of steps with
+    /// [`TailWeight::Steps`]). Nothing by default.
+    fn end_segment(&mut self, _tail_weight: f64, _t: f64) -> Result<(), ModelError> {
+        Ok(())
+    }
+}
+
+/// Which steps of a segment of `n` steps make its tail.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TailSteps {
+    /// The steps from index `floor((1 − TAIL) n)` on.
+    #[default]
+    Floor,
+    /// The last `max(n / 5, 1)` steps (integer division).
+    LastFifth,
+}
+
+/// How the steps of a tail are weighted in its means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TailWeight {
+    /// By their length (time-weighted means).
+    #[default]
+    Time,
+    /// Equally (means over the steps).
+    Steps,
+}
+
+/// How the end time of a step (not the last of its segment, which ends at
+/// the segment's end) is computed, and with it the run-tail test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StepClock {
+    /// `t1 = t0 + h`, `t0 = t_seg + k h`; a step is in the run tail when its
+    /// middle `(t0 + t1) / 2` is.
+    #[default]
+    FromStepStart,
+    /// `t1 = t_seg + (k + 1) h`; a step is in the run tail when `t1 − h/2` is.
+    FromSegmentStart,
 }
 
 /// How [`run_pushes`] runs.
@@ -180,6 +227,29 @@ pub struct StepLoop {
     /// Read the support forces after every step (for the smallest loads);
     /// otherwise only on the steps of the segment tails and the run tail.
     pub forces_every_step: bool,
+    /// Which steps make a segment's tail.
+    pub tail: TailSteps,
+    /// How tail steps are weighted.
+    pub tail_weight: TailWeight,
+    /// How step end times are computed.
+    pub clock: StepClock,
+}
+
+impl StepLoop {
+    /// Steps of at most `dt` (s) for `supports` supports, the lift measured
+    /// from `z_rest` (m); forces read on every step; the default tail and
+    /// clock.
+    pub fn new(dt: f64, supports: usize, z_rest: f64) -> Self {
+        Self {
+            dt,
+            supports,
+            z_rest,
+            forces_every_step: true,
+            tail: TailSteps::Floor,
+            tail_weight: TailWeight::Time,
+            clock: StepClock::FromStepStart,
+        }
+    }
 }
 
 /// What [`run_pushes`] gathered.
@@ -262,7 +332,14 @@ pub fn run_pushes<W: PlateWorld>(
     for (j, push) in problem.pushes.iter().enumerate() {
         let n = (push.duration / cfg.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
         let h = push.duration / n as f64;
-        let tail_from = ((1.0 - TAIL) * n as f64).floor() as usize;
+        let tail_from = match cfg.tail {
+            TailSteps::Floor => ((1.0 - TAIL) * n as f64).floor() as usize,
+            TailSteps::LastFifth => n - (n / 5).max(1),
+        };
+        let w = match cfg.tail_weight {
+            TailWeight::Time => h,
+            TailWeight::Steps => 1.0,
+        };
         let (mut acc_w, mut acc_w2, mut acc_t) = (0.0, 0.0, 0.0);
         let mut acc_n = vec![0.0; n_sup];
         let mut acc_f = vec![0.0; n_sup];
@@ -273,7 +350,10 @@ pub fn run_pushes<W: PlateWorld>(
             let t1 = if k + 1 == n {
                 t_seg + push.duration
             } else {
-                t0 + h
+                match cfg.clock {
+                    StepClock::FromStepStart => t0 + h,
+                    StepClock::FromSegmentStart => t_seg + (k + 1) as f64 * h,
+                }
             };
             let (sn, cs) = world.heading(&state, h).sin_cos();
             let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y];
@@ -284,17 +364,21 @@ pub fn run_pushes<W: PlateWorld>(
             world.step(h, t1)?;
             out.steps += 1;
             state = world.state(&state);
-            let p = world.plate(&state);
-            if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite() && p.omega.is_finite()) {
+            if !world.finite(&state) {
                 return Err(ModelError::NonFinite {
                     t: t1,
                     step: out.steps,
                 });
             }
+            world.after_step(&state);
+            let p = world.plate(&state);
             out.max_tilt = out.max_tilt.max(p.tilt);
             out.max_lift = out.max_lift.max((p.z - cfg.z_rest).abs());
             let in_tail = k >= tail_from;
-            let in_run_tail = 0.5 * (t0 + t1) >= run_from;
+            let in_run_tail = match cfg.clock {
+                StepClock::FromStepStart => 0.5 * (t0 + t1) >= run_from,
+                StepClock::FromSegmentStart => t1 - 0.5 * h >= run_from,
+            };
             let forces = if cfg.forces_every_step || in_tail || in_run_tail {
                 world.support_forces(&state, h)?
             } else {
@@ -312,16 +396,16 @@ pub fn run_pushes<W: PlateWorld>(
                 }
             }
             if in_tail {
-                acc_w += p.omega * h;
-                acc_w2 += p.omega * p.omega * h;
-                acc_t += h;
+                acc_w += p.omega * w;
+                acc_w2 += p.omega * p.omega * w;
+                acc_t += w;
                 if let Some(f) = &forces {
                     for (a, &l) in acc_n.iter_mut().zip(&f.normal) {
-                        *a += l * h;
+                        *a += l * w;
                     }
                     if let Some(fr) = &f.friction {
                         for (a, &l) in acc_f.iter_mut().zip(fr) {
-                            *a += l * h;
+                            *a += l * w;
                         }
                     }
                 }
@@ -343,12 +427,284 @@ pub fn run_pushes<W: PlateWorld>(
         out.segment_tail_friction
             .push(acc_f.iter().map(|a| a / acc_t).collect());
         out.segment_tail_min_slip.push(min_slip);
-        world.end_segment(acc_t);
         t_seg += push.duration;
+        world.end_segment(acc_t, t_seg)?;
     }
     out.loads = run_n
         .iter()
         .map(|a| a / run_t.max(f64::MIN_POSITIVE))
         .collect();
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pushval_model::{Body, Initial, Push, Support, Switching};
+
+    /// An object carried rigidly by the pusher: it moves at the commanded
+    /// velocity, turns at a constant rate `w` and rises linearly; every
+    /// support carries a fixed load and friction force.
+    struct Carried {
+        w: f64,
+        state: Plate,
+        vel: [f64; 2],
+        drives: usize,
+        nan_at: Option<usize>,
+        steps: usize,
+        tail_calls: usize,
+        segment_ends: Vec<f64>,
+    }
+
+    impl PlateWorld for Carried {
+        type State = Plate;
+        fn plate(&self, s: &Plate) -> Plate {
+            *s
+        }
+        fn drive(&mut self, _: &Plate, velocity: [f64; 2], _h: f64) -> f64 {
+            self.vel = velocity;
+            self.drives += 1;
+            // The first drive (the start) reports a large drift.
+            if self.drives == 1 {
+                100.0
+            } else {
+                1e-3 * self.drives as f64
+            }
+        }
+        fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
+            self.steps += 1;
+            let s = &mut self.state;
+            s.x += self.vel[0] * h;
+            s.y += self.vel[1] * h;
+            s.z += 0.5 * h;
+            s.theta += self.w * h;
+            s.omega = self.w;
+            s.tilt = 0.01 * self.steps as f64;
+            if self.nan_at == Some(self.steps) {
+                s.x = f64::NAN;
+            }
+            Ok(())
+        }
+        fn state(&mut self, _: &Plate) -> Plate {
+            self.state
+        }
+        fn support_forces(
+            &mut self,
+            _: &Plate,
+            _h: f64,
+        ) -> Result<Option<SupportForces>, ModelError> {
+            Ok(Some(SupportForces {
+                normal: vec![1.0, 2.0, 3.0],
+                friction: Some(vec![0.5, 0.25, 0.0]),
+            }))
+        }
+        fn slip(&self, _: &Plate, i: usize) -> Option<f64> {
+            (i == 0).then_some(0.125 * self.steps as f64)
+        }
+        fn tail_step(&mut self, _: &Plate, _h: f64) -> Result<(), ModelError> {
+            self.tail_calls += 1;
+            Ok(())
+        }
+        fn end_segment(&mut self, tail_time: f64, _t: f64) -> Result<(), ModelError> {
+            self.segment_ends.push(tail_time);
+            Ok(())
+        }
+    }
+
+    fn problem(pushes: Vec<Push>) -> Problem {
+        let supports: Vec<Support> = [[-0.1, -0.1], [0.1, -0.1], [0.0, 0.1]]
+            .iter()
+            .map(|c| Support {
+                position: Vec2::new(c[0], c[1]),
+                friction: 1.0,
+            })
+            .collect();
+        Problem {
+            body: Body::new(1.0, 0.01, Vec2::new(-0.1, 0.0), &supports).unwrap(),
+            limits: Default::default(),
+            pushes,
+            initial: Initial::default(),
+            switching: Switching::Impulsive,
+            sample_dt: 0.05,
+        }
+    }
+
+    fn carried(w: f64, nan_at: Option<usize>) -> Carried {
+        Carried {
+            w,
+            state: Plate {
+                omega: w,
+                ..Default::default()
+            },
+            vel: [0.0; 2],
+            drives: 0,
+            nan_at,
+            steps: 0,
+            tail_calls: 0,
+            segment_ends: Vec::new(),
+        }
+    }
+
+    const CFG: StepLoop = StepLoop {
+        dt: 0.1,
+        supports: 3,
+        z_rest: 0.0,
+        forces_every_step: true,
+        tail: TailSteps::Floor,
+        tail_weight: TailWeight::Time,
+        clock: StepClock::FromStepStart,
+    };
+
+    /// 1.1 / 0.1 is 11.000000000000002 in floating point: still 11 steps;
+    /// 0.35 / 0.1 gives 4 steps of 0.0875. Times are contiguous and each
+    /// segment ends exactly at its end time.
+    #[test]
+    fn schedule_cuts_segments_into_equal_steps() {
+        let p = problem(vec![
+            Push {
+                duration: 1.1,
+                speed: 0.1,
+                phi: 0.0,
+            },
+            Push {
+                duration: 0.35,
+                speed: 0.1,
+                phi: 0.5,
+            },
+        ]);
+        let mut w = carried(0.0, None);
+        let start = w.state;
+        let run = run_pushes(&mut w, &p, &CFG, start).unwrap();
+        assert_eq!(run.steps, 15);
+        assert_eq!(run.history.len(), 16);
+        let h = &run.history;
+        assert_eq!((h[0].t0, h[0].t1), (0.0, 0.0));
+        // Contiguous to rounding: t0 = t_seg + k h, the previous t1 = t0' + h.
+        assert_eq!(h[1].t0, 0.0);
+        for k in 2..h.len() {
+            assert!((h[k].t0 - h[k - 1].t1).abs() < 1e-15, "{k}");
+        }
+        assert_eq!(h[11].t1, 1.1);
+        assert_eq!(h[11].segment, 0);
+        assert_eq!(h[12].segment, 1);
+        assert!((h[12].t1 - h[12].t0 - 0.0875).abs() < 1e-15);
+        assert_eq!(h[15].t1, 1.1 + 0.35);
+        // Tails: steps 8..11 of the first segment (floor(0.8 · 11) = 8) and
+        // step 3 of the second (floor(0.8 · 4) = 3).
+        assert_eq!(w.tail_calls, 3 + 1);
+        assert_eq!(w.segment_ends.len(), 2);
+        assert!((w.segment_ends[0] - 0.3).abs() < 1e-12);
+        assert!((w.segment_ends[1] - 0.0875).abs() < 1e-12);
+    }
+
+    /// The pusher moves at the contact velocity turned by the mid-step yaw
+    /// θ + ω h/2; a carried object follows it exactly.
+    #[test]
+    fn pusher_velocity_is_set_at_the_mid_step_heading() {
+        let (speed, phi, w0) = (0.2, 0.3, 1.5);
+        let p = problem(vec![Push {
+            duration: 0.1,
+            speed,
+            phi,
+        }]);
+        let mut w = carried(w0, None);
+        let start = w.state;
+        let run = run_pushes(&mut w, &p, &CFG, start).unwrap();
+        assert_eq!(run.steps, 1);
+        let a = phi + 0.5 * 0.1 * w0;
+        let r = run.history[1];
+        assert!((r.x - 0.1 * speed * a.cos()).abs() < 1e-15);
+        assert!((r.y - 0.1 * speed * a.sin()).abs() < 1e-15);
+    }
+
+    /// Tail means of constants are the constants; the drift of the first
+    /// drive is left out; the smallest slip is over the tail only; the lift
+    /// and tilt are the largest over the run.
+    #[test]
+    fn tails_and_extremes() {
+        let p = problem(vec![Push {
+            duration: 1.0,
+            speed: 0.1,
+            phi: 0.0,
+        }]);
+        let mut w = carried(0.7, None);
+        let start = w.state;
+        let run = run_pushes(&mut w, &p, &CFG, start).unwrap();
+        assert_eq!(run.steps, 10);
+        assert!((run.segment_tail_omega[0] - 0.7).abs() < 1e-12);
+        assert!(run.segment_tail_omega_std[0] < 1e-6);
+        for (got, want) in run.segment_tail_loads[0].iter().zip([1.0, 2.0, 3.0]) {
+            assert!((got - want).abs() < 1e-12);
+        }
+        for (got, want) in run.segment_tail_friction[0].iter().zip([0.5, 0.25, 0.0]) {
+            assert!((got - want).abs() < 1e-12);
+        }
+        for (got, want) in run.loads.iter().zip([1.0, 2.0, 3.0]) {
+            assert!((got - want).abs() < 1e-12);
+        }
+        assert_eq!(run.min_loads, vec![1.0, 2.0, 3.0]);
+        // Tail steps are 9 and 10 (k = 8, 9): slip 0.125 · 9.
+        assert_eq!(run.segment_tail_min_slip[0][0], 0.125 * 9.0);
+        assert_eq!(run.segment_tail_min_slip[0][1], f64::INFINITY);
+        assert!((run.max_joint_drift - 1e-3 * 10.0).abs() < 1e-15);
+        assert!((run.max_lift - 0.5).abs() < 1e-12);
+        assert!((run.max_tilt - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_non_finite_state_stops_the_run() {
+        let p = problem(vec![Push {
+            duration: 1.0,
+            speed: 0.1,
+            phi: 0.0,
+        }]);
+        let mut w = carried(0.0, Some(4));
+        let start = w.state;
+        match run_pushes(&mut w, &p, &CFG, start) {
+            Err(ModelError::NonFinite { t, step }) => {
+                assert_eq!(step, 4);
+                assert!((t - 0.4).abs() < 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// The other conventions: the last `max(n / 5, 1)` steps as the tail,
+    /// weighted equally, and step ends counted from the segment's start.
+    #[test]
+    fn last_fifth_by_steps_from_the_segment_start() {
+        let p = problem(vec![
+            Push {
+                duration: 1.1,
+                speed: 0.1,
+                phi: 0.0,
+            },
+            Push {
+                duration: 0.35,
+                speed: 0.1,
+                phi: 0.5,
+            },
+        ]);
+        let cfg = StepLoop {
+            tail: TailSteps::LastFifth,
+            tail_weight: TailWeight::Steps,
+            clock: StepClock::FromSegmentStart,
+            ..StepLoop::new(0.1, 3, 0.0)
+        };
+        let mut w = carried(0.7, None);
+        let start = w.state;
+        let run = run_pushes(&mut w, &p, &cfg, start).unwrap();
+        // 11 steps: the last 2; 4 steps: the last 1 (4 / 5 = 0, at least 1).
+        assert_eq!(w.segment_ends, vec![2.0, 1.0]);
+        assert_eq!(w.tail_calls, 3);
+        let h = 1.1 / 11.0;
+        for k in 1..11 {
+            assert_eq!(run.history[k].t1, 0.0 + k as f64 * h);
+        }
+        assert_eq!(run.history[11].t1, 1.1);
+        assert!((run.segment_tail_omega[0] - 0.7).abs() < 1e-12);
+        for (got, want) in run.segment_tail_loads[1].iter().zip([1.0, 2.0, 3.0]) {
+            assert!((got - want).abs() < 1e-12);
+        }
+    }
 }

@@ -202,7 +202,7 @@ impl PlateWorld for Scene3d {
         Ok(())
     }
 
-    fn state(&self, prev: &State) -> State {
+    fn state(&mut self, prev: &State) -> State {
         read(&self.world, self.object, prev.theta)
     }
 
@@ -390,12 +390,7 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         state.omega = init.omega;
     }
 
-    let cfg = StepLoop {
-        dt: s.dt,
-        supports: n_feet,
-        z_rest,
-        forces_every_step: true,
-    };
+    let cfg = StepLoop::new(s.dt, n_feet, z_rest);
     let run = stepping::run_pushes(&mut w, problem, &cfg, state)?;
     Ok(Rapier3dRun {
         trajectory: run.trajectory(problem),
