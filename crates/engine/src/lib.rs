@@ -10,7 +10,8 @@
 //! this trait, so none of them names an engine.
 //!
 //! It also holds the one resampler every adapter shares ([`resample`]):
-//! engine steps in, samples at the problem's sample times out.
+//! engine steps in, samples at the problem's sample times out; and the one
+//! stepping loop of the plate engines ([`stepping`]).
 //!
 //! What it is not: an engine (it depends on none), or the analytic model
 //! (that is `pushval-model`).
@@ -22,6 +23,7 @@ use pushval_model::{ModelError, Problem, Trajectory};
 
 mod options;
 mod resample;
+pub mod stepping;
 
 pub use options::{EngineOptions, OptionError, SceneFrame};
 /// The friction laws in closed form live in `pushval-laws`; re-exported so

@@ -2,15 +2,12 @@
 
 use std::f64::consts::{PI, TAU};
 
-use pushval_engine::StepRecord;
-use pushval_model::{Body, ModelError, Problem, SolverStats, Trajectory, Vec2};
+use pushval_engine::stepping::{self, Plate, PlateWorld, StepLoop, SupportForces, TAIL};
+use pushval_model::{Body, ModelError, Problem, Vec2};
 
 use crate::predict::{box_corners, friction_slip_angle};
 use crate::sys::{BodyState, Collider, Spec, World};
 use crate::{JoltRun, JoltSettings, Scene, SupportContact};
-
-/// Share of a segment (and of the settle phase) averaged at its end.
-const TAIL: f64 = 0.2;
 
 /// One manifold of the contact cache (`ContactConstraintManager::
 /// ManifoldCache::SaveState`, Jolt 5.6.0).
@@ -358,119 +355,167 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         st = world.state(world.object);
     }
 
-    let mut history = vec![StepRecord {
-        segment: 0,
-        t0: 0.0,
-        t1: 0.0,
-        x: st.com[0],
-        y: st.com[1],
-        theta,
-        omega: st.angular[2],
-    }];
-    let mut steps = 0usize;
-    let (mut max_tilt, mut max_lift, mut max_drift) = (0.0f64, 0.0f64, 0.0f64);
-    let mut tail_omega = Vec::new();
-    let mut tail_omega_std = Vec::new();
-    let mut tail_contacts = Vec::new();
-    let mut tail_angle = Vec::new();
-    let mut tail_angle_law = Vec::new();
-    let mut tail_load_range = Vec::new();
-    // The run's last fifth (steps whose middle is past it), time-weighted.
-    let run_from = (1.0 - TAIL) * problem.duration();
-    let (mut run_n, mut run_t) = (vec![0.0; n_sup], 0.0);
-    let mut t_seg = 0.0;
-    for (j, push) in problem.pushes.iter().enumerate() {
-        let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-        let h = push.duration / n as f64;
-        let tail_from = ((1.0 - TAIL) * n as f64).floor() as usize;
-        let (mut acc_w, mut acc_w2, mut acc_t) = (0.0, 0.0, 0.0);
-        let mut acc_c = vec![SupportContact::default(); n_sup];
-        let mut max_angle = 0.0f64;
-        let mut max_angle_vs_law = 0.0f64;
-        let mut load_range = vec![[f64::INFINITY, f64::NEG_INFINITY]; n_sup];
-        let vc = push.velocity();
-        for k in 0..n {
-            let t0 = t_seg + k as f64 * h;
-            let t1 = if k + 1 == n {
-                t_seg + push.duration
-            } else {
-                t0 + h
-            };
-            let omega = st.angular[2];
-            let (sn, cs) = (theta + 0.5 * h * omega).sin_cos();
-            let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y, 0.0];
-            let a = world.anchor_world(st.com, theta, anchor);
-            if k > 0 || j > 0 {
-                let p = world.state(world.pusher).com;
-                max_drift = max_drift.max((p[0] - a[0]).hypot(p[1] - a[1]));
-            }
-            world.drive_pusher(a, vel);
-            if !world.step(h) {
-                return Err(ModelError::Integration {
-                    t: t1,
-                    reason: "Jolt: update failed".into(),
-                });
-            }
-            steps += 1;
-            st = world.state(world.object);
-            theta = unwrap(theta, yaw_of(st.rotation));
-            if !(st.com.iter().all(|x| x.is_finite()) && st.angular[2].is_finite()) {
-                return Err(ModelError::NonFinite { t: t1, step: steps });
-            }
-            max_tilt = max_tilt.max(tilt_of(st.rotation));
-            max_lift = max_lift.max((st.com[2] - z_rest).abs());
-            let in_run_tail = 0.5 * (t0 + t1) >= run_from;
-            if in_run_tail && k < tail_from {
-                let c = contacts(&world, (mass, iz), &st, &targets, h)?;
-                for (a, x) in run_n.iter_mut().zip(&c.supports) {
-                    *a += x.normal * h;
-                }
-                run_t += h;
-            }
-            if k >= tail_from {
-                let w = st.angular[2];
-                acc_w += w * h;
-                acc_w2 += w * w * h;
-                acc_t += h;
-                let c = contacts(&world, (mass, iz), &st, &targets, h)?;
-                if in_run_tail {
-                    for (a, x) in run_n.iter_mut().zip(&c.supports) {
-                        *a += x.normal * h;
-                    }
-                    run_t += h;
-                }
-                for (r, x) in load_range.iter_mut().zip(&c.supports) {
-                    r[0] = r[0].min(x.normal);
-                    r[1] = r[1].max(x.normal);
-                }
-                for &(a, l) in &c.angles {
-                    max_angle = max_angle.max(a.abs());
-                    max_angle_vs_law = max_angle_vs_law.max((a - l).abs());
-                }
-                for (a, x) in acc_c.iter_mut().zip(&c.supports) {
-                    a.normal += x.normal * h;
-                    a.twist += x.twist * h;
-                    for q in 0..2 {
-                        a.friction[q] += x.friction[q] * h;
-                        a.slip[q] += x.slip[q] * h;
-                    }
-                }
-            }
-            history.push(StepRecord {
-                segment: j,
-                t0,
-                t1,
-                x: st.com[0],
-                y: st.com[1],
-                theta,
-                omega: st.angular[2],
+    let mut w = Stepper {
+        world,
+        anchor,
+        mass_inertia: (mass, iz),
+        targets,
+        last: None,
+        tail: Tail::new(n_sup),
+        out: Tails::default(),
+    };
+    let cfg = StepLoop {
+        forces_every_step: false,
+        ..StepLoop::new(s.dt, n_sup, z_rest)
+    };
+    let run = stepping::run_pushes(&mut w, problem, &cfg, (st, theta))?;
+    let history = run.records();
+    let tails = w.out;
+    Ok(JoltRun {
+        trajectory: run.trajectory(problem),
+        settings: *s,
+        steps: run.steps,
+        wall_time: Default::default(),
+        mu,
+        rest_loads,
+        loads: support_loads(body, &w.targets, run.loads),
+        manifold_sizes,
+        segment_tail_omega: run.segment_tail_omega,
+        segment_tail_omega_std: run.segment_tail_omega_std,
+        segment_tail_contacts: tails.contacts,
+        segment_tail_max_angle: tails.angle,
+        segment_tail_max_angle_vs_law: tails.angle_law,
+        segment_tail_load_range: tails.load_range,
+        max_tilt: run.max_tilt,
+        max_lift: run.max_lift,
+        max_joint_drift: run.max_joint_drift,
+        history,
+    })
+}
+
+/// The sums of one segment's tail that only Jolt gathers.
+struct Tail {
+    contacts: Vec<SupportContact>,
+    max_angle: f64,
+    max_angle_vs_law: f64,
+    load_range: Vec<[f64; 2]>,
+}
+
+impl Tail {
+    fn new(n_sup: usize) -> Self {
+        Self {
+            contacts: vec![SupportContact::default(); n_sup],
+            max_angle: 0.0,
+            max_angle_vs_law: 0.0,
+            load_range: vec![[f64::INFINITY, f64::NEG_INFINITY]; n_sup],
+        }
+    }
+}
+
+/// Per segment, what [`Tail`] gathered.
+#[derive(Default)]
+struct Tails {
+    contacts: Vec<Vec<SupportContact>>,
+    angle: Vec<f64>,
+    angle_law: Vec<f64>,
+    load_range: Vec<Vec<[f64; 2]>>,
+}
+
+/// The scene as the shared stepping loop sees it.
+struct Stepper {
+    world: World,
+    /// The pusher's anchor in the object's frame.
+    anchor: [f64; 3],
+    mass_inertia: (f64, f64),
+    /// Where the contact points are gathered (object frame).
+    targets: Vec<Vec2>,
+    /// The contacts read after the current step.
+    last: Option<StepContacts>,
+    tail: Tail,
+    out: Tails,
+}
+
+impl PlateWorld for Stepper {
+    /// The object's state and its unwrapped yaw (rad).
+    type State = (BodyState, f64);
+
+    fn plate(&self, (st, theta): &(BodyState, f64)) -> Plate {
+        Plate {
+            x: st.com[0],
+            y: st.com[1],
+            z: st.com[2],
+            theta: *theta,
+            omega: st.angular[2],
+            tilt: tilt_of(st.rotation),
+        }
+    }
+
+    fn drive(&mut self, (st, theta): &(BodyState, f64), vel: [f64; 2], _h: f64) -> f64 {
+        let a = self.world.anchor_world(st.com, *theta, self.anchor);
+        let p = self.world.state(self.world.pusher).com;
+        let drift = (p[0] - a[0]).hypot(p[1] - a[1]);
+        self.world.drive_pusher(a, [vel[0], vel[1], 0.0]);
+        drift
+    }
+
+    fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+        self.last = None;
+        if !self.world.step(h) {
+            return Err(ModelError::Integration {
+                t: t1,
+                reason: "Jolt: update failed".into(),
             });
         }
-        let mean = acc_w / acc_t;
-        tail_omega.push(mean);
-        tail_omega_std.push((acc_w2 / acc_t - mean * mean).max(0.0).sqrt());
-        tail_contacts.push(
-            acc_c
+        Ok(())
+    }
+
+    fn state(&mut self, (_, theta): &(BodyState, f64)) -> (BodyState, f64) {
+        let st = self.world.state(self.world.object);
+        (st, unwrap(*theta, yaw_of(st.rotation)))
+    }
+
+    fn support_forces(
+        &mut self,
+        (st, _): &(BodyState, f64),
+        h: f64,
+    ) -> Result<Option<SupportForces>, ModelError> {
+        let c = contacts(&self.world, self.mass_inertia, st, &self.targets, h)?;
+        let normal = c.supports.iter().map(|x| x.normal).collect();
+        self.last = Some(c);
+        Ok(Some(SupportForces {
+            normal,
+            friction: None,
+        }))
+    }
+
+    fn tail_step(&mut self, _: &(BodyState, f64), h: f64) -> Result<(), ModelError> {
+        let Some(c) = &self.last else {
+            return Ok(());
+        };
+        let tail = &mut self.tail;
+        for (r, x) in tail.load_range.iter_mut().zip(&c.supports) {
+            r[0] = r[0].min(x.normal);
+            r[1] = r[1].max(x.normal);
+        }
+        for &(a, l) in &c.angles {
+            tail.max_angle = tail.max_angle.max(a.abs());
+            tail.max_angle_vs_law = tail.max_angle_vs_law.max((a - l).abs());
+        }
+        for (a, x) in tail.contacts.iter_mut().zip(&c.supports) {
+            a.normal += x.normal * h;
+            a.twist += x.twist * h;
+            for q in 0..2 {
+                a.friction[q] += x.friction[q] * h;
+                a.slip[q] += x.slip[q] * h;
+            }
+        }
+        Ok(())
+    }
+
+    fn end_segment(&mut self, acc_t: f64, _t: f64) -> Result<(), ModelError> {
+        let tail = std::mem::replace(&mut self.tail, Tail::new(self.targets.len()));
+        self.out.contacts.push(
+            tail.contacts
                 .iter()
                 .map(|a| SupportContact {
                     normal: a.normal / acc_t,
@@ -480,49 +525,11 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
                 })
                 .collect(),
         );
-        tail_angle.push(max_angle);
-        tail_angle_law.push(max_angle_vs_law);
-        tail_load_range.push(load_range);
-        t_seg += push.duration;
+        self.out.angle.push(tail.max_angle);
+        self.out.angle_law.push(tail.max_angle_vs_law);
+        self.out.load_range.push(tail.load_range);
+        Ok(())
     }
-    let (samples, segments) = pushval_engine::resample(problem, &history);
-    Ok(JoltRun {
-        trajectory: Trajectory {
-            model: String::new(),
-            samples,
-            segments,
-            stats: SolverStats {
-                rhs_evals: steps,
-                steps,
-                rejected: 0,
-            },
-            ..Default::default()
-        },
-        settings: *s,
-        steps,
-        wall_time: Default::default(),
-        mu,
-        rest_loads,
-        loads: support_loads(
-            body,
-            &targets,
-            run_n
-                .iter()
-                .map(|a| a / run_t.max(f64::MIN_POSITIVE))
-                .collect(),
-        ),
-        manifold_sizes,
-        segment_tail_omega: tail_omega,
-        segment_tail_omega_std: tail_omega_std,
-        segment_tail_contacts: tail_contacts,
-        segment_tail_max_angle: tail_angle,
-        segment_tail_max_angle_vs_law: tail_angle_law,
-        segment_tail_load_range: tail_load_range,
-        max_tilt,
-        max_lift,
-        max_joint_drift: max_drift,
-        history,
-    })
 }
 
 /// The loads of `targets` (feet, or the box's corners) in the problem's

@@ -3,8 +3,10 @@
 use std::time::Instant;
 
 use mujoco_rs::prelude::*;
-use pushval_engine::StepRecord;
-use pushval_model::{ModelError, Problem, Trajectory};
+use pushval_engine::stepping::{
+    self, Plate, PlateWorld, StepClock, StepLoop, SupportForces, TailSteps, TailWeight,
+};
+use pushval_model::{ModelError, Problem};
 
 use crate::scene::{self, CARRIAGE_DOF, OBJECT};
 use crate::{MjStep, MujocoRun, MujocoSettings};
@@ -20,6 +22,7 @@ fn fail(t: f64, reason: String) -> ModelError {
 struct ObjState {
     x: f64,
     y: f64,
+    z: f64,
     /// Yaw in (−π, π].
     yaw: f64,
     /// Rotation matrix (row major).
@@ -44,6 +47,7 @@ fn read(data: &Data) -> ObjState {
     ObjState {
         x: q[0],
         y: q[1],
+        z: q[2],
         yaw: mat[3].atan2(mat[0]),
         mat,
         v: [qv[0], qv[1], qv[2]],
@@ -88,7 +92,7 @@ fn check_warnings(data: &Data, t: f64) -> Result<(), ModelError> {
 
 /// Runs the problem (see the crate docs for the scene).
 pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<MujocoRun, ModelError> {
-    let start = Instant::now();
+    let start_time = Instant::now();
     let body = &problem.body;
     let n = body.len();
     let supports: Vec<(f64, f64, f64)> = body
@@ -176,158 +180,51 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         qv[CARRIAGE_DOF + 2] = 0.0;
     }
 
-    let total_steps: usize = problem
-        .pushes
-        .iter()
-        .map(|p| {
-            (p.duration / settings.timestep * (1.0 - 1e-12))
-                .ceil()
-                .max(1.0) as usize
-        })
-        .sum();
-    let mut history = Vec::with_capacity(total_steps + 1);
-    let tilt_of = |m: &[f64; 9]| m[8].clamp(-1.0, 1.0).acos();
-    let foot_speed = |s: &ObjState| -> f64 {
-        let mut best = f64::INFINITY;
-        for &(px, py, _) in &supports {
-            let l = [px, py, -h];
-            let r = [
-                s.mat[0] * l[0] + s.mat[1] * l[1] + s.mat[2] * l[2],
-                s.mat[3] * l[0] + s.mat[4] * l[1] + s.mat[5] * l[2],
-                s.mat[6] * l[0] + s.mat[7] * l[1] + s.mat[8] * l[2],
-            ];
-            let ux = s.v[0] + s.w[1] * r[2] - s.w[2] * r[1];
-            let uy = s.v[1] + s.w[2] * r[0] - s.w[0] * r[2];
-            best = best.min((ux * ux + uy * uy).sqrt());
-        }
-        best
-    };
-    let mut theta = init.theta + wrap(s0.yaw - init.theta);
-    history.push(MjStep {
-        segment: 0,
-        t: 0.0,
-        x: s0.x,
-        y: s0.y,
+    let theta = init.theta + wrap(s0.yaw - init.theta);
+    let start = MjState {
+        s: read(&data),
         theta,
         omega: if init.from_rest { 0.0 } else { init.omega },
-        tilt: tilt_of(&s0.mat),
-        min_foot_speed: f64::NAN,
-    });
-
-    let mut max_gap = 0.0f64;
-    let mut max_pen = max_penetration(&data);
-    let mut max_tilt = 0.0f64;
-    let mut tail_loads = Vec::with_capacity(problem.pushes.len());
-    let mut tail_omega = Vec::with_capacity(problem.pushes.len());
-    let mut tail_std = Vec::with_capacity(problem.pushes.len());
-    let mut loads = vec![0.0; n];
-    // The run's last fifth (steps whose middle is past it), time-weighted.
-    let run_from = 0.8 * problem.duration();
-    let mut run_load_sum = vec![0.0; n];
-    let mut run_load_t = 0.0;
-    let mut t = 0.0;
-    let mut steps = 0usize;
-    for (j, push) in problem.pushes.iter().enumerate() {
-        let nk = (push.duration / settings.timestep * (1.0 - 1e-12))
-            .ceil()
-            .max(1.0) as usize;
-        let hk = push.duration / nk as f64;
-        data.model_opt_mut().timestep = hk;
-        let tail_from = nk - (nk / 5).max(1);
-        let mut load_sum = vec![0.0; n];
-        let (mut w_sum, mut w2_sum, mut cnt) = (0.0, 0.0, 0usize);
-        let t_seg = t;
-        for k in 0..nk {
-            let s = read(&data);
-            let mid = s.yaw + 0.5 * hk * s.w[2];
-            let c = command(mid, push);
-            {
-                let qv = data.qvel_mut();
-                qv[CARRIAGE_DOF] = c[0];
-                qv[CARRIAGE_DOF + 1] = c[1];
-            }
-            data.step();
-            steps += 1;
-            t = if k + 1 == nk {
-                t_seg + push.duration
-            } else {
-                t_seg + (k + 1) as f64 * hk
-            };
-            let s = read(&data);
-            theta += wrap(s.yaw - theta);
-            if !(s.x.is_finite() && s.y.is_finite() && theta.is_finite() && s.w[2].is_finite()) {
-                return Err(ModelError::NonFinite { t, step: steps });
-            }
-            let tilt = tilt_of(&s.mat);
-            max_tilt = max_tilt.max(tilt);
-            let sx = data.site_xpos();
-            let gap = ((sx[0][0] - sx[1][0]).powi(2)
-                + (sx[0][1] - sx[1][1]).powi(2)
-                + (sx[0][2] - sx[1][2]).powi(2))
-            .sqrt();
-            max_gap = max_gap.max(gap);
-            max_pen = max_pen.max(max_penetration(&data));
-            let in_run_tail = t - 0.5 * hk >= run_from;
-            if k >= tail_from || in_run_tail {
-                foot_loads(&data, n, &mut loads);
-            }
-            if in_run_tail {
-                run_load_sum
-                    .iter_mut()
-                    .zip(&loads)
-                    .for_each(|(a, b)| *a += b * hk);
-                run_load_t += hk;
-            }
-            if k >= tail_from {
-                load_sum.iter_mut().zip(&loads).for_each(|(a, b)| *a += b);
-                w_sum += s.w[2];
-                w2_sum += s.w[2] * s.w[2];
-                cnt += 1;
-            }
-            history.push(MjStep {
-                segment: j,
-                t,
-                x: s.x,
-                y: s.y,
-                theta,
-                omega: s.w[2],
-                tilt,
-                min_foot_speed: foot_speed(&s),
-            });
-        }
-        check_warnings(&data, t)?;
-        let cntf = cnt.max(1) as f64;
-        tail_loads.push(load_sum.iter().map(|v| v / cntf).collect());
-        let mean = w_sum / cntf;
-        tail_omega.push(mean);
-        tail_std.push((w2_sum / cntf - mean * mean).max(0.0).sqrt());
-    }
-
-    // The shared resampler (pose at step ends, ω at step middles: MuJoCo's
-    // Euler is semi-implicit, so the velocity after a step is the one held
-    // over it).
-    let records: Vec<StepRecord> = history
+    };
+    let max_pen = max_penetration(&data);
+    let mut w = Stepper {
+        data: &mut data,
+        supports: &supports,
+        h,
+        loads: vec![0.0; n],
+        max_gap: 0.0,
+        max_pen,
+        foot_speeds: Vec::new(),
+    };
+    let cfg = StepLoop {
+        forces_every_step: false,
+        tail: TailSteps::LastFifth,
+        tail_weight: TailWeight::Steps,
+        clock: StepClock::FromSegmentStart,
+        ..StepLoop::new(settings.timestep, n, 0.0)
+    };
+    let run = stepping::run_pushes(&mut w, problem, &cfg, start)?;
+    let (max_gap, max_pen) = (w.max_gap, w.max_pen);
+    let history: Vec<MjStep> = run
+        .history
         .iter()
-        .enumerate()
-        .map(|(k, r)| StepRecord {
+        .zip(std::iter::once(f64::NAN).chain(w.foot_speeds.iter().copied()))
+        .map(|(r, min_foot_speed)| MjStep {
             segment: r.segment,
-            t0: if k == 0 { r.t } else { history[k - 1].t },
-            t1: r.t,
+            t: r.t1,
             x: r.x,
             y: r.y,
             theta: r.theta,
             omega: r.omega,
+            tilt: r.tilt,
+            min_foot_speed,
         })
         .collect();
-    let (samples, segments) = pushval_engine::resample(problem, &records);
-    let mut trajectory = Trajectory {
-        model: String::new(),
-        samples,
-        segments,
-        ..Default::default()
-    };
-    trajectory.stats.steps = steps;
-    trajectory.stats.rhs_evals = steps;
+
+    // The shared resampler (pose at step ends, ω at step middles: MuJoCo's
+    // Euler is semi-implicit, so the velocity after a step is the one held
+    // over it).
+    let mut trajectory = run.trajectory(problem);
     trajectory.assumptions.min_support_speed = history
         .iter()
         .skip(1)
@@ -339,19 +236,140 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         history,
         rest_loads,
         mu,
-        tail_loads,
-        loads: run_load_sum
-            .iter()
-            .map(|a| a / run_load_t.max(f64::MIN_POSITIVE))
-            .collect(),
-        segment_tail_omega: tail_omega,
-        segment_tail_omega_std: tail_std,
+        tail_loads: run.segment_tail_loads,
+        loads: run.loads,
+        segment_tail_omega: run.segment_tail_omega,
+        segment_tail_omega_std: run.segment_tail_omega_std,
         max_pusher_gap: max_gap,
         max_penetration: max_pen,
-        max_tilt,
-        steps,
-        wall_time: start.elapsed(),
+        max_tilt: run.max_tilt,
+        steps: run.steps,
+        wall_time: start_time.elapsed(),
     })
+}
+
+/// The object as the stepping loop reads it.
+#[derive(Clone, Copy)]
+struct MjState {
+    s: ObjState,
+    /// Yaw, unwrapped (rad).
+    theta: f64,
+    /// The angular velocity recorded for the state (rad/s): MuJoCo's, or at
+    /// the start the initial one.
+    omega: f64,
+}
+
+/// The scene as the shared stepping loop sees it.
+struct Stepper<'a> {
+    data: &'a mut Data,
+    /// Position and friction of each foot.
+    supports: &'a [(f64, f64, f64)],
+    /// Height of the centre of mass (m).
+    h: f64,
+    /// The feet's normal forces after the last step (N).
+    loads: Vec<f64>,
+    max_gap: f64,
+    max_pen: f64,
+    /// Per step, the smallest horizontal speed over the feet (m/s).
+    foot_speeds: Vec<f64>,
+}
+
+impl Stepper<'_> {
+    /// The smallest horizontal speed (m/s) over the feet.
+    fn foot_speed(&self, s: &ObjState) -> f64 {
+        let mut best = f64::INFINITY;
+        for &(px, py, _) in self.supports {
+            let l = [px, py, -self.h];
+            let r = [
+                s.mat[0] * l[0] + s.mat[1] * l[1] + s.mat[2] * l[2],
+                s.mat[3] * l[0] + s.mat[4] * l[1] + s.mat[5] * l[2],
+                s.mat[6] * l[0] + s.mat[7] * l[1] + s.mat[8] * l[2],
+            ];
+            let ux = s.v[0] + s.w[1] * r[2] - s.w[2] * r[1];
+            let uy = s.v[1] + s.w[2] * r[0] - s.w[0] * r[2];
+            best = best.min((ux * ux + uy * uy).sqrt());
+        }
+        best
+    }
+}
+
+impl PlateWorld for Stepper<'_> {
+    type State = MjState;
+
+    fn plate(&self, st: &MjState) -> Plate {
+        Plate {
+            x: st.s.x,
+            y: st.s.y,
+            z: st.s.z,
+            theta: st.theta,
+            omega: st.omega,
+            tilt: tilt_of(&st.s.mat),
+        }
+    }
+
+    /// MuJoCo's yaw (in (−π, π]) at mid-step.
+    fn heading(&self, st: &MjState, h: f64) -> f64 {
+        st.s.yaw + 0.5 * h * st.s.w[2]
+    }
+
+    /// The carriage's velocity; it has no drift to report.
+    fn drive(&mut self, _: &MjState, vel: [f64; 2], _h: f64) -> f64 {
+        let qv = self.data.qvel_mut();
+        qv[CARRIAGE_DOF] = vel[0];
+        qv[CARRIAGE_DOF + 1] = vel[1];
+        0.0
+    }
+
+    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
+        self.data.model_opt_mut().timestep = h;
+        self.data.step();
+        Ok(())
+    }
+
+    fn state(&mut self, prev: &MjState) -> MjState {
+        let s = read(self.data);
+        MjState {
+            s,
+            theta: prev.theta + wrap(s.yaw - prev.theta),
+            omega: s.w[2],
+        }
+    }
+
+    fn finite(&self, st: &MjState) -> bool {
+        st.s.x.is_finite() && st.s.y.is_finite() && st.theta.is_finite() && st.s.w[2].is_finite()
+    }
+
+    fn after_step(&mut self, st: &MjState) {
+        let sx = self.data.site_xpos();
+        let gap = ((sx[0][0] - sx[1][0]).powi(2)
+            + (sx[0][1] - sx[1][1]).powi(2)
+            + (sx[0][2] - sx[1][2]).powi(2))
+        .sqrt();
+        self.max_gap = self.max_gap.max(gap);
+        self.max_pen = self.max_pen.max(max_penetration(self.data));
+        let speed = self.foot_speed(&st.s);
+        self.foot_speeds.push(speed);
+    }
+
+    fn support_forces(
+        &mut self,
+        _: &MjState,
+        _h: f64,
+    ) -> Result<Option<SupportForces>, ModelError> {
+        foot_loads(self.data, self.supports.len(), &mut self.loads);
+        Ok(Some(SupportForces {
+            normal: self.loads.clone(),
+            friction: None,
+        }))
+    }
+
+    fn end_segment(&mut self, _count: f64, t: f64) -> Result<(), ModelError> {
+        check_warnings(self.data, t)
+    }
+}
+
+fn tilt_of(m: &[f64; 9]) -> f64 {
+    m[8].clamp(-1.0, 1.0).acos()
 }
 
 /// `a` wrapped into (−π, π].

@@ -6,11 +6,11 @@ use std::sync::{Arc, Mutex};
 use physx::material::Material;
 use physx::prelude::*;
 use physx::traits::Class;
-use pushval_engine::StepRecord;
-use pushval_model::{ModelError, Problem, SolverStats, Trajectory};
+use pushval_engine::stepping::{self, Plate, PlateWorld, StepLoop, SupportForces, TAIL};
+use pushval_model::{ModelError, Problem};
 
 use crate::sys;
-use crate::{FootContacts, FrictionType, PhysxRun, PhysxSettings, PxStep};
+use crate::{FootContacts, FrictionType, PhysxRun, PhysxSettings};
 
 type PxMaterial = physx::material::PxMaterial<()>;
 /// Shape user data: the foot's index + 1 (0 for the ground).
@@ -36,9 +36,6 @@ type PxScene = physx::scene::PxScene<
 
 const OBJECT: usize = 1;
 const PUSHER: usize = 2;
-
-/// Fraction of a phase's steps, at its end, over which tail means are taken.
-const TAIL: f64 = 0.2;
 
 /// PhysX keeps one foundation per process: runs take turns.
 static FOUNDATION: Mutex<()> = Mutex::new(());
@@ -441,152 +438,101 @@ impl World {
             state.omega = init.omega;
         }
 
-        let p0 = state.position();
-        let mut history = vec![PxStep {
-            segment: 0,
-            t0: 0.0,
-            t1: 0.0,
-            x: p0[0],
-            y: p0[1],
-            z: p0[2],
-            theta: state.theta,
-            omega: state.omega,
-            tilt: state.tilt,
-        }];
-        let mut steps = 0usize;
-        let mut max_tilt = 0.0f64;
-        let mut max_lift = 0.0f64;
-        let mut max_drift = 0.0f64;
-        let mut min_loads = vec![f64::INFINITY; n_feet];
-        let mut tail_omega = Vec::new();
-        let mut tail_omega_std = Vec::new();
-        let mut tail_loads = Vec::new();
-        let mut tail_force = Vec::new();
-        // The run's last fifth (steps whose middle is past it), time-weighted.
-        let run_from = (1.0 - TAIL) * problem.duration();
-        let (mut run_n, mut run_t) = (vec![0.0; n_feet], 0.0);
-        let mut t_seg = 0.0;
-        for (j, push) in problem.pushes.iter().enumerate() {
-            let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-            let h = push.duration / n as f64;
-            let tail_from = ((1.0 - TAIL) * n as f64).floor() as usize;
-            let (mut acc_w, mut acc_w2, mut acc_t) = (0.0, 0.0, 0.0);
-            let mut acc_n = vec![0.0; n_feet];
-            let mut acc_f = [0.0; 2];
-            let vc = push.velocity();
-            for k in 0..n {
-                let t0 = t_seg + k as f64 * h;
-                let t1 = if k + 1 == n {
-                    t_seg + push.duration
-                } else {
-                    t0 + h
-                };
-                let (sn, cs) = (state.theta + 0.5 * h * state.omega).sin_cos();
-                let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y];
-                let drift = self.drive(&state, vel, h);
-                if k > 0 || j > 0 {
-                    max_drift = max_drift.max(drift);
-                }
-                let loads = self.step(h, t1)?;
-                steps += 1;
-                state = read(self.scene(), state.theta);
-                let p = state.position();
-                if !(p.iter().all(|x| x.is_finite()) && state.omega.is_finite()) {
-                    return Err(ModelError::NonFinite { t: t1, step: steps });
-                }
-                for (m, &f) in min_loads.iter_mut().zip(&loads) {
-                    *m = m.min(f);
-                }
-                max_tilt = max_tilt.max(state.tilt);
-                max_lift = max_lift.max((p[2] - z_rest).abs());
-                if 0.5 * (t0 + t1) >= run_from {
-                    for (a, l) in run_n.iter_mut().zip(&loads) {
-                        *a += l * h;
-                    }
-                    run_t += h;
-                }
-                if k >= tail_from {
-                    acc_w += state.omega * h;
-                    acc_w2 += state.omega * state.omega * h;
-                    acc_t += h;
-                    for (a, l) in acc_n.iter_mut().zip(&loads) {
-                        *a += l * h;
-                    }
-                    // The object feels the opposite of the force on the
-                    // pusher; turned into the object frame.
-                    let f = self
-                        .joint
-                        .as_ref()
-                        .map_or([0.0; 3], |j| j.force_on_pusher());
-                    let (sn, cs) = state.theta.sin_cos();
-                    acc_f[0] -= (cs * f[0] + sn * f[1]) * h;
-                    acc_f[1] -= (-sn * f[0] + cs * f[1]) * h;
-                }
-                history.push(PxStep {
-                    segment: j,
-                    t0,
-                    t1,
-                    x: p[0],
-                    y: p[1],
-                    z: p[2],
-                    theta: state.theta,
-                    omega: state.omega,
-                    tilt: state.tilt,
-                });
-            }
-            let mean = acc_w / acc_t;
-            tail_omega.push(mean);
-            tail_omega_std.push((acc_w2 / acc_t - mean * mean).max(0.0).sqrt());
-            tail_loads.push(acc_n.iter().map(|a| a / acc_t).collect());
-            tail_force.push([acc_f[0] / acc_t, acc_f[1] / acc_t]);
-            t_seg += push.duration;
-        }
-        let records: Vec<StepRecord> = history.iter().map(record).collect();
-        let (samples, segments) = pushval_engine::resample(problem, &records);
+        let cfg = StepLoop::new(s.dt, n_feet, z_rest);
+        let mut w = Stepper {
+            world: self,
+            loads: Vec::new(),
+            acc_f: [0.0; 2],
+            tail_force: Vec::new(),
+        };
+        let run = stepping::run_pushes(&mut w, problem, &cfg, state)?;
         Ok(PhysxRun {
-            trajectory: Trajectory {
-                model: String::new(),
-                samples,
-                segments,
-                stats: SolverStats {
-                    rhs_evals: steps,
-                    steps,
-                    rejected: 0,
-                },
-                ..Default::default()
-            },
+            trajectory: run.trajectory(problem),
             settings: *s,
-            steps,
+            steps: run.steps,
             wall_time: Default::default(),
             mu,
             engine_friction: settled.loads.iter().map(|n| mu * n).collect(),
             rest_loads: settled.loads,
-            segment_tail_omega: tail_omega,
-            segment_tail_omega_std: tail_omega_std,
-            segment_tail_loads: tail_loads,
-            loads: run_n
-                .iter()
-                .map(|a| a / run_t.max(f64::MIN_POSITIVE))
-                .collect(),
-            segment_tail_pusher_force: tail_force,
-            min_loads,
-            max_tilt,
-            max_lift,
-            max_joint_drift: max_drift,
-            history,
+            segment_tail_omega: run.segment_tail_omega,
+            segment_tail_omega_std: run.segment_tail_omega_std,
+            segment_tail_loads: run.segment_tail_loads,
+            loads: run.loads,
+            segment_tail_pusher_force: w.tail_force,
+            min_loads: run.min_loads,
+            max_tilt: run.max_tilt,
+            max_lift: run.max_lift,
+            max_joint_drift: run.max_joint_drift,
+            history: run.history,
         })
     }
 }
 
-/// The shared resampler's view of a step.
-fn record(r: &PxStep) -> StepRecord {
-    StepRecord {
-        segment: r.segment,
-        t0: r.t0,
-        t1: r.t1,
-        x: r.x,
-        y: r.y,
-        theta: r.theta,
-        omega: r.omega,
+/// The scene as the shared stepping loop sees it.
+struct Stepper<'a> {
+    world: &'a mut World,
+    /// The feet's normal forces over the last step (N).
+    loads: Vec<f64>,
+    /// The current segment's tail integral of the pusher's force on the
+    /// object (object frame, N s).
+    acc_f: [f64; 2],
+    /// Per segment, that force's tail mean (N).
+    tail_force: Vec<[f64; 2]>,
+}
+
+impl PlateWorld for Stepper<'_> {
+    type State = State;
+
+    fn plate(&self, st: &State) -> Plate {
+        let p = st.position();
+        Plate {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+            theta: st.theta,
+            omega: st.omega,
+            tilt: st.tilt,
+        }
+    }
+
+    fn drive(&mut self, st: &State, vel: [f64; 2], h: f64) -> f64 {
+        self.world.drive(st, vel, h)
+    }
+
+    fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+        self.loads = self.world.step(h, t1)?;
+        Ok(())
+    }
+
+    fn state(&mut self, prev: &State) -> State {
+        read(self.world.scene(), prev.theta)
+    }
+
+    fn support_forces(&mut self, _: &State, _h: f64) -> Result<Option<SupportForces>, ModelError> {
+        Ok(Some(SupportForces {
+            normal: self.loads.clone(),
+            friction: None,
+        }))
+    }
+
+    fn tail_step(&mut self, st: &State, h: f64) -> Result<(), ModelError> {
+        // The object feels the opposite of the force on the pusher; turned
+        // into the object frame.
+        let f = self
+            .world
+            .joint
+            .as_ref()
+            .map_or([0.0; 3], |j| j.force_on_pusher());
+        let (sn, cs) = st.theta.sin_cos();
+        self.acc_f[0] -= (cs * f[0] + sn * f[1]) * h;
+        self.acc_f[1] -= (-sn * f[0] + cs * f[1]) * h;
+        Ok(())
+    }
+
+    fn end_segment(&mut self, acc_t: f64, _t: f64) -> Result<(), ModelError> {
+        self.tail_force
+            .push([self.acc_f[0] / acc_t, self.acc_f[1] / acc_t]);
+        self.acc_f = [0.0; 2];
+        Ok(())
     }
 }

@@ -249,28 +249,9 @@ impl From<&Rapier3dSettings> for predict::SceneParams {
     }
 }
 
-/// One engine step: time, pose at its end, the angular velocity held over it.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Step3d {
-    /// Push segment of the step.
-    pub segment: usize,
-    /// Start time (s); equal to `t1` for the initial record.
-    pub t0: f64,
-    /// End time (s).
-    pub t1: f64,
-    /// World x of the centre of mass at `t1` (m).
-    pub x: f64,
-    /// World y of the centre of mass at `t1` (m).
-    pub y: f64,
-    /// World z (up) of the centre of mass at `t1` (m).
-    pub z: f64,
-    /// Yaw at `t1`, unwrapped (rad).
-    pub theta: f64,
-    /// Vertical angular velocity over the step (rad/s).
-    pub omega: f64,
-    /// Tilt of the body's z axis from the vertical at `t1` (rad).
-    pub tilt: f64,
-}
+/// One engine step: time, pose at its end, the angular velocity held over
+/// it, height and tilt (the shared stepping loop's record).
+pub use pushval_engine::stepping::PlateStep as Step3d;
 
 /// A 3-D run: the sampled trajectory and what the engine did.
 #[derive(Debug, Clone, PartialEq)]

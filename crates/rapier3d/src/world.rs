@@ -2,12 +2,12 @@
 
 use std::f64::consts::{PI, TAU};
 
-use pushval_engine::StepRecord;
-use pushval_model::{ModelError, Problem, SolverStats, Trajectory};
+use pushval_engine::stepping::{self, Plate, PlateWorld, StepLoop, SupportForces};
+use pushval_model::{ModelError, Problem};
 use rapier3d_f64::prelude::*;
 
 use crate::predict::{Scene, SceneParams};
-use crate::{ContactFriction, FeetColliders, Rapier3dRun, Rapier3dSettings, Step3d};
+use crate::{ContactFriction, FeetColliders, Rapier3dRun, Rapier3dSettings};
 
 /// Natural frequency (Hz) of the pusher joint's softness: rigid at every
 /// step length used here (rapier's default, 1e6 Hz, leaves it slightly soft
@@ -16,9 +16,6 @@ const JOINT_FREQUENCY: f64 = 1.0e9;
 
 /// Half-size (m) of the ground cuboid's top face, around the start position.
 const GROUND_HALF: f64 = 1.0e3;
-
-/// Fraction of a segment's steps, at its end, over which tail means are taken.
-const TAIL: f64 = 0.2;
 
 /// The prediction scene of `problem` (μ_i from the rest loads): the law
 /// crate's [`Scene::of`] with the settings' plain parameters.
@@ -118,11 +115,84 @@ fn nearest(points: &[[f64; 2]], x: f64, y: f64) -> usize {
     best.0
 }
 
+/// The scene as the shared stepping loop sees it.
+struct Scene3d {
+    world: PhysicsWorld,
+    object: RigidBodyHandle,
+    pusher: RigidBodyHandle,
+    /// The pusher joint's anchor in the object's frame.
+    anchor_local: Vector,
+    feet: Feet,
+    /// Height of the centre of mass above the ground (m).
+    h_cm: f64,
+}
+
+impl PlateWorld for Scene3d {
+    type State = State;
+
+    fn plate(&self, st: &State) -> Plate {
+        let tr = st.pose.translation;
+        Plate {
+            x: tr.x,
+            y: tr.y,
+            z: tr.z,
+            theta: st.theta,
+            omega: st.omega,
+            tilt: st.tilt,
+        }
+    }
+
+    /// Re-pins the pusher on the object's contact point and sets its velocity.
+    fn drive(&mut self, st: &State, vel: [f64; 2], _h: f64) -> f64 {
+        self.pin(st, v3(vel[0], vel[1], 0.0))
+    }
+
+    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
+        self.world.integration_parameters.dt = h;
+        self.world.step();
+        Ok(())
+    }
+
+    fn state(&mut self, prev: &State) -> State {
+        read(&self.world, self.object, prev.theta)
+    }
+
+    fn support_forces(&mut self, _st: &State, h: f64) -> Result<Option<SupportForces>, ModelError> {
+        let (normal, friction, _, _) = self.feet.forces(&self.world, h);
+        Ok(Some(SupportForces {
+            normal,
+            friction: Some(friction),
+        }))
+    }
+
+    fn slip(&self, st: &State, i: usize) -> Option<f64> {
+        let rb = &self.world.bodies[self.object];
+        let p = self.feet.points[i];
+        let wp = st.pose.transform_point(v3(p[0], p[1], -self.h_cm));
+        let u = rb.velocity_at_point(wp);
+        Some((u.x * u.x + u.y * u.y).sqrt())
+    }
+}
+
+impl Scene3d {
+    /// Re-pins the pusher on the object's contact point and sets its
+    /// velocity; returns how far it was from that point (m, horizontal).
+    fn pin(&mut self, st: &State, vel: Vector) -> f64 {
+        let anchor = st.pose.transform_point(self.anchor_local);
+        let p = &mut self.world.bodies[self.pusher];
+        let before = p.translation();
+        let drift = ((before.x - anchor.x).powi(2) + (before.y - anchor.y).powi(2)).sqrt();
+        p.set_translation(anchor, true);
+        p.set_linvel(vel, true);
+        p.set_angvel(Vector::ZERO, true);
+        drift
+    }
+}
+
 /// Runs the problem.
 pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier3dRun, ModelError> {
     let scene = scene_of(problem, s)?;
     let nominal_loads = scene.rest_loads();
-    let body = &problem.body;
     let init = problem.initial;
     let n_feet = scene.points.len();
     let pc = scene.contact;
@@ -228,29 +298,25 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         .contacts_enabled(false)
         .softness(SpringCoefficients::new(JOINT_FREQUENCY, 1.0));
     world.insert_impulse_joint(pusher, object, joint);
-
-    // Re-pins the pusher on the object's contact point and sets its velocity.
-    let drive = |world: &mut PhysicsWorld, st: &State, vel: Vector| -> f64 {
-        let anchor = st.pose.transform_point(anchor_local);
-        let p = &mut world.bodies[pusher];
-        let before = p.translation();
-        let drift = ((before.x - anchor.x).powi(2) + (before.y - anchor.y).powi(2)).sqrt();
-        p.set_translation(anchor, true);
-        p.set_linvel(vel, true);
-        p.set_angvel(Vector::ZERO, true);
-        drift
+    let mut w = Scene3d {
+        world,
+        object,
+        pusher,
+        anchor_local,
+        feet,
+        h_cm,
     };
 
     // Settle with the pusher at rest.
-    let mut state = read(&world, object, init.theta);
+    let mut state = read(&w.world, object, init.theta);
     let settle_steps = (s.settle_time / s.dt).ceil() as usize;
     let mut rest = (vec![0.0; n_feet], vec![0.0; n_feet], 0, 0);
-    world.integration_parameters.dt = s.dt;
+    w.world.integration_parameters.dt = s.dt;
     for _ in 0..settle_steps {
-        drive(&mut world, &state, Vector::ZERO);
-        world.step();
-        state = read(&world, object, state.theta);
-        rest = feet.forces(&world, s.dt);
+        w.pin(&state, Vector::ZERO);
+        w.world.step();
+        state = read(&w.world, object, state.theta);
+        rest = w.feet.forces(&w.world, s.dt);
     }
     let (rest_loads, _, manifolds, manifold_points) = rest;
     let z_rest = state.pose.translation.z;
@@ -261,7 +327,7 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         let vc = p.velocity();
         let local = [vc.x + init.omega * pc[1], vc.y - init.omega * pc[0]];
         let (sn, cs) = state.theta.sin_cos();
-        let rb = &mut world.bodies[object];
+        let rb = &mut w.world.bodies[object];
         let vz = rb.linvel().z;
         rb.set_linvel(
             v3(
@@ -275,158 +341,27 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         state.omega = init.omega;
     }
 
-    let mut history = Vec::new();
-    history.push(Step3d {
-        segment: 0,
-        t0: 0.0,
-        t1: 0.0,
-        x: state.pose.translation.x,
-        y: state.pose.translation.y,
-        z: state.pose.translation.z,
-        theta: state.theta,
-        omega: state.omega,
-        tilt: state.tilt,
-    });
-    let mut steps = 0usize;
-    let mut max_tilt = 0.0f64;
-    let mut max_lift = 0.0f64;
-    let mut max_drift = 0.0f64;
-    let mut min_loads = vec![f64::INFINITY; n_feet];
-    let mut tail_omega = Vec::new();
-    let mut tail_loads = Vec::new();
-    let mut tail_friction = Vec::new();
-    let mut tail_slip = Vec::new();
-    // The run's last fifth (steps whose middle is past it), time-weighted.
-    let run_from = (1.0 - TAIL) * problem.duration();
-    let (mut run_n, mut run_t) = (vec![0.0; n_feet], 0.0);
-    let mut t_seg = 0.0;
-    for (j, push) in problem.pushes.iter().enumerate() {
-        let n = (push.duration / s.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-        let h = push.duration / n as f64;
-        world.integration_parameters.dt = h;
-        let tail_from = ((1.0 - TAIL) * n as f64).floor() as usize;
-        let mut acc_w = 0.0;
-        let mut acc_t = 0.0;
-        let mut acc_n = vec![0.0; n_feet];
-        let mut acc_f = vec![0.0; n_feet];
-        let mut min_slip = vec![f64::INFINITY; n_feet];
-        let vc = push.velocity();
-        for k in 0..n {
-            let t0 = t_seg + k as f64 * h;
-            let t1 = if k + 1 == n {
-                t_seg + push.duration
-            } else {
-                t0 + h
-            };
-            let (sn, cs) = (state.theta + 0.5 * h * state.omega).sin_cos();
-            let vel = v3(cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y, 0.0);
-            let drift = drive(&mut world, &state, vel);
-            if k > 0 || j > 0 {
-                max_drift = max_drift.max(drift);
-            }
-            world.step();
-            steps += 1;
-            state = read(&world, object, state.theta);
-            let tr = state.pose.translation;
-            if !(tr.x.is_finite()
-                && tr.y.is_finite()
-                && tr.z.is_finite()
-                && state.omega.is_finite())
-            {
-                return Err(ModelError::NonFinite { t: t1, step: steps });
-            }
-            let (normal, friction, _, _) = feet.forces(&world, h);
-            for (m, &f) in min_loads.iter_mut().zip(&normal) {
-                *m = m.min(f);
-            }
-            max_tilt = max_tilt.max(state.tilt);
-            max_lift = max_lift.max((tr.z - z_rest).abs());
-            if 0.5 * (t0 + t1) >= run_from {
-                for (a, &f) in run_n.iter_mut().zip(&normal) {
-                    *a += f * h;
-                }
-                run_t += h;
-            }
-            if k >= tail_from {
-                acc_w += state.omega * h;
-                acc_t += h;
-                let rb = &world.bodies[object];
-                for i in 0..n_feet {
-                    acc_n[i] += normal[i] * h;
-                    acc_f[i] += friction[i] * h;
-                    let p = scene.points[i];
-                    let wp = state.pose.transform_point(v3(p[0], p[1], -h_cm));
-                    let u = rb.velocity_at_point(wp);
-                    min_slip[i] = min_slip[i].min((u.x * u.x + u.y * u.y).sqrt());
-                }
-            }
-            history.push(Step3d {
-                segment: j,
-                t0,
-                t1,
-                x: tr.x,
-                y: tr.y,
-                z: tr.z,
-                theta: state.theta,
-                omega: state.omega,
-                tilt: state.tilt,
-            });
-        }
-        tail_omega.push(acc_w / acc_t);
-        tail_loads.push(acc_n.iter().map(|a| a / acc_t).collect());
-        tail_friction.push(acc_f.iter().map(|a| a / acc_t).collect());
-        tail_slip.push(min_slip);
-        t_seg += push.duration;
-    }
-    let records: Vec<StepRecord> = history.iter().map(record).collect();
-    let (samples, segments) = pushval_engine::resample(problem, &records);
-    let trajectory = Trajectory {
-        model: String::new(),
-        samples,
-        segments,
-        stats: SolverStats {
-            rhs_evals: steps,
-            steps,
-            rejected: 0,
-        },
-        ..Default::default()
-    };
-    let _ = body;
+    let cfg = StepLoop::new(s.dt, n_feet, z_rest);
+    let run = stepping::run_pushes(&mut w, problem, &cfg, state)?;
     Ok(Rapier3dRun {
-        trajectory,
+        trajectory: run.trajectory(problem),
         settings: *s,
-        steps,
+        steps: run.steps,
         wall_time: Default::default(),
         mu: scene.mu.clone(),
         nominal_loads,
         rest_loads,
-        segment_tail_omega: tail_omega,
-        segment_tail_loads: tail_loads,
-        loads: run_n
-            .iter()
-            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
-            .collect(),
-        segment_tail_friction: tail_friction,
-        segment_tail_min_slip: tail_slip,
-        min_loads,
-        max_tilt,
-        max_lift,
-        max_joint_drift: max_drift,
+        segment_tail_omega: run.segment_tail_omega,
+        segment_tail_loads: run.segment_tail_loads,
+        loads: run.loads,
+        segment_tail_friction: run.segment_tail_friction,
+        segment_tail_min_slip: run.segment_tail_min_slip,
+        min_loads: run.min_loads,
+        max_tilt: run.max_tilt,
+        max_lift: run.max_lift,
+        max_joint_drift: run.max_joint_drift,
         manifolds,
         manifold_points,
-        history,
+        history: run.history,
     })
-}
-
-/// The shared resampler's view of a step.
-fn record(r: &Step3d) -> StepRecord {
-    StepRecord {
-        segment: r.segment,
-        t0: r.t0,
-        t1: r.t1,
-        x: r.x,
-        y: r.y,
-        theta: r.theta,
-        omega: r.omega,
-    }
 }
