@@ -26,6 +26,11 @@
 //! mass: no turn). The information only grows with the duration (one more
 //! sample adds a positive semi-definite term), so bisection over whole
 //! sample steps finds the shortest duration exactly.
+//!
+//! Why one file of about 1,060 lines: the grid, the Fisher analysis per
+//! point, the repeated noisy fits that check it and the `fit.md` writer share
+//! one row type and one check list; split, every piece would import the
+//! others' types, and the answer `fit.md` gives would be spread over files.
 
 use std::f64::consts::FRAC_PI_4;
 use std::path::{Path, PathBuf};

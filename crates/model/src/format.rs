@@ -29,6 +29,10 @@
 //! The writer writes the header `model,t,x,y,theta,omega` and every number
 //! in Rust's shortest round-trip form, so reading a written file gives back
 //! the same `f64`s.
+//!
+//! Why one file of a little over 800 lines: 630 of them are the reader, the
+//! writer and the ω derivation, which share the column rules and the error
+//! type; the rest are their tests.
 
 use std::io::{self, BufRead, Write};
 
