@@ -342,6 +342,35 @@ fn main() {
         ));
     }
 
+    // The main job (`pushval` with no command: every shipped scenario,
+    // pushval's own pure-Python engines as sessions) as a user runs it: the
+    // release binary from the repository's root, whole process, wall time.
+    let bin = root().join("target/release/pushval");
+    if bin.is_file() {
+        let mut runs_ok = true;
+        let wall = time(if quick { 2 } else { 5 }, || {
+            let st = Command::new(&bin)
+                .current_dir(root())
+                .env_remove("CI")
+                .output()
+                .expect("the pushval binary runs");
+            runs_ok &= st.status.success();
+        });
+        assert!(runs_ok, "the main job failed while timed");
+        put(
+            &mut rows,
+            "main_job_wall",
+            wall,
+            format!(
+                "target/release/pushval (the main job: {} scenarios, the pure-Python engines as sessions), whole process, {} cores",
+                std::fs::read_dir(root().join("scenarios")).map_or(0, |d| d.count()),
+                std::thread::available_parallelism().map_or(1, |n| n.get())
+            ),
+        );
+    } else {
+        eprintln!("outside_overhead: no target/release/pushval; main_job_wall not measured (cargo build --release first)");
+    }
+
     let mut csv_text = String::from("quantity,median,min,unit,note\n");
     for (name, med, min, unit, note) in &rows {
         csv_text.push_str(&format!(
