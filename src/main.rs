@@ -212,6 +212,10 @@ enum Command {
         /// Only the paper scenario at 1 m/s, coarser bisection (for tests).
         #[arg(long)]
         quick: bool,
+        /// Draw OUT/gate_power.svg again from OUT/gate_power.csv (nothing
+        /// measured).
+        #[arg(long, conflicts_with = "quick")]
+        replot: bool,
     },
     /// Print the pushval-problem JSON document an outside engine receives
     /// for this scenario (adapters/pushval-problem-1.schema.json, or -2 with
@@ -503,7 +507,10 @@ fn main() -> ExitCode {
             engine,
             protocol,
         }) => problem(file, dt, engine, protocol),
-        Some(Command::Power { out, quick }) => pushval::power::cli(&out, quick),
+        Some(Command::Power {
+            out, replot: true, ..
+        }) => pushval::power::replot(&out),
+        Some(Command::Power { out, quick, .. }) => pushval::power::cli(&out, quick),
         Some(Command::Fit {
             file,
             trajectory,

@@ -21,7 +21,7 @@ use pushval_scenario::Scenario;
 use crate::harness::{
     compare_trajectory, run_scenario, Figures, Resolved, RunOptions, SegmentInfo, SteadyRead,
 };
-use crate::plot::{Axis, Figure, Legend, Panel, Series, Stroke};
+use crate::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
 
 use crate::inject::inject;
 pub use crate::inject::ErrorKind;
@@ -397,7 +397,6 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
             Axis::log("smallest magnitude caught"),
         )
         .legend(Legend::Outside);
-        let styles = crate::plot::family_styles(&engines);
         for (k, e) in engines.iter().enumerate() {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -407,9 +406,9 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
                     r.both().map(|m| (i, m))
                 })
                 .collect();
-            // Markers only (a scenario is a category, not a curve), one
-            // colour per engine family.
-            p = p.series(Series::new(*e, styles[k].0, Stroke::Dots).points(pts));
+            // Markers only (a scenario is a category, not a curve): one
+            // colour per gated engine and mode, so that markers tell apart.
+            p = p.series(Series::new(*e, PALETTE[k % PALETTE.len()], Stroke::Dots).points(pts));
         }
         if let Some(t) = kind.target() {
             let n = scenarios.len().max(2) as f64 - 1.0;
@@ -434,6 +433,78 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
             ..Default::default()
         }),
     })
+}
+
+/// The rows of a `gate_power.csv` this module wrote (for `--replot`): every
+/// figure the chart draws, read back at the precision the file keeps.
+pub fn read_csv(path: &Path) -> anyhow::Result<Vec<Row>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .with_context(|| format!("{}: line 1: no column `{name}`", path.display()))
+    };
+    let (isc, ien, iki, ipl, imi, ico, itp, itt, ito, idt, iwa, ili) = (
+        col("scenario")?,
+        col("engine")?,
+        col("kind")?,
+        col("smallest_caught_plus")?,
+        col("smallest_caught_minus")?,
+        col("smallest_caught_by_compare")?,
+        col("tolerance_position_m")?,
+        col("tolerance_theta_rad")?,
+        col("tolerance_omega_rel")?,
+        col("engine_dt_s")?,
+        col("gate_wall_time_s")?,
+        col("linear_estimate")?,
+    );
+    let mut rows = Vec::new();
+    for (n, line) in lines.enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let at = |i: usize| f.get(i).copied().unwrap_or_default();
+        let num = |i: usize| at(i).parse::<f64>().ok();
+        let kind = ErrorKind::ALL
+            .into_iter()
+            .find(|k| k.name() == at(iki))
+            .with_context(|| {
+                format!(
+                    "{}: line {}: column `kind`: unknown `{}`",
+                    path.display(),
+                    n + 2,
+                    at(iki)
+                )
+            })?;
+        rows.push(Row {
+            scenario: at(isc).to_string(),
+            engine: at(ien).to_string(),
+            kind,
+            plus: num(ipl),
+            minus: num(imi),
+            compare: num(ico),
+            tolerance: Figures {
+                position_max: num(itp).unwrap_or(f64::NAN),
+                theta_max: num(itt).unwrap_or(f64::NAN),
+                omega_steady_rel: num(ito).unwrap_or(f64::NAN),
+            },
+            dt: num(idt).unwrap_or(f64::NAN),
+            gate_seconds: num(iwa).unwrap_or(f64::NAN),
+            linear: num(ili),
+        });
+    }
+    Ok(rows)
+}
+
+/// `pushval power --replot`: OUT/gate_power.svg drawn again from
+/// OUT/gate_power.csv, nothing measured.
+pub fn replot(out: &Path) -> anyhow::Result<std::process::ExitCode> {
+    let rows = read_csv(&out.join("gate_power.csv"))?;
+    crate::atomic::write_atomic(&out.join("gate_power.svg"), figure(&rows)?.as_bytes())?;
+    println!("wrote {}", out.join("gate_power.svg").display());
+    Ok(std::process::ExitCode::SUCCESS)
 }
 
 /// `pushval power`: measure and write OUT/gate_power.{csv,svg}.
