@@ -45,7 +45,7 @@ impl MujocoModel {
         };
         // Semi-implicit Euler: first order. Options: `cm_height` and
         // `push_height` (m, >= 0; [`MujocoSettings`]).
-        let info = EngineInfo::new(
+        EngineInfo::new(
             name,
             description,
             "pushval-mujoco",
@@ -61,8 +61,7 @@ impl MujocoModel {
                 "build with --features mujoco (and run scripts/setup-mujoco.sh for libmujoco.so)"
                     .into(),
             )
-        });
-        info
+        })
     }
 }
 

@@ -48,7 +48,7 @@ impl PhysxModel {
             }
         };
         // Symplectic Euler with the pusher at the mid-step heading: first order.
-        let info = EngineInfo::new(
+        EngineInfo::new(
             settings.friction.model_name(),
             description,
             "pushval-physx",
@@ -69,8 +69,7 @@ impl PhysxModel {
             Ok(())
         } else {
             Err("build with --features physx (needs clang++: apt-get install clang)".into())
-        });
-        info
+        })
     }
 }
 

@@ -43,7 +43,7 @@ impl Rapier3dModel {
             ),
         };
         // Symplectic Euler with the pusher at the mid-step heading: first order.
-        let info = EngineInfo::new(
+        EngineInfo::new(
             name,
             description,
             "pushval-rapier3d",
@@ -51,8 +51,7 @@ impl Rapier3dModel {
             1.0,
             settings.dt,
         )
-        .with_options(OptionKeys::Listed(&["feet", "cm_height", "push_height"]));
-        info
+        .with_options(OptionKeys::Listed(&["feet", "cm_height", "push_height"]))
     }
 }
 
