@@ -37,7 +37,8 @@ pub const THRESHOLD_CAP: f64 = 1e-3;
 /// The columns of `coulomb_fit.csv` after `schedule`.
 pub const COLUMNS: &str = "dt,mu_scale,mu_scale_std,cof_x,cof_y,inertia_cm,inertia_cm_std,start_position_rms,start_theta_rms,position_rms,theta_rms,engine_error_position,engine_error_theta,converged,fitted";
 /// Values in a fit's row (the columns above less `fitted`, plus three
-/// flags: centre of friction fitted, I_cm fitted, degenerate).
+/// flags: centre of friction fitted, I_cm fitted, and which parameters are
+/// near zero: 1 the μ scale, 2 I_cm, 3 both, 0 none).
 pub const WIDTH: usize = 17;
 
 fn rms_difference(a: &[Sample], b: &[Sample]) -> [f64; 2] {
@@ -126,27 +127,44 @@ pub fn fit_engine(engine: &dyn Engine, k: usize, study_dt: f64) -> anyhow::Resul
         flag(f.converged),
         flag(set.contains(&Param::CenterOfFriction)),
         flag(set.contains(&Param::InertiaCm)),
-        flag(!f.degenerate.is_empty()),
+        // Which fitted parameters are near zero: 1 μ scale, 2 I_cm (a sum).
+        f.degenerate
+            .iter()
+            .map(|why| {
+                if why.starts_with(Param::MuScale.name()) {
+                    1.0
+                } else if why.starts_with(Param::InertiaCm.name()) {
+                    2.0
+                } else {
+                    0.0
+                }
+            })
+            .sum(),
     ])
 }
 
 /// Why a row is degenerate (empty when it is not): the fitted μ scale or
 /// I_cm near zero ([`crate::fit::degenerate_reasons`]).
 pub fn degenerate_reason(row: &[f64]) -> String {
-    if row[16] != 1.0 {
-        return String::new();
-    }
+    let bits = row[16] as u32;
     let mut why = Vec::new();
-    if !(row[1] > crate::fit::NEAR_ZERO) {
+    if bits & 1 != 0 {
+        why.push(format!("mu_scale {:.2e} (a frictionless plate)", row[1]));
+    }
+    if bits & 2 != 0 {
         why.push(format!(
-            "mu_scale {:.2e} ~ 0 (a frictionless plate)",
-            row[1]
+            "inertia_cm {:.2e} kg m^2 (a massless plate)",
+            row[5]
         ));
     }
-    if row[15] == 1.0 {
-        why.push(format!("inertia_cm {:.2e} kg m^2", row[5]));
+    if why.is_empty() {
+        return String::new();
     }
-    format!("parameters near zero: {}", why.join(", "))
+    format!(
+        "near zero (at most {} x the file's value): {}",
+        crate::fit::NEAR_ZERO,
+        why.join(", ")
+    )
 }
 
 /// `[position, θ]` thresholds of a row: `max(10 e, 1e-6)`.
@@ -156,7 +174,7 @@ pub fn thresholds(row: &[f64]) -> [f64; 2] {
 
 /// The verdict of a row (see the module doc).
 pub fn verdict(row: &[f64]) -> &'static str {
-    if row[16] == 1.0 {
+    if row[16] > 0.0 {
         return "degenerate";
     }
     let t = thresholds(row);
