@@ -179,7 +179,7 @@ fn main() {
         &mut rows,
         "parse_resample",
         time(runs * 10, || {
-            let recs = csv::read(&text).unwrap();
+            let recs = csv::read(&text, problem.body.len()).unwrap();
             let history = history_from_rows(&problem, &recs).unwrap();
             trajectory_from_steps("pure_python", &problem, &history)
         }),
@@ -392,7 +392,7 @@ fn main() {
     });
     c.bench_function("outside/parse_resample", |b| {
         b.iter(|| {
-            let recs = csv::read(&text).unwrap();
+            let recs = csv::read(&text, problem.body.len()).unwrap();
             let history = history_from_rows(&problem, &recs).unwrap();
             trajectory_from_steps("pure_python", &problem, &history)
         })

@@ -115,9 +115,16 @@ pub const LOADS: usize = 4;
 /// Values of a run's row: ω of the engine, of Coulomb and of the law
 /// (rad/s), the law's class code ([`class_code`]) and its rest moments,
 /// then [`LOADS`] support loads measured by the engine and as many
-/// predicted by the law (N; NaN where unknown), and the engine's angle at
-/// the end of the run (rad).
-pub const RUN_WIDTH: usize = 8 + 2 * LOADS;
+/// predicted by the law (N; NaN where unknown), the engine's angle at the
+/// end of the run (rad), then what the run's own loads give
+/// ([`LAW_RUN`]): the law's ω on them (tail mean, rad/s), the RMS of the
+/// engine's ω against it over the tail (rad/s), the largest rise (m) and the
+/// share of steps with a support out of contact.
+pub const RUN_WIDTH: usize = 12 + 2 * LOADS;
+
+/// Index in a run's row of `omega_law_run`; `law_run_rms`, `max_rise_m` and
+/// `contact_lost_share` follow it.
+pub const LAW_RUN: usize = 8 + 2 * LOADS;
 
 /// A sweep of the study file, ready to run.
 pub struct SweepPlan {
@@ -476,7 +483,54 @@ fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
     }
     let end = run.as_ref().and_then(|r| r.trajectory.samples.last());
     row.push(end.map_or(f64::NAN, |s| s.theta));
+    let contact = run.as_ref().and_then(|r| Some((r, r.contact.as_ref()?)));
+    let (law_run, rms) = match (contact, law) {
+        (Some((r, c)), Some(law)) => law_on_run_loads(law, p, seg, dt, tail, r, c),
+        _ => (f64::NAN, f64::NAN),
+    };
+    row.extend([
+        law_run,
+        rms,
+        contact.map_or(f64::NAN, |(_, c)| c.max_rise_m),
+        contact.map_or(f64::NAN, |(_, c)| c.contact_lost_share),
+    ]);
     row
+}
+
+/// The law on the run's own loads over the tail of segment `seg` (the
+/// samples of its last `tail` share): the mean of the law's steady ω at
+/// each sample's loads (`omega_law_run`, rad/s) and the RMS of the engine's
+/// ω against those values (rad/s). The law is taken quasi-statically: at
+/// each sample, the steady ω its friction rule gives with that sample's
+/// loads (no transient between samples). NaN where the engine's loads do
+/// not cover the supports or the law has no steady state on them.
+fn law_on_run_loads(
+    law: &dyn pushval_engine::FrictionLaw,
+    p: &Problem,
+    seg: usize,
+    dt: f64,
+    tail: f64,
+    run: &pushval_engine::EngineRun,
+    contact: &pushval_engine::ContactRecord,
+) -> (f64, f64) {
+    let (t0, t1) = p.segment_times()[seg];
+    let from = t1 - tail * (t1 - t0);
+    let (mut sum, mut sq, mut n) = (0.0, 0.0, 0usize);
+    for (s, loads) in run.trajectory.samples.iter().zip(&contact.loads) {
+        if s.t < from - 1e-12 || s.t > t1 + 1e-12 {
+            continue;
+        }
+        let Some(w) = law.steady_on_loads(p, seg, dt, loads) else {
+            return (f64::NAN, f64::NAN);
+        };
+        sum += w.omega;
+        sq += (s.omega - w.omega).powi(2);
+        n += 1;
+    }
+    if n == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    (sum / n as f64, (sq / n as f64).sqrt())
 }
 
 /// The engine against a reference ω: relative with the gate's floor

@@ -6,13 +6,14 @@ use std::path::Path;
 
 use super::plate::{froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
 use super::records::{num, parse, Records};
-use super::{class_name, err, fit, opt, Plan, Task, LOADS, RUN_WIDTH};
+use super::{class_name, err, fit, opt, Plan, Task, LAW_RUN, LOADS};
 use crate::outdir::Writer;
 
 /// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
-/// within 1e-2 of the law, turns, locked, semi_stable)`.
-pub fn map_stats(map: &Records) -> [usize; 7] {
-    let mut s = [0; 7];
+/// within 1e-2 of the law, turns, locked, semi_stable, with the law on the
+/// run's loads, within 1e-2 of it)`.
+pub fn map_stats(map: &Records) -> [usize; 9] {
+    let mut s = [0; 9];
     for r in map {
         let (we, wc, wl) = (
             num(r, "omega_engine"),
@@ -25,6 +26,11 @@ pub fn map_stats(map: &Records) -> [usize; 7] {
         if wl.is_finite() {
             s[2] += 1;
             s[3] += usize::from(err(we, wl, wc, speed) <= 1e-2);
+        }
+        let wr = num(r, "omega_law_run");
+        if wr.is_finite() {
+            s[7] += 1;
+            s[8] += usize::from(err(we, wr, wc, speed) <= 1e-2);
         }
         match r.get("class").map(String::as_str) {
             Some("turns") => s[4] += 1,
@@ -44,6 +50,15 @@ fn pct(a: usize, b: usize) -> String {
     }
 }
 
+/// A share as a percentage, `–` where undefined.
+fn share(v: f64) -> String {
+    if v.is_finite() {
+        format!("{:.2} %", 100.0 * v)
+    } else {
+        "–".into()
+    }
+}
+
 /// `f` to 4 significant digits, `–` where undefined.
 fn sig(v: f64) -> String {
     if v.is_finite() {
@@ -57,13 +72,31 @@ fn run_line(r: &[f64]) -> String {
     format!("{},{},{}", opt(r[0]), opt(r[1]), opt(r[2]))
 }
 
+/// The columns of what the run's own loads give (empty where the engine
+/// measures no loads): header and values.
+const LAW_RUN_HEAD: &str = "omega_law_run,law_run_rms,max_rise_m,contact_lost_share";
+
+fn law_run_line(r: &[f64]) -> String {
+    r[LAW_RUN..LAW_RUN + 4]
+        .iter()
+        .map(|v| opt(*v))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
 fn map_csv(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], setup: usize) -> String {
-    let mut s = String::from("froude,phi,omega_engine,omega_coulomb,omega_law,class\n");
+    let mut s = format!("froude,phi,omega_engine,omega_coulomb,omega_law,class,{LAW_RUN_HEAD}\n");
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Map { s: k, i, j } = *t {
             if k == setup {
                 let (fr, phi) = (frs(plan.quick)[i], phis(plan.quick)[j]);
-                let _ = writeln!(s, "{fr},{phi},{},{}", run_line(r), class_name(r[3]));
+                let _ = writeln!(
+                    s,
+                    "{fr},{phi},{},{},{}",
+                    run_line(r),
+                    class_name(r[3]),
+                    law_run_line(r)
+                );
             }
         }
     }
@@ -80,10 +113,16 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             .map(|(t, r)| (*t, r))
             .collect()
     };
-    let mut paper = String::from("speed,omega_engine,omega_coulomb,omega_law\n");
+    let mut paper = format!("speed,omega_engine,omega_coulomb,omega_law,{LAW_RUN_HEAD}\n");
     for (t, r) in rows_of(&|t| matches!(t, Task::Table { s: 0, .. })) {
         if let Task::Table { v, .. } = t {
-            let _ = writeln!(paper, "{},{}", TABLE_SPEEDS[v], run_line(r));
+            let _ = writeln!(
+                paper,
+                "{},{},{}",
+                TABLE_SPEEDS[v],
+                run_line(r),
+                law_run_line(r)
+            );
         }
     }
     w.file("paper_plate.csv", paper.as_bytes())?;
@@ -318,7 +357,7 @@ fn sweeps(
                 class,
                 opt(ec),
                 opt(el),
-                opt(r[RUN_WIDTH - 1])
+                opt(r[LAW_RUN - 1])
             );
             let _ = write!(
                 md,
@@ -432,23 +471,31 @@ fn readme(
     let _ = write!(
         s,
         "## Paper plate (`paper_plate.csv`)\n\nφ = π/4 + 0.3 = {PHI_TABLE:.4} rad. Error against Coulomb: relative to ω*; against the law: relative, or |ω|/|ω*| where the law holds ω = 0.\n\n\
-         | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law |\n|---|---|---|---|---|---|\n"
+         ω law is the law with the problem's statics (`omega_law`); ω law, run's loads (`omega_law_run`) is the law's steady ω at each sample's loads as the engine measured them, averaged over the tail, and RMS its RMS distance from the engine's ω(t) there (quasi-static: no transient between samples). \
+         Rise: the centre of mass's largest height above its resting height; lost: the share of steps with a support carrying no load (≤ 1e-6 m g). Empty where the engine measures no loads.\n\n\
+         | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law | ω law, run's loads | vs it | RMS (rad/s) | rise (m) | lost |\n|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     for r in parse(paper) {
-        let (v, we, wc, wl) = (
+        let (v, we, wc, wl, wr) = (
             num(&r, "speed"),
             num(&r, "omega_engine"),
             num(&r, "omega_coulomb"),
             num(&r, "omega_law"),
+            num(&r, "omega_law_run"),
         );
         let _ = writeln!(
             s,
-            "| {v} | {} | {} | {} | {} | {} |",
+            "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             sig(we),
             sig(wc),
             sig(wl),
             sig(err(we, wc, wc, v)),
-            sig(err(we, wl, wc, v))
+            sig(err(we, wl, wc, v)),
+            sig(wr),
+            sig(err(we, wr, wc, v)),
+            sig(num(&r, "law_run_rms")),
+            sig(num(&r, "max_rise_m")),
+            share(num(&r, "contact_lost_share"))
         );
     }
     let mut map_section = |name: &str, file: &str, text: &str| {
@@ -456,7 +503,7 @@ fn readme(
         let _ = write!(
             s,
             "\n## (Fr, φ) map{name} (`{file}`)\n\n{} cells, Fr from {} to {} (log), φ from {:.2} to {:.2} rad. \
-             Within 1e-2 of Coulomb: {}. Within 1e-2 of the engine's law: {}. The law's class: turns {}, locked {}, semi_stable {}.\n",
+             Within 1e-2 of Coulomb: {}. Within 1e-2 of the engine's law with the problem's loads (`omega_law`): {}; with the run's own loads (`omega_law_run`): {}. The law's class: turns {}, locked {}, semi_stable {}.\n",
             st[0],
             frs(plan.quick)[0],
             frs(plan.quick)[frs(plan.quick).len() - 1],
@@ -464,6 +511,7 @@ fn readme(
             phis(plan.quick)[phis(plan.quick).len() - 1],
             pct(st[1], st[0]),
             pct(st[3], st[2]),
+            pct(st[8], st[7]),
             st[4],
             st[5],
             st[6]
@@ -558,7 +606,7 @@ pub fn index(root: &Path, models: &[String], quick: bool, w: &mut Writer) -> any
     if quick {
         s.push_str("**Quick run: reduced grids (for tests).**\n\n");
     }
-    s.push_str("| model | ω engine (rad/s) | ω* Coulomb | ω law | map within 1e-2 of Coulomb | of the law | locked / semi-stable cells |\n|---|---|---|---|---|---|---|\n");
+    s.push_str("| model | ω engine (rad/s) | ω* Coulomb | ω law | map within 1e-2 of Coulomb | of the law | of the law on the run's loads | locked / semi-stable cells |\n|---|---|---|---|---|---|---|---|\n");
     for m in models {
         let read = |f: &str| std::fs::read_to_string(root.join(m).join(f)).ok();
         let (Some(paper), Some(map)) = (read("paper_plate.csv"), read("map.csv")) else {
@@ -576,12 +624,13 @@ pub fn index(root: &Path, models: &[String], quick: bool, w: &mut Writer) -> any
         let st = map_stats(&parse(&map));
         let _ = writeln!(
             s,
-            "| [{m}]({m}/README.md) | {} | {} | {} | {} | {} | {} / {} |",
+            "| [{m}]({m}/README.md) | {} | {} | {} | {} | {} | {} | {} / {} |",
             sig(num(r, "omega_engine")),
             sig(num(r, "omega_coulomb")),
             sig(num(r, "omega_law")),
             pct(st[1], st[0]),
             pct(st[3], st[2]),
+            pct(st[8], st[7]),
             st[5],
             st[6]
         );

@@ -190,6 +190,7 @@ impl Engine for Avian2dModel {
                 "max_joint_drift": r.max_joint_drift,
             }),
             trajectory: r.trajectory,
+            contact: None,
         })
     }
 }
@@ -235,6 +236,7 @@ impl Engine for Avian3dModel {
                 "loads": r.loads,
             }),
             trajectory: r.trajectory,
+            contact: r.contact,
         })
     }
 }

@@ -318,6 +318,9 @@ pub struct Avian3dRun {
     /// The time-weighted mean normal force of each foot over the last fifth
     /// of the run (N), in support order: the engine diagnostics' `"loads"`.
     pub loads: Vec<f64>,
+    /// The feet's loads at every sample, the largest rise and the share of
+    /// steps with a foot out of contact (the engine run's `contact`).
+    pub contact: Option<pushval_engine::ContactRecord>,
     /// Largest tilt of the object (rad): angle between its vertical axis and
     /// the world's.
     pub max_tilt: f64,

@@ -369,6 +369,9 @@ pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, 
         omega: state.omega,
     }];
     let n_feet = scene.feet.len();
+    // Loads per sample and the rise, measured from the settled height.
+    let z_rest = state.position.z;
+    let mut recorder = pushval_engine::LoadRecorder::new(problem, n_feet, pushval_laws::GRAVITY);
     let mut tail_loads = Vec::with_capacity(problem.pushes.len());
     // The run's last fifth (steps whose middle is past it), time-weighted.
     let run_from = 0.8 * problem.duration();
@@ -408,6 +411,12 @@ pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, 
                 .map_or(DVec3::NAN, |p| p.0);
             let gap = anchor - state.position - state.rotation * scene.anchor;
             max_drift = max_drift.max(gap.x.hypot(gap.y));
+            recorder.step(
+                t1,
+                h,
+                Some(&loads(app.world(), &scene.feet, h)),
+                Some(state.position.z - z_rest),
+            );
             if 0.5 * (t0 + t1) >= tail_from {
                 add_loads(app.world(), &scene.feet, h, h, &mut acc);
                 acc_t += h;
@@ -445,6 +454,7 @@ pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, 
             .iter()
             .map(|a| a / run_t.max(f64::MIN_POSITIVE))
             .collect(),
+        contact: recorder.finish(),
         max_tilt,
         max_joint_drift: max_drift,
         steps,

@@ -140,6 +140,7 @@ impl Engine for Box2dModel {
         })
         .run(problem)?;
         Ok(EngineRun {
+            contact: None,
             dt,
             steps: r.steps,
             wall_time: r.wall_time,

@@ -21,14 +21,18 @@ use std::time::Duration;
 
 use pushval_model::{ModelError, Problem, Trajectory};
 
+mod contact;
 mod options;
 mod resample;
 pub mod stepping;
 
+pub use contact::{ContactRecord, LoadRecorder, LOST_SHARE_OF_WEIGHT};
 pub use options::{EngineOptions, OptionError, SceneFrame};
 /// The friction laws in closed form live in `pushval-laws`; re-exported so
 /// that `pushval_engine::FrictionLaw` and its companions keep their paths.
-pub use pushval_laws::{coulomb_steady, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB};
+pub use pushval_laws::{
+    coulomb_steady, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB, GRAVITY,
+};
 pub use resample::{
     resample, sample, segment_reports, step_tail_omega, tail_mean_omega, trajectory_from_steps,
     StepRecord,
@@ -51,6 +55,11 @@ pub struct EngineRun {
     /// each support's load (N, in the problem's support order) averaged over
     /// the last fifth of the run ([`tail_loads`] reads it).
     pub diagnostics: serde_json::Value,
+    /// The supports' loads at every sample, the largest rise and the share
+    /// of steps with a support out of contact, where the engine measures
+    /// loads (None for the 2-D engines and outside engines whose rows carry
+    /// no `load_i` columns).
+    pub contact: Option<ContactRecord>,
 }
 
 /// The measured support loads of a run (N): its diagnostics' `"loads"`

@@ -33,6 +33,7 @@
 
 use pushval_model::{ModelError, Problem, SolverStats, Trajectory, Vec2};
 
+use crate::contact::{ContactRecord, LoadRecorder};
 use crate::resample::{resample, StepRecord};
 
 /// Fraction of a segment's steps (and of the run), at its end, over which
@@ -224,8 +225,9 @@ pub struct StepLoop {
     pub supports: usize,
     /// Height of the centre of mass the lift is measured from (m).
     pub z_rest: f64,
-    /// Read the support forces after every step (for the smallest loads);
-    /// otherwise only on the steps of the segment tails and the run tail.
+    /// Take the smallest loads over every step; otherwise only over the
+    /// steps of the segment tails and the run tail. (The forces themselves
+    /// are read on every step, for the per-sample loads.)
     pub forces_every_step: bool,
     /// Which steps make a segment's tail.
     pub tail: TailSteps,
@@ -284,6 +286,10 @@ pub struct Stepped {
     /// Each support's time-weighted mean normal force over the run's last
     /// fifth (N).
     pub loads: Vec<f64>,
+    /// The loads at every sample, the largest rise above `z_rest` and the
+    /// share of steps with a support out of contact (None where the world
+    /// reports no support forces).
+    pub contact: Option<ContactRecord>,
 }
 
 impl Stepped {
@@ -329,6 +335,7 @@ pub fn run_pushes<W: PlateWorld>(
     let run_from = (1.0 - TAIL) * problem.duration();
     let (mut run_n, mut run_t) = (vec![0.0; n_sup], 0.0);
     let mut t_seg = 0.0;
+    let mut recorder = LoadRecorder::new(problem, n_sup, pushval_laws::GRAVITY);
     for (j, push) in problem.pushes.iter().enumerate() {
         let n = (push.duration / cfg.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
         let h = push.duration / n as f64;
@@ -379,14 +386,20 @@ pub fn run_pushes<W: PlateWorld>(
                 StepClock::FromStepStart => 0.5 * (t0 + t1) >= run_from,
                 StepClock::FromSegmentStart => t1 - 0.5 * h >= run_from,
             };
-            let forces = if cfg.forces_every_step || in_tail || in_run_tail {
-                world.support_forces(&state, h)?
-            } else {
-                None
-            };
+            // Forces are read on every step (for the per-sample loads);
+            // the smallest loads are taken where the world asks for them.
+            let forces = world.support_forces(&state, h)?;
+            recorder.step(
+                t1,
+                h,
+                forces.as_ref().map(|f| f.normal.as_slice()),
+                Some(p.z - cfg.z_rest),
+            );
             if let Some(f) = &forces {
-                for (m, &l) in out.min_loads.iter_mut().zip(&f.normal) {
-                    *m = m.min(l);
+                if cfg.forces_every_step || in_tail || in_run_tail {
+                    for (m, &l) in out.min_loads.iter_mut().zip(&f.normal) {
+                        *m = m.min(l);
+                    }
                 }
                 if in_run_tail {
                     for (a, &l) in run_n.iter_mut().zip(&f.normal) {
@@ -434,6 +447,7 @@ pub fn run_pushes<W: PlateWorld>(
         .iter()
         .map(|a| a / run_t.max(f64::MIN_POSITIVE))
         .collect();
+    out.contact = recorder.finish();
     Ok(out)
 }
 

@@ -139,6 +139,7 @@ impl Engine for JoltModel {
             wall_time: r.wall_time,
             diagnostics,
             trajectory: r.trajectory,
+            contact: r.contact,
         })
     }
 }

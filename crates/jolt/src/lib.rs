@@ -214,6 +214,10 @@ pub struct JoltRun {
     /// supports' loads when every support sits on a corner of the box, and
     /// None otherwise.
     pub loads: Option<Vec<f64>>,
+    /// The supports' loads at every sample (empty where the box's corners
+    /// are not the supports, as for [`JoltRun::loads`]), the largest rise
+    /// and the share of steps with a contact point out of contact.
+    pub contact: Option<pushval_engine::ContactRecord>,
     /// Number of manifolds between the object and the floor after the
     /// settle phase, and their sizes (contact points each).
     pub manifold_sizes: Vec<usize>,

@@ -371,6 +371,14 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
     let run = stepping::run_pushes(&mut w, problem, &cfg, (st, theta))?;
     let history = run.records();
     let tails = w.out;
+    let contact = run.contact.map(|mut c| {
+        c.loads = std::mem::take(&mut c.loads)
+            .into_iter()
+            .map(|l| support_loads(body, &w.targets, l))
+            .collect::<Option<Vec<_>>>()
+            .unwrap_or_default();
+        c
+    });
     Ok(JoltRun {
         trajectory: run.trajectory(problem),
         settings: *s,
@@ -379,6 +387,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         mu,
         rest_loads,
         loads: support_loads(body, &w.targets, run.loads),
+        contact,
         manifold_sizes,
         segment_tail_omega: run.segment_tail_omega,
         segment_tail_omega_std: run.segment_tail_omega_std,

@@ -309,6 +309,16 @@ impl FrictionLaw for Avian3dTilt {
         let scene = PlateScene::new(problem, self.plate).ok()?;
         scene.steady(push, 0.0).map(|(_, loads)| loads)
     }
+    /// Coulomb along −u at every foot with the given loads.
+    fn steady_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        dt: f64,
+        loads: &[f64],
+    ) -> Option<LawSteady> {
+        crate::COULOMB.steady(&crate::on_loads(problem, loads)?, segment, dt)
+    }
 }
 
 #[cfg(test)]

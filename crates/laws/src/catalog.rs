@@ -561,4 +561,63 @@ mod tests {
             );
         }
     }
+
+    /// A law fed back its own predicted loads gives its own steady ω: the
+    /// run's-loads evaluation and the law's load prediction meet at the
+    /// law's fixed point. Checked on the plate with its centre of mass
+    /// raised (the loads move) for every law whose loads are its own.
+    #[test]
+    fn a_law_on_its_own_loads_is_itself() {
+        let p = plate_problem();
+        let mut checked = 0;
+        for e in catalog() {
+            let mut params = Map::new();
+            if e.params.iter().any(|s| s.name == "cm_height") {
+                params.insert("cm_height".into(), Value::from(0.02));
+            }
+            let law = e.build(&params).unwrap();
+            let (Some(own), Some(loads)) = (law.steady(&p, 0, 1e-3), law.loads(&p, 0, 1e-3)) else {
+                continue;
+            };
+            let Some(fed) = law.steady_on_loads(&p, 0, 1e-3, &loads) else {
+                panic!("{}: no steady state on its own loads {loads:?}", e.name);
+            };
+            assert!(
+                (fed.omega - own.omega).abs() <= 1e-6 * own.omega.abs().max(1e-3),
+                "{}: {} on its own loads vs {}",
+                e.name,
+                fed.omega,
+                own.omega
+            );
+            checked += 1;
+        }
+        assert!(checked >= 5, "only {checked} laws predict loads");
+    }
+
+    /// The plate's own statics (m g / 4 a foot) as a run's loads change
+    /// nothing; moving load onto the two feet nearest the pusher changes
+    /// Coulomb's ω, and a load list of the wrong length is refused.
+    #[test]
+    fn coulomb_on_loads() {
+        let p = plate_problem();
+        let rest = vec![9.81 / 4.0; 4];
+        let a = crate::COULOMB.steady(&p, 0, 1e-3).unwrap().omega;
+        let b = crate::COULOMB
+            .steady_on_loads(&p, 0, 1e-3, &rest)
+            .unwrap()
+            .omega;
+        assert!((a - b).abs() < 1e-12 * a.abs(), "{a} vs {b}");
+        // The pushed corner (−h, −h) and its neighbours carry more: the
+        // friction moment about the contact shrinks, the plate turns faster.
+        let moved = [3.0, 2.5, 1.905, 2.405];
+        let c = crate::COULOMB
+            .steady_on_loads(&p, 0, 1e-3, &moved)
+            .unwrap()
+            .omega;
+        assert!(c.abs() > a.abs(), "{c} vs {a}");
+        assert!(crate::COULOMB
+            .steady_on_loads(&p, 0, 1e-3, &rest[..3])
+            .is_none());
+        assert!(crate::on_loads(&p, &[1.0, -1.0, 1.0, 1.0]).is_none());
+    }
 }

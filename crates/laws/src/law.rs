@@ -8,7 +8,7 @@
 //! engine with it and with Coulomb. An engine that applies Coulomb's law
 //! returns [`COULOMB`], an engine with no closed form returns `None`.
 
-use pushval_model::{Problem, SegmentDynamics};
+use pushval_model::{Body, Problem, SegmentDynamics, Support};
 
 /// What ω = 0 is under a law, for a run that starts there.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,6 +85,64 @@ pub trait FrictionLaw: Send + Sync {
     fn loads(&self, _problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
         None
     }
+    /// The steady state of segment `segment` with the supports carrying
+    /// `loads` (N, the problem's support order) instead of the problem's
+    /// statics: the law's friction rule fed a run's own loads. The default
+    /// suits laws that take their loads from the problem: it evaluates
+    /// [`FrictionLaw::steady`] on [`on_loads`]. A law that predicts its own
+    /// loads overrides it (with its friction rule at the given loads) or
+    /// returns None.
+    fn steady_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        dt: f64,
+        loads: &[f64],
+    ) -> Option<LawSteady> {
+        self.steady(&on_loads(problem, loads)?, segment, dt)
+    }
+}
+
+/// Gravity (m/s²) of every engine scene pushval builds, and so the weight
+/// `m g` whose statics give a problem's rest loads.
+pub const GRAVITY: f64 = 9.81;
+
+/// `problem` with its supports carrying `loads` (N) instead of their rest
+/// loads: each support's friction `μ_i N_i` is scaled by `N_i / N_i^rest`,
+/// the rest loads being the statics of the weight `m g`
+/// ([`crate::mujoco::rest_loads`], the split every engine scene is
+/// calibrated with), so each support keeps its μ. None where the loads are
+/// not one finite, non-negative number per support or a support with
+/// friction has no load at rest.
+pub fn on_loads(problem: &Problem, loads: &[f64]) -> Option<Problem> {
+    let body = &problem.body;
+    if loads.len() != body.len() || loads.iter().any(|n| !n.is_finite() || *n < 0.0) {
+        return None;
+    }
+    let rest = crate::mujoco::rest_loads(body, body.mass() * GRAVITY)?;
+    let mut supports = Vec::with_capacity(body.len());
+    for ((s, &n), &r) in body.supports().zip(loads).zip(&rest) {
+        let friction = if s.friction == 0.0 {
+            0.0
+        } else if r > 0.0 {
+            s.friction * n / r
+        } else {
+            return None;
+        };
+        supports.push(Support {
+            position: s.position,
+            friction,
+        });
+    }
+    // A support may carry no load; the body needs some friction somewhere.
+    if supports.iter().all(|s| s.friction == 0.0) {
+        return None;
+    }
+    let body = Body::new(body.mass(), body.inertia_cm(), body.contact(), &supports).ok()?;
+    Some(Problem {
+        body,
+        ..problem.clone()
+    })
 }
 
 /// Coulomb friction at every support: the analytic model's own law.

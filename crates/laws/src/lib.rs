@@ -32,4 +32,6 @@ pub mod physx;
 pub mod rapier3d;
 
 pub use catalog::{catalog, law_entry, LawEntry, Loads, ParamError, ParamKind, ParamSpec};
-pub use law::{coulomb_steady, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB};
+pub use law::{
+    coulomb_steady, on_loads, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB, GRAVITY,
+};

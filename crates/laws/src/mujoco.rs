@@ -320,4 +320,15 @@ impl crate::FrictionLaw for MujocoElliptic {
     fn loads(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<Vec<f64>> {
         self.transfer(problem, segment).map(|(_, loads)| loads)
     }
+    /// Coulomb at every foot with the given loads (the transfer is what the
+    /// run's loads already hold).
+    fn steady_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        dt: f64,
+        loads: &[f64],
+    ) -> Option<LawSteady> {
+        COULOMB.steady(&crate::on_loads(problem, loads)?, segment, dt)
+    }
 }

@@ -675,7 +675,45 @@ impl FrictionLaw for PhysxClamp {
     }
     fn steady(&self, problem: &Problem, segment: usize, _dt: f64) -> Option<LawSteady> {
         let push = problem.pushes.get(segment)?;
-        let body = &self.engine_body(problem)?;
+        self.steady_of(&self.engine_body(problem)?, push)
+    }
+    /// PhysX's loads at rest ([`pgs_rest_loads`]: the PGS split of `m g`
+    /// over the feet, in the supports' order). The centre of mass and the
+    /// pusher are on the floor's plane, so the push moves no load.
+    fn loads(&self, problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
+        Some(self.rest_loads(problem))
+    }
+    /// The rows and caps at the run's loads: every foot's cap `μ̄ N_i` with
+    /// the given `N_i` in place of the rest loads.
+    fn steady_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        _dt: f64,
+        loads: &[f64],
+    ) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let body = &problem.body;
+        if loads.len() != body.len() || loads.iter().any(|n| !n.is_finite() || *n < 0.0) {
+            return None;
+        }
+        let mu = body.total_friction() / (body.mass() * self.gravity);
+        let supports: Vec<Support> = body
+            .supports()
+            .zip(loads)
+            .map(|(s, n)| Support {
+                position: s.position,
+                friction: mu * n,
+            })
+            .collect();
+        let body = Body::new(body.mass(), body.inertia_cm(), body.contact(), &supports).ok()?;
+        self.steady_of(&body, push)
+    }
+}
+
+impl PhysxClamp {
+    /// The law's steady state for `body` (its caps the supports' friction).
+    fn steady_of(&self, body: &Body, push: &Push) -> Option<LawSteady> {
         let points: Vec<[f64; 2]> = body
             .supports()
             .map(|s| [s.position.x, s.position.y])
@@ -698,11 +736,5 @@ impl FrictionLaw for PhysxClamp {
             omega: steady_from_rest(body, push, law).omega,
             class,
         })
-    }
-    /// PhysX's loads at rest ([`pgs_rest_loads`]: the PGS split of `m g`
-    /// over the feet, in the supports' order). The centre of mass and the
-    /// pusher are on the floor's plane, so the push moves no load.
-    fn loads(&self, problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
-        Some(self.rest_loads(problem))
     }
 }

@@ -340,28 +340,7 @@ pub fn predict_steady(
     let mut iterations = 0;
     for it in 0..200 {
         iterations = it + 1;
-        let body = scene.body(&loads)?;
-        let (w, friction) = match law {
-            Law::Coulomb => {
-                let w = coulomb_steady(&body, push, 0.0).ok_or(ModelError::Integration {
-                    t: 0.0,
-                    reason: "no steady state".into(),
-                })?;
-                (w, SegmentDynamics::new(&body, push).friction_force(w))
-            }
-            Law::SimplifiedOneManifold => {
-                let mu = scene.mu[0];
-                let w = simplified_steady(&scene.points, &loads, mu, &body, push);
-                (
-                    w,
-                    simplified_friction(&scene.points, &loads, mu, push, &body, w),
-                )
-            }
-            Law::EffectiveMassDisk => {
-                let w = effective_mass_steady(scene, &loads, push);
-                (w, effective_mass_forces(scene, &loads, push, w).1)
-            }
-        };
+        let (w, friction) = omega_at_loads(scene, push, law, &loads)?;
         omega = w;
         if !coupled {
             break;
@@ -383,6 +362,38 @@ pub fn predict_steady(
         loads,
         moment,
         iterations,
+    })
+}
+
+/// The law's steady ω (rad/s) with the feet carrying `loads` (N), and the
+/// resultant friction force it holds there (N).
+pub fn omega_at_loads(
+    scene: &Scene,
+    push: &Push,
+    law: Law,
+    loads: &[f64],
+) -> Result<(f64, Vec2), ModelError> {
+    let body = scene.body(loads)?;
+    Ok(match law {
+        Law::Coulomb => {
+            let w = coulomb_steady(&body, push, 0.0).ok_or(ModelError::Integration {
+                t: 0.0,
+                reason: "no steady state".into(),
+            })?;
+            (w, SegmentDynamics::new(&body, push).friction_force(w))
+        }
+        Law::SimplifiedOneManifold => {
+            let mu = scene.mu[0];
+            let w = simplified_steady(&scene.points, loads, mu, &body, push);
+            (
+                w,
+                simplified_friction(&scene.points, loads, mu, push, &body, w),
+            )
+        }
+        Law::EffectiveMassDisk => {
+            let w = effective_mass_steady(scene, loads, push);
+            (w, effective_mass_forces(scene, loads, push, w).1)
+        }
     })
 }
 
@@ -651,5 +662,33 @@ impl FrictionLaw for Rapier3dTilt {
         predict_steady(&scene, push, self.law, true)
             .ok()
             .map(|p| p.loads)
+    }
+    /// The law's friction rule with the feet carrying the given loads (no
+    /// tilting balance: the loads are the run's).
+    fn steady_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        _dt: f64,
+        loads: &[f64],
+    ) -> Option<LawSteady> {
+        let push = problem.pushes.get(segment)?;
+        let scene = Scene::of(problem, &self.scene).ok()?;
+        if loads.len() != scene.points.len() || loads.iter().any(|n| !n.is_finite() || *n < 0.0) {
+            return None;
+        }
+        let (omega, _) = omega_at_loads(&scene, push, self.law, loads).ok()?;
+        let locked = self.law == Law::SimplifiedOneManifold && {
+            let body = scene.body(loads).ok()?;
+            simplified_locks(&scene.points, loads, scene.mu[0], &body, push)
+        };
+        Some(LawSteady {
+            omega,
+            class: if locked {
+                LawClass::Locked
+            } else {
+                LawClass::Turns
+            },
+        })
     }
 }

@@ -143,6 +143,7 @@ impl Engine for MujocoModel {
                 "loads": r.loads,
             }),
             trajectory: r.trajectory,
+            contact: r.contact,
         })
     }
 }

@@ -254,6 +254,9 @@ pub struct MujocoRun {
     /// The time-weighted mean normal force of each foot over the last fifth
     /// of the run (N), in support order: the engine diagnostics' `"loads"`.
     pub loads: Vec<f64>,
+    /// The supports' loads at every sample, the largest rise and the share
+    /// of steps with a foot out of contact (the engine run's `contact`).
+    pub contact: Option<pushval_engine::ContactRecord>,
     /// Per segment, the mean ω over the segment's last 20 % of steps (rad/s).
     pub segment_tail_omega: Vec<f64>,
     /// Per segment, the standard deviation of ω over the same steps (rad/s).

@@ -238,6 +238,7 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         mu,
         tail_loads: run.segment_tail_loads,
         loads: run.loads,
+        contact: run.contact,
         segment_tail_omega: run.segment_tail_omega,
         segment_tail_omega_std: run.segment_tail_omega_std,
         max_pusher_gap: max_gap,

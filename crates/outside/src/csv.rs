@@ -2,7 +2,10 @@
 //! format ([`pushval_model::format`], which `compare`, `fit` and `track`
 //! read too): header with `t,x,y,theta` required, `omega` optional (derived
 //! from θ when absent), `model` optional (one model only), further columns
-//! ignored. Errors name the line and the column.
+//! ignored but two: `rise` (m, the centre of mass above its resting height)
+//! and `load_1`, …, `load_n` (N, each support's normal force), which an
+//! engine that measures them may add and pushval reads ([`Record::rise`],
+//! [`Record::loads`]). Errors name the line and the column.
 
 use std::io::BufRead;
 
@@ -21,32 +24,50 @@ pub struct Record {
     /// `t, x, y, theta, omega`; ω derived from θ when the output has no
     /// `omega` column.
     pub numbers: [f64; 5],
+    /// The row's `rise` (m), where the output has the column.
+    pub rise: Option<f64>,
+    /// The row's `load_1..load_n` (N), where the output has every one of
+    /// the problem's supports.
+    pub loads: Option<Vec<f64>>,
 }
 
-/// Reads a whole output text (at most [`MAX_ROWS`] rows).
-pub fn read(text: &str) -> Result<Vec<Record>, CsvError> {
-    read_from(text.as_bytes(), MAX_ROWS)
+/// Reads a whole output text (at most [`MAX_ROWS`] rows) of a problem with
+/// `supports` supports.
+pub fn read(text: &str, supports: usize) -> Result<Vec<Record>, CsvError> {
+    read_from(text.as_bytes(), MAX_ROWS, supports)
 }
 
-/// Reads an output as it arrives from `input`, at most `max_rows` rows.
-pub fn read_from<R: BufRead>(input: R, max_rows: usize) -> Result<Vec<Record>, CsvError> {
-    let mut reader = Reader::new(input, "", max_rows);
+/// Reads an output as it arrives from `input`, at most `max_rows` rows, of
+/// a problem with `supports` supports.
+pub fn read_from<R: BufRead>(
+    input: R,
+    max_rows: usize,
+    supports: usize,
+) -> Result<Vec<Record>, CsvError> {
+    let names: Vec<String> = std::iter::once("rise".to_string())
+        .chain((1..=supports).map(|i| format!("load_{i}")))
+        .collect();
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut reader = Reader::new(input, "", max_rows).extra(&refs);
     let has_omega = reader.header()?.has_omega();
-    let mut lines = Vec::new();
+    let mut rows = Vec::new();
     let mut samples = Vec::new();
     while let Some(row) = reader.next_row()? {
-        lines.push(row.line);
         samples.push(row.sample(f64::NAN));
+        let loads: Option<Vec<f64>> = row.extra[1..].iter().copied().collect();
+        rows.push((row.line, row.extra[0], loads.filter(|l| !l.is_empty())));
     }
     if !has_omega {
         derive_omega(&mut samples);
     }
-    Ok(lines
+    Ok(rows
         .into_iter()
         .zip(samples)
-        .map(|(line, s)| Record {
+        .map(|((line, rise, loads), s)| Record {
             line,
             numbers: [s.t, s.x, s.y, s.theta, s.omega],
+            rise,
+            loads,
         })
         .collect())
 }

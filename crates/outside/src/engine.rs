@@ -4,8 +4,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use pushval_engine::{
-    trajectory_from_steps, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw,
-    OptionKeys, StepRecord,
+    trajectory_from_steps, ContactRecord, Engine, EngineCrate, EngineInfo, EngineOptions,
+    EngineRun, FrictionLaw, LoadRecorder, OptionKeys, StepRecord,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -181,11 +181,12 @@ impl Engine for OutsideEngine {
         let parse_start = Instant::now();
         let text = std::str::from_utf8(&stdout)
             .map_err(|e| fail(format!("wrote standard output that is not UTF-8 ({e})")))?;
-        let rows = csv::read(text)
+        let rows = csv::read(text, problem.body.len())
             .map_err(|e| fail(format!("wrote a malformed row on its standard output: {e}")))?;
         let history = history_from_rows(problem, &rows)
             .map_err(|e| fail(format!("wrote rows that do not cover the run: {e}")))?;
         let trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
+        let contact = contact_from_rows(problem, &rows);
         let parse_time = parse_start.elapsed();
         Ok(EngineRun {
             trajectory,
@@ -201,8 +202,25 @@ impl Engine for OutsideEngine {
                 "protocol": self.spec.protocol,
                 "session": served_by,
             }),
+            contact,
         })
     }
+}
+
+/// The contact record of an engine's rows where they carry `load_i`
+/// columns: each row after the first is a step ending at its `t`.
+pub fn contact_from_rows(problem: &Problem, rows: &[csv::Record]) -> Option<ContactRecord> {
+    let mut recorder = LoadRecorder::new(problem, problem.body.len(), pushval_engine::GRAVITY);
+    for pair in rows.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        recorder.step(
+            b.numbers[0],
+            b.numbers[0] - a.numbers[0],
+            b.loads.as_deref(),
+            b.rise,
+        );
+    }
+    recorder.finish()
 }
 
 /// An outside engine's rows (`t, x, y, theta, omega`) as a step history for

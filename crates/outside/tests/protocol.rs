@@ -54,24 +54,24 @@ fn pushval_toml_errors_name_file_and_key() {
 
 #[test]
 fn malformed_rows_name_line_and_column() {
-    let e = csv::read("t,x,y,theta,omega\n0,0,0,0,0\n0.1,abc,0,0,0\n").unwrap_err();
+    let e = csv::read("t,x,y,theta,omega\n0,0,0,0,0\n0.1,abc,0,0,0\n", 0).unwrap_err();
     assert_eq!(e.to_string(), "line 3: column `x`: `abc` is not a number");
-    let e = csv::read("t,x,theta,omega\n0,0,0,0\n").unwrap_err();
+    let e = csv::read("t,x,theta,omega\n0,0,0,0\n", 0).unwrap_err();
     assert!(
         e.to_string()
             .starts_with("line 1: the header lacks the column `y`"),
         "{e}"
     );
     // Without `omega`: ω from θ (θ = t², ω = 2t exactly).
-    let r = csv::read("t,x,y,theta\n0,0,0,0\n1,0,0,1\n2,0,0,4\n").unwrap();
+    let r = csv::read("t,x,y,theta\n0,0,0,0\n1,0,0,1\n2,0,0,4\n", 0).unwrap();
     let w: Vec<f64> = r.iter().map(|r| r.numbers[4]).collect();
     assert_eq!(w, vec![0.0, 2.0, 4.0]);
-    let e = csv::read("t,x,y,theta,omega\n0,0,0,0\n").unwrap_err();
+    let e = csv::read("t,x,y,theta,omega\n0,0,0,0\n", 0).unwrap_err();
     assert_eq!(e.to_string(), "line 2: 4 fields, the header has 5");
-    let e = csv::read("t,x,y,theta,omega\n0,0,0,inf,0\n").unwrap_err();
+    let e = csv::read("t,x,y,theta,omega\n0,0,0,inf,0\n", 0).unwrap_err();
     assert_eq!(e.to_string(), "line 2: column `theta`: inf is not finite");
     // Extra columns and their order do not matter.
-    let r = csv::read("omega,t,extra,x,y,theta\n4,0,z,1,2,3\n").unwrap();
+    let r = csv::read("omega,t,extra,x,y,theta\n4,0,z,1,2,3\n", 0).unwrap();
     assert_eq!(r[0].numbers, [0.0, 1.0, 2.0, 3.0, 4.0]);
 }
 
@@ -91,7 +91,7 @@ fn rows_become_steps_covering_the_run() {
     };
     let ts: Vec<f64> = (0..=1000).map(|k| k as f64 * 0.01).collect();
     let text = rows_text(&ts);
-    let rows = csv::read(&text).unwrap();
+    let rows = csv::read(&text, 0).unwrap();
     let h = history_from_rows(&p, &rows).unwrap();
     assert_eq!(h.len(), 1001);
     assert_eq!(h[200].segment, 0); // the step (1.99, 2.00]
@@ -99,18 +99,18 @@ fn rows_become_steps_covering_the_run() {
     assert_eq!(h[1000].segment, 4);
     // Short of the end.
     let text = rows_text(&ts[..900]);
-    let e = history_from_rows(&p, &csv::read(&text).unwrap()).unwrap_err();
+    let e = history_from_rows(&p, &csv::read(&text, 0).unwrap()).unwrap_err();
     assert!(
         e.contains("line 901") && e.contains("before the end"),
         "{e}"
     );
     // Not from 0, or not increasing.
     let text = rows_text(&ts[1..]);
-    let e = history_from_rows(&p, &csv::read(&text).unwrap()).unwrap_err();
+    let e = history_from_rows(&p, &csv::read(&text, 0).unwrap()).unwrap_err();
     assert!(e.contains("line 2") && e.contains("not at 0"), "{e}");
     let mut back = ts.clone();
     back[5] = 0.02;
     let text = rows_text(&back);
-    let e = history_from_rows(&p, &csv::read(&text).unwrap()).unwrap_err();
+    let e = history_from_rows(&p, &csv::read(&text, 0).unwrap()).unwrap_err();
     assert!(e.contains("line 7: column `t`"), "{e}");
 }

@@ -158,6 +158,7 @@ impl Engine for PhysxModel {
                 "loads": r.loads,
             }),
             trajectory: r.trajectory,
+            contact: r.contact,
         })
     }
 }

@@ -217,6 +217,9 @@ pub struct PhysxRun {
     /// The time-weighted mean normal force of each foot over the last fifth
     /// of the run (N), in support order: the engine diagnostics' `"loads"`.
     pub loads: Vec<f64>,
+    /// The supports' loads at every sample, the largest rise and the share
+    /// of steps with a foot out of contact (the engine run's `contact`).
+    pub contact: Option<pushval_engine::ContactRecord>,
     /// Per segment, the mean pusher force over the last 20 % (N, object
     /// frame, the force the pusher applies to the object), from the joint's
     /// constraint force.

@@ -458,6 +458,7 @@ impl World {
             segment_tail_omega_std: run.segment_tail_omega_std,
             segment_tail_loads: run.segment_tail_loads,
             loads: run.loads,
+            contact: run.contact,
             segment_tail_pusher_force: w.tail_force,
             min_loads: run.min_loads,
             max_tilt: run.max_tilt,

@@ -238,6 +238,7 @@ impl Engine for Rapier2dModel {
         let mut trajectory = r.trajectory;
         trajectory.model = self.info.name.clone();
         Ok(EngineRun {
+            contact: None,
             trajectory,
             dt,
             steps: r.steps,

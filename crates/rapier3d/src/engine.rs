@@ -134,6 +134,7 @@ impl Engine for Rapier3dModel {
                 "loads": r.loads,
             }),
             trajectory: r.trajectory,
+            contact: r.contact,
         })
     }
 }

@@ -277,6 +277,9 @@ pub struct Rapier3dRun {
     /// The time-weighted mean normal force of each foot over the last fifth
     /// of the run (N), in support order: the engine diagnostics' `"loads"`.
     pub loads: Vec<f64>,
+    /// The supports' loads at every sample, the largest rise and the share
+    /// of steps with a foot out of contact (the engine run's `contact`).
+    pub contact: Option<pushval_engine::ContactRecord>,
     /// Per segment, each foot's mean friction force magnitude (N) over the
     /// last 20 % (compare with `μ_i N_i`: below it, the foot sticks).
     pub segment_tail_friction: Vec<Vec<f64>>,

@@ -354,6 +354,7 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         segment_tail_omega: run.segment_tail_omega,
         segment_tail_loads: run.segment_tail_loads,
         loads: run.loads,
+        contact: run.contact,
         segment_tail_friction: run.segment_tail_friction,
         segment_tail_min_slip: run.segment_tail_min_slip,
         min_loads: run.min_loads,
