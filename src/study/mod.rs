@@ -119,11 +119,12 @@ pub const LOADS: usize = 4;
 /// end of the run (rad), then what the run's own loads give
 /// ([`LAW_RUN`]): the law's ω on them (tail mean, rad/s), the RMS of the
 /// engine's ω against it over the tail (rad/s), the largest rise (m) and the
-/// share of steps with a support out of contact.
-pub const RUN_WIDTH: usize = 12 + 2 * LOADS;
+/// share of steps with a support out of contact, and the smallest and
+/// largest per-step load of any support (N).
+pub const RUN_WIDTH: usize = 14 + 2 * LOADS;
 
-/// Index in a run's row of `omega_law_run`; `law_run_rms`, `max_rise_m` and
-/// `contact_lost_share` follow it.
+/// Index in a run's row of `omega_law_run`; `law_run_rms`, `max_rise_m`,
+/// `contact_lost_share`, `load_min` and `load_max` follow it.
 pub const LAW_RUN: usize = 8 + 2 * LOADS;
 
 /// A sweep of the study file, ready to run.
@@ -493,6 +494,8 @@ fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
         rms,
         contact.map_or(f64::NAN, |(_, c)| c.max_rise_m),
         contact.map_or(f64::NAN, |(_, c)| c.contact_lost_share),
+        contact.map_or(f64::NAN, |(_, c)| c.load_range[0]),
+        contact.map_or(f64::NAN, |(_, c)| c.load_range[1]),
     ]);
     row
 }

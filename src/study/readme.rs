@@ -50,6 +50,14 @@ fn pct(a: usize, b: usize) -> String {
     }
 }
 
+/// A record's per-step load range, `min – max` (N), `–` where unknown.
+fn load_range(r: &std::collections::BTreeMap<String, String>) -> String {
+    match (num(r, "load_min"), num(r, "load_max")) {
+        (a, b) if a.is_finite() && b.is_finite() => format!("{a:.3} – {b:.3}"),
+        _ => "–".into(),
+    }
+}
+
 /// A share as a percentage, `–` where undefined.
 fn share(v: f64) -> String {
     if v.is_finite() {
@@ -74,10 +82,11 @@ fn run_line(r: &[f64]) -> String {
 
 /// The columns of what the run's own loads give (empty where the engine
 /// measures no loads): header and values.
-const LAW_RUN_HEAD: &str = "omega_law_run,law_run_rms,max_rise_m,contact_lost_share";
+const LAW_RUN_HEAD: &str =
+    "omega_law_run,law_run_rms,max_rise_m,contact_lost_share,load_min,load_max";
 
 fn law_run_line(r: &[f64]) -> String {
-    r[LAW_RUN..LAW_RUN + 4]
+    r[LAW_RUN..LAW_RUN + 6]
         .iter()
         .map(|v| opt(*v))
         .collect::<Vec<_>>()
@@ -187,8 +196,8 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     if let Some(c) = &creep {
         w.file("creep.csv", c.as_bytes())?;
     }
-    let mut variants = String::from(
-        "variant,options,supports_half,phi,dt,speed,omega_engine,omega_coulomb,omega_law,class\n",
+    let mut variants = format!(
+        "variant,options,supports_half,phi,dt,speed,omega_engine,omega_coulomb,omega_law,class,{LAW_RUN_HEAD}\n",
     );
     let mut variant_maps = Vec::new();
     for (k, s) in plan.setups.iter().enumerate().skip(1) {
@@ -202,7 +211,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             if let Task::Table { v, .. } = t {
                 let _ = writeln!(
                     variants,
-                    "{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{}",
                     s.name,
                     options.join(" ").replace(',', ";"),
                     s.supports_half.map_or(String::new(), |h| h.to_string()),
@@ -210,7 +219,8 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
                     s.dt,
                     TABLE_SPEEDS[v],
                     run_line(r),
-                    class_name(r[3])
+                    class_name(r[3]),
+                    law_run_line(r)
                 );
             }
         }
@@ -472,8 +482,8 @@ fn readme(
         s,
         "## Paper plate (`paper_plate.csv`)\n\nφ = π/4 + 0.3 = {PHI_TABLE:.4} rad. Error against Coulomb: relative to ω*; against the law: relative, or |ω|/|ω*| where the law holds ω = 0.\n\n\
          ω law is the law with the problem's statics (`omega_law`); ω law, run's loads (`omega_law_run`) is the law's steady ω at each sample's loads as the engine measured them, averaged over the tail, and RMS its RMS distance from the engine's ω(t) there (quasi-static: no transient between samples). \
-         Rise: the centre of mass's largest height above its resting height; lost: the share of steps with a support carrying no load (≤ 1e-6 m g). Empty where the engine measures no loads.\n\n\
-         | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law | ω law, run's loads | vs it | RMS (rad/s) | rise (m) | lost |\n|---|---|---|---|---|---|---|---|---|---|---|\n"
+         Rise: the centre of mass's largest height above its resting height; lost: the share of steps with a support carrying no load (≤ 1e-6 m g); per-step loads: the smallest and largest normal force of any support on any step (N; the plate's weight is 9.81 N). Empty where the engine measures no loads.\n\n\
+         | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law | ω law, run's loads | vs it | RMS (rad/s) | rise (m) | lost | per-step loads (N) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     for r in parse(paper) {
         let (v, we, wc, wl, wr) = (
@@ -485,7 +495,7 @@ fn readme(
         );
         let _ = writeln!(
             s,
-            "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             sig(we),
             sig(wc),
             sig(wl),
@@ -495,7 +505,8 @@ fn readme(
             sig(err(we, wr, wc, v)),
             sig(num(&r, "law_run_rms")),
             sig(num(&r, "max_rise_m")),
-            share(num(&r, "contact_lost_share"))
+            share(num(&r, "contact_lost_share")),
+            load_range(&r)
         );
     }
     let mut map_section = |name: &str, file: &str, text: &str| {
@@ -554,11 +565,11 @@ fn readme(
         ladder_table(&mut s, c);
     }
     if plan.setups.len() > 1 {
-        s.push_str("\n## Variants (`variants.csv`)\n\n| variant | options | supports half side (m) | φ (rad) | Δt (s) | v_c | ω engine | ω* Coulomb | ω law | class |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        s.push_str("\n## Variants (`variants.csv`)\n\n| variant | options | supports half side (m) | φ (rad) | Δt (s) | v_c | ω engine | ω* Coulomb | ω law | class | ω law, run's loads | per-step loads (N) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for r in parse(variants) {
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 r["variant"],
                 r["options"],
                 r["supports_half"],
@@ -568,7 +579,9 @@ fn readme(
                 sig(num(&r, "omega_engine")),
                 sig(num(&r, "omega_coulomb")),
                 sig(num(&r, "omega_law")),
-                r["class"]
+                r["class"],
+                sig(num(&r, "omega_law_run")),
+                load_range(&r)
             );
         }
     }

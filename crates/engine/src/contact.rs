@@ -25,6 +25,9 @@ pub struct ContactRecord {
     /// Share of the steps with loads in which at least one support carried
     /// no load ([`LOST_SHARE_OF_WEIGHT`]).
     pub contact_lost_share: f64,
+    /// The smallest and the largest normal force any support carried on any
+    /// step (N): the spread of the per-step loads.
+    pub load_range: [f64; 2],
 }
 
 /// Builds a [`ContactRecord`] from the steps of a run, in time order.
@@ -39,6 +42,7 @@ pub struct LoadRecorder {
     steps: usize,
     lost: usize,
     max_rise: f64,
+    range: [f64; 2],
 }
 
 impl LoadRecorder {
@@ -57,6 +61,7 @@ impl LoadRecorder {
             steps: 0,
             lost: 0,
             max_rise: f64::NAN,
+            range: [f64::INFINITY, f64::NEG_INFINITY],
         }
     }
 
@@ -77,6 +82,9 @@ impl LoadRecorder {
         self.steps += 1;
         if normal.iter().any(|&n| n <= self.threshold) {
             self.lost += 1;
+        }
+        for &n in normal {
+            self.range = [self.range[0].min(n), self.range[1].max(n)];
         }
         // The sample this step ends in: the first at or after t1 (a step
         // ending within 1e-9 h of a sample time ends at it).
@@ -121,6 +129,7 @@ impl LoadRecorder {
             loads: loads.into_iter().map(|l| l.unwrap_or_default()).collect(),
             max_rise_m: self.max_rise,
             contact_lost_share: self.lost as f64 / self.steps as f64,
+            load_range: self.range,
         })
     }
 }
@@ -180,6 +189,7 @@ mod tests {
         assert_eq!(c.loads[0], c.loads[1]);
         assert!((c.max_rise_m - 1e-5).abs() < 1e-15);
         assert_eq!(c.contact_lost_share, 0.0);
+        assert!((c.load_range[0] - 1e-3).abs() < 1e-15 && c.load_range[1] == 2.0 - 1e-3);
     }
 
     /// A support with no load in a quarter of the steps; steps longer than
@@ -195,6 +205,7 @@ mod tests {
         }
         let c = r.finish().unwrap();
         assert_eq!(c.contact_lost_share, 0.25);
+        assert_eq!(c.load_range, [0.0, 1.0]);
         assert!(c.max_rise_m.is_nan());
         // Steps end at 0.025 (sample 3), 0.05 (sample 5), 0.075 (8), 0.1 (10).
         let n0: Vec<f64> = c.loads.iter().map(|l| l[0]).collect();

@@ -4,7 +4,8 @@
 //! listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry, OptionError,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -53,6 +54,7 @@ impl JoltModel {
             "Jolt {JOLT_VERSION} ({} {})",
             ENGINE_CRATE.name, ENGINE_CRATE.version
         ))
+        .with_options(OptionKeys::Listed(&["floor_convex_radius"]))
         .with_availability(if AVAILABLE {
             Ok(())
         } else {
@@ -69,6 +71,15 @@ fn build(scene: Scene, opts: &EngineOptions) -> Result<Box<dyn Engine>, OptionEr
     };
     if let Some(dt) = opts.dt {
         settings.dt = dt;
+    }
+    if let Some(r) = opts.non_negative("floor_convex_radius")? {
+        if r >= 0.5 {
+            return Err(OptionError {
+                key: "floor_convex_radius".into(),
+                problem: format!("{r} m is not below the floor box's half height, 0.5 m"),
+            });
+        }
+        settings.floor_convex_radius = r;
     }
     Ok(Box::new(JoltModel::new(settings)))
 }
@@ -109,6 +120,7 @@ impl Engine for JoltModel {
             "velocity_steps": s.velocity_steps,
             "position_steps": s.position_steps,
             "penetration_slop": s.penetration_slop,
+            "floor_convex_radius": s.floor_convex_radius,
             "precision": "f64 positions, f32 solver",
             "label": s.label(),
         })

@@ -73,6 +73,8 @@ pub(crate) struct Spec {
     pub velocity_steps: u32,
     pub position_steps: u32,
     pub penetration_slop: f64,
+    /// Convex radius of the floor box (m).
+    pub floor_convex_radius: f64,
     /// Initial pose of the centre of mass (m) and yaw (rad).
     pub position: [f64; 3],
     pub theta: f64,
@@ -172,7 +174,8 @@ impl World {
             let bi = JPH_PhysicsSystem_GetBodyInterface(self.system);
 
             // Floor: a static box with its top face at z = 0.
-            let floor_shape = JPH_BoxShape_Create(&v3([50.0, 50.0, 0.5]), 0.0);
+            let floor_shape =
+                JPH_BoxShape_Create(&v3([50.0, 50.0, 0.5]), spec.floor_convex_radius as f32);
             let s = JPH_BodyCreationSettings_Create3(
                 floor_shape as *const JPH_Shape,
                 &r3([0.0, 0.0, -0.5]),

@@ -300,6 +300,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         velocity_steps: s.velocity_steps,
         position_steps: s.position_steps,
         penetration_slop: s.penetration_slop,
+        floor_convex_radius: s.floor_convex_radius,
         position: [init.position.x, init.position.y, 0.0],
         theta: init.theta,
         anchor: [pc.x, pc.y, 0.0],
@@ -371,7 +372,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
     let run = stepping::run_pushes(&mut w, problem, &cfg, (st, theta))?;
     let history = run.records();
     let tails = w.out;
-    let contact = run.contact.map(|mut c| {
+    let contact = run.contact.clone().map(|mut c| {
         c.loads = std::mem::take(&mut c.loads)
             .into_iter()
             .map(|l| support_loads(body, &w.targets, l))
