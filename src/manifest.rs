@@ -247,9 +247,12 @@ pub const STALE: &[(&str, &str)] = &[
     ),
 ];
 
+/// An engine crate's model table (as [`crate::registry::ENGINE_CRATES`] holds it).
+pub type ModelTable = fn() -> Vec<ModelEntry>;
+
 /// The cargo feature behind each engine crate that has one (the root
 /// package's `[features]`), by the crate's model table.
-pub const FEATURES: &[(&str, fn() -> Vec<ModelEntry>)] = &[
+pub const FEATURES: &[(&str, ModelTable)] = &[
     ("mujoco", pushval_mujoco::models),
     ("physx", pushval_physx::models),
     ("avian", pushval_avian::models),
