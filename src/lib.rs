@@ -7,6 +7,7 @@ pub mod fit;
 pub mod harness;
 pub mod init;
 pub mod inject;
+pub mod manifest;
 pub mod outdir;
 pub mod output;
 pub mod outside;

@@ -255,6 +255,18 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Write results/MANIFEST.csv: every file of results/ and the one
+    /// command that regenerates it, from the rules of src/manifest.rs.
+    Manifest {
+        /// Write nothing; exit 1 listing every difference between the
+        /// committed MANIFEST.csv and the rules, every file no rule matches
+        /// and every file two rules match.
+        #[arg(long)]
+        check: bool,
+        /// The repository root (the folder holding results/).
+        #[arg(long, default_value = ".", value_name = "DIR")]
+        root: PathBuf,
+    },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
         file: PathBuf,
@@ -494,6 +506,7 @@ fn main() -> ExitCode {
             deny_loose,
         }) => validate(files, json, junit, deny_loose),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Manifest { check, root }) => pushval::manifest::cli(&root, check),
         Some(Command::Init { force }) => pushval::init::cli(Path::new("."), force),
         Some(Command::Shipped { out, force }) => {
             pushval::shipped::write_out(&out, force).map(|files| {

@@ -13,6 +13,7 @@ mod fit;
 mod gate;
 mod kappa;
 mod laws;
+mod manifest;
 mod outside;
 mod power;
 mod properties;

@@ -1,9 +1,13 @@
-//! Jolt's friction against its closed form and Coulomb's on the paper plate:
-//! writes `results/friction_models/jolt_box/` and `jolt_feet/`
-//! (`paper_plate.csv`, `map.csv`, `diagnostics.csv`, `README.md`) and
-//! `results/friction_models/jolt_feet/loads.csv`. Stands in for `pushval
-//! study jolt_box|jolt_feet` until the generic study lands (same columns,
-//! same plate and grid as `src/study/plate.rs`).
+//! Jolt's friction against its closed form and Coulomb's on the paper plate,
+//! with what `pushval study jolt_box|jolt_feet` does not write: per map cell
+//! the friction slip angle, the loads and the law's band
+//! (`diagnostics.csv`), and the rest loads against the step and the
+//! iterations (`loads.csv`), beside its own `paper_plate.csv`, `map.csv` and
+//! `README.md`, one folder per model (`jolt_box/`, `jolt_feet/`).
+//!
+//! Writes into `target/jolt-study/` of the workspace (or `--out DIR`), never
+//! into `results/`: the studies there are `pushval study`'s
+//! (`results/MANIFEST.csv`).
 //!
 //! ```sh
 //! cargo run --release -p pushval-jolt --features jolt --example study [-- --quick] [-- --out DIR]
@@ -157,6 +161,11 @@ fn band(scene: Scene, p: &Problem, mu: f64, t: f64) -> (f64, f64) {
         })
 }
 
+/// The workspace's `target/jolt-study/`.
+fn default_out() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/jolt-study")
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
@@ -164,7 +173,7 @@ fn main() {
         .iter()
         .position(|a| a == "--out")
         .and_then(|i| args.get(i + 1))
-        .map_or_else(|| PathBuf::from("results/friction_models"), PathBuf::from);
+        .map_or_else(default_out, PathBuf::from);
     let frs: &[f64] = if quick { &FRS_QUICK } else { &FRS };
     let nphi = if quick { 5 } else { 20 };
     let phis: Vec<f64> = (0..nphi)
@@ -172,7 +181,7 @@ fn main() {
         .collect();
     for scene in Scene::ALL {
         let dir = out.join(scene.model_name());
-        std::fs::create_dir_all(&dir).expect("results folder");
+        std::fs::create_dir_all(&dir).expect("output folder");
         // Paper table.
         let mut table = String::from("speed,omega_engine,omega_coulomb,omega_law\n");
         let mut table_rows = Vec::new();
