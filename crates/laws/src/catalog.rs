@@ -5,6 +5,7 @@ use serde_json::{Map, Value};
 
 use crate::avian::{Avian3dTilt, PlateParams};
 use crate::box2d::Box2dMotorJoint;
+use crate::drake::{Approximation, DrakeConvex};
 use crate::idioms::{
     ImpulseBox, ImpulseDisk, RegularisedLinear, RegularisedTanh, RowsDisk, DEFAULT_SLIP_SPEED,
 };
@@ -465,7 +466,61 @@ pub fn catalog() -> Vec<LawEntry> {
             about: "Jolt on sphere feet: a disc μN per foot along the effective-mass direction of world-axis rows (yaw-dependent, no twist row); the mean ω over the segment's last fifth.",
             make: |_| Box::new(JoltFeet),
         },
+        LawEntry {
+            name: "drake_sap",
+            engines: &[],
+            params: drake_params(Approximation::Sap),
+            loads: Loads::Law,
+            about: "Drake's SAP on sphere feet: Coulomb at every foot with the loads of the convex relaxation's lift (N = k(x + (δt+τ_d)(μ|v_t| − v_n))): a glide plane's twist while every foot penetrates, else hops and the statics' loads.",
+            make: |v| drake(Approximation::Sap, v),
+        },
+        LawEntry {
+            name: "drake_similar",
+            engines: &[],
+            params: drake_params(Approximation::Similar),
+            loads: Loads::Law,
+            about: "Drake's Similar on sphere feet: Coulomb at every foot with the loads of Hunt–Crossley at z = v_n − μ|v_t|: a glide plane's twist while every foot penetrates, else hops and the statics' loads.",
+            make: |v| drake(Approximation::Similar, v),
+        },
     ]
+}
+
+fn drake_params(a: Approximation) -> Vec<ParamSpec> {
+    let d = DrakeConvex::new(a);
+    let mut p = vec![ParamSpec::number(
+        "penetration",
+        d.penetration,
+        "m",
+        "rest penetration δ: each foot's stiffness is its load / δ",
+    )
+    .positive()];
+    match a {
+        Approximation::Sap => p.push(ParamSpec::number(
+            "relaxation_time",
+            d.relaxation_time,
+            "s",
+            "SAP's relaxation time τ_d (default: critical at δ = 1e-4 m, 2 sqrt(δ/g))",
+        )),
+        Approximation::Similar => p.push(ParamSpec::number(
+            "hunt_crossley_dissipation",
+            d.dissipation,
+            "s/m",
+            "Hunt–Crossley dissipation d (default: critical at δ = 1e-4 m, 2/sqrt(g δ))",
+        )),
+    }
+    p.push(gravity(d.gravity));
+    p
+}
+
+fn drake(a: Approximation, v: &Values) -> Box<dyn FrictionLaw> {
+    let mut law = DrakeConvex::new(a);
+    law.penetration = v.num("penetration");
+    law.gravity = v.num("gravity");
+    match a {
+        Approximation::Sap => law.relaxation_time = v.num("relaxation_time"),
+        Approximation::Similar => law.dissipation = v.num("hunt_crossley_dissipation"),
+    }
+    Box::new(law)
 }
 
 #[cfg(test)]

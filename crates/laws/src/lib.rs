@@ -9,7 +9,7 @@
 //! One module per family, each the closed form of what one engine's solver
 //! does to friction (derived from its source; no engine is needed to
 //! evaluate it): [`idioms`] (2-D game-engine idioms), [`rapier3d`],
-//! [`mujoco`], [`physx`], [`box2d`], [`avian`], [`jolt`]. Every law is a
+//! [`mujoco`], [`physx`], [`box2d`], [`avian`], [`jolt`], [`drake`]. Every law is a
 //! value with its parameters; an engine model holds the one it follows.
 //!
 //! [`catalog`] lists them all by a stable name, with parameters and the
@@ -25,6 +25,7 @@ mod law;
 
 pub mod avian;
 pub mod box2d;
+pub mod drake;
 pub mod idioms;
 pub mod jolt;
 pub mod mujoco;
