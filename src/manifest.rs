@@ -226,22 +226,6 @@ pub const RULES: &[Rule] = &[
 /// gone fails `--check`: remove it here then).
 pub const STALE: &[(&str, &str)] = &[
     (
-        "results/friction_models/jolt_box/diagnostics.csv",
-        "written once by crates/jolt/examples/study.rs (commit d01d1c7), which now writes into target/jolt-study/; pushval study jolt_box does not write it",
-    ),
-    (
-        "results/friction_models/jolt_box/loads.csv",
-        "written once by crates/jolt/examples/study.rs (commit d01d1c7), which now writes into target/jolt-study/; pushval study jolt_box does not write it",
-    ),
-    (
-        "results/friction_models/jolt_feet/diagnostics.csv",
-        "written once by crates/jolt/examples/study.rs (commit d01d1c7), which now writes into target/jolt-study/; pushval study jolt_feet does not write it",
-    ),
-    (
-        "results/friction_models/jolt_feet/loads.csv",
-        "written once by crates/jolt/examples/study.rs (commit d01d1c7), which now writes into target/jolt-study/; pushval study jolt_feet does not write it",
-    ),
-    (
         "results/friction_models/drake/validate_paper_drake_tamsi_auto.json",
         "`pushval validate --json` of /tmp/dv/drake_tamsi.toml (commit f4e45c6), a scenario file the repository does not hold",
     ),
