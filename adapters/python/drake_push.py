@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """A pushval outside engine in Drake (drake==1.51.1): MultibodyPlant, discrete.
 
-One row per plant step; the protocol (one-shot or --session, limits,
+One row per plant step, with the columns load_1..load_n (each foot's normal
+force in the step, N, the problem's support order) and rise (the plate's
+centre of mass above its height at the end of the settling, m); the protocol (one-shot or --session, limits,
 progress, --timing) is pushval.adapter's (adapters/python/README.md).
 Drake's contact makes the pusher's velocity jumps itself: impulsive
 switching only.
@@ -386,6 +388,7 @@ class DrakePush(Engine):
             self.advance()
         com, yaw, _wz, _v, _w = self.pose()
         self.rest_height = float(com[2])
+        self.row_extras = self.extras_now(self.contacts(), com)
         self.stats = {"steps": 0, "lost_steps": 0, "max_rise": 0.0, "max_load_error": 0.0}
         self.stats_dir = []
         want_diag = self.diag is not None or self.args.check
@@ -459,11 +462,25 @@ class DrakePush(Engine):
             raise AdapterError(f"Drake failed at t = {self.t:.6g} s: {e}") from None
         self.t += h
         state = self.pose()
+        cts = self.contacts()
+        self.row_extras = self.extras_now(cts, state[0])
         if self.want_diag:
-            self.record(self.t, self.contacts(), state)
+            self.record(self.t, cts, state)
         com, yaw, wz, _v, _w = state
         self.theta += math.remainder(yaw - self.theta, 2 * math.pi)
         return State(float(com[0]), float(com[1]), self.theta, wz)
+
+    def extras_now(self, cts, com):
+        """load_1..load_n and rise for the step whose contacts are ``cts``
+        and whose centre of mass ends at ``com``."""
+        loads = [c[0] if c is not None else 0.0 for c in cts]
+        return (*loads, float(com[2]) - self.rest_height)
+
+    def extra_columns(self, problem):
+        return (*(f"load_{i + 1}" for i in range(len(problem.supports))), "rise")
+
+    def extras(self):
+        return self.row_extras
 
     def close(self):
         if getattr(self, "want_diag", False) and getattr(self, "stats", None) and self.stats["steps"]:
