@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """A pushval outside engine in MuJoCo's Python bindings (mujoco==4.0.0).
 
-One row per MuJoCo step; the protocol (one-shot or --session, limits,
+One row per MuJoCo step, with the columns load_1..load_n (each foot's normal
+force in the step, mj_contactForce, N, the problem's support order) and rise
+(the object's centre of mass above its height at the end of the settling,
+m); the protocol (one-shot or --session, limits,
 progress, --timing) is pushval.adapter's (adapters/python/README.md). MuJoCo's
 contact makes the pusher's velocity jumps itself: impulsive switching only.
 
@@ -98,6 +101,20 @@ def mjcf(problem, cone, dt, mus):
     return "\n".join(x)
 
 
+def foot_loads(mujoco, model, data, n, f6):
+    """Each foot's normal force (N) in the step just taken: the sum of
+    mj_contactForce's normal component over the foot's contacts (geoms
+    1..n are the feet, 0 the floor)."""
+    loads = [0.0] * n
+    for i in range(data.ncon):
+        con = data.contact[i]
+        gi = max(con.geom[0], con.geom[1])
+        if 1 <= gi <= n:
+            mujoco.mj_contactForce(model, data, i, f6)
+            loads[gi - 1] += float(f6[0])
+    return loads
+
+
 def yaw_and_omega(data):
     mat = data.xmat[OBJECT]
     wl = data.qvel[3:6]
@@ -143,14 +160,10 @@ class MujocoPush(Engine):
         # 1. Settle at rest; calibrate each foot's coefficient to its load.
         for _ in range(math.ceil(SETTLE_TIME / dt)):
             mujoco.mj_step(model, data)
-        loads = [0.0] * n
-        f6 = self.np.zeros(6)
-        for i in range(data.ncon):
-            con = data.contact[i]
-            gi = max(con.geom[0], con.geom[1])
-            if 1 <= gi <= n:
-                mujoco.mj_contactForce(model, data, i, f6)
-                loads[gi - 1] += f6[0]
+        self.f6 = self.np.zeros(6)
+        loads = foot_loads(mujoco, model, data, n, self.f6)
+        self.rest_height = float(data.qpos[2])
+        self.row_extras = (*loads, 0.0)
         for k in range(n):
             if forces[k] == 0.0:
                 model.geom_friction[k + 1][0] = 0.0
@@ -196,7 +209,15 @@ class MujocoPush(Engine):
                 raise AdapterError(f"MuJoCo warned {name} at t = {self.t:.6g} s: the run is unstable")
         yaw, wz = yaw_and_omega(data)
         self.theta += math.remainder(yaw - self.theta, 2 * math.pi)
+        loads = foot_loads(mujoco, model, data, len(self.row_extras) - 1, self.f6)
+        self.row_extras = (*loads, float(data.qpos[2]) - self.rest_height)
         return State(float(data.qpos[0]), float(data.qpos[1]), self.theta, wz)
+
+    def extra_columns(self, problem):
+        return (*(f"load_{i + 1}" for i in range(len(problem.supports))), "rise")
+
+    def extras(self):
+        return self.row_extras
 
 
 if __name__ == "__main__":

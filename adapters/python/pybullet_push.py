@@ -1,7 +1,12 @@
 #!/usr/bin/env python3
 """A pushval outside engine in PyBullet (pybullet==3.2.7).
 
-One row per Bullet step; the protocol (one-shot or --session, limits,
+One row per Bullet step, with the columns load_1..load_n (N, the problem's
+support order) and rise (m): in contact mode each foot's normal force in the
+step (getContactPoints' normalForce, summed per foot) and the plate's centre
+of mass above its settled height; in forces mode the loads the applied
+Coulomb forces use (the problem's) and the height above its start (the plate
+floats: 0 unless the constraint moves it). The protocol (one-shot or --session, limits,
 progress, --timing) is pushval.adapter's (adapters/python/README.md). Bullet's
 contact makes the pusher's velocity jumps itself: impulsive switching only.
 
@@ -43,6 +48,7 @@ except ImportError:  # run from the source tree without the wheel installed
 THICK = 0.005
 FOOT = 0.0025
 SLIDER_MASS = 1e-3
+SETTLE_AGAIN = 0.3
 
 
 class PyBulletPush(Engine):
@@ -130,12 +136,36 @@ class PyBulletPush(Engine):
                 p.changeDynamics(body, j, lateralFriction=mus[j], physicsClientId=client)
             p.changeDynamics(body, -1, lateralFriction=0.0, physicsClientId=client)
             p.setGravity(0, 0, -g, physicsClientId=client)
-            # Settle on the feet before the clock starts.
+            # Settle on the feet before the clock starts: 0.2 s from the
+            # drop, the pose put back level at the initial x, y and yaw (the
+            # settled height kept), then SETTLE_AGAIN s more. The drop's
+            # rest is not the statics: Bullet keeps the feet's unequal
+            # landing penetrations and reports loads that do not balance
+            # the weight's moment (a three-foot plate: 5.84, 6.38, 7.42 N
+            # against the statics' 6.16, 6.67, 6.79 N, unchanged after 0.5 s);
+            # from the level pose it comes to rest near the statics. The
+            # last reset keeps that rest's height, roll and pitch and only
+            # puts x, y and yaw back (about 1e-7 of drift).
             for _ in range(int(0.2 / dt)):
                 p.stepSimulation(physicsClientId=client)
+            z0 = p.getBasePositionAndOrientation(body, physicsClientId=client)[0][2]
             p.resetBasePositionAndOrientation(
-                body, [ini.position[0], ini.position[1], p.getBasePositionAndOrientation(body, physicsClientId=client)[0][2]],
+                body, [ini.position[0], ini.position[1], z0],
                 p.getQuaternionFromEuler([0, 0, th0]), physicsClientId=client)
+            for _ in range(int(SETTLE_AGAIN / dt)):
+                p.stepSimulation(physicsClientId=client)
+            self.ground = ground
+            rest_loads = self.foot_loads()
+            pos0, orn0 = p.getBasePositionAndOrientation(body, physicsClientId=client)
+            z0 = pos0[2]
+            roll, pitch, _ = p.getEulerFromQuaternion(orn0)
+            p.resetBasePositionAndOrientation(
+                body, [ini.position[0], ini.position[1], z0],
+                p.getQuaternionFromEuler([roll, pitch, th0]), physicsClientId=client)
+        else:
+            rest_loads = [s[3] for s in sup]
+        self.rest_height = z0
+        self.row_extras = (*rest_loads, 0.0)
         # The pusher: a kinematic (mass 0) point moved each step, joined to the
         # contact point. In contact mode the joint acts at the feet's contact
         # height through a light link free to slide vertically (see the top).
@@ -168,6 +198,23 @@ class PyBulletPush(Engine):
             p.resetBaseVelocity(body, [vpx + w0 * py, vpy - w0 * px, 0], [0, 0, w0], physicsClientId=client)
         self.theta = th0
         return State(ini.position[0], ini.position[1], th0, w0)
+
+    def foot_loads(self):
+        """Each foot's normal force (N) in the step just taken (contact
+        mode): getContactPoints' normalForce (Bullet's applied impulse / dt)
+        summed over the contacts of that foot's link with the ground."""
+        loads = [0.0] * len(self.sup)
+        for c in self.p.getContactPoints(self.body, self.ground, physicsClientId=self.client):
+            j = c[3]  # linkIndexA: the foot
+            if 0 <= j < len(loads):
+                loads[j] += c[9]
+        return loads
+
+    def extra_columns(self, problem):
+        return (*(f"load_{i + 1}" for i in range(len(problem.supports))), "rise")
+
+    def extras(self):
+        return self.row_extras
 
     def contact_world(self):
         """The contact point in the world, at the plate's height."""
@@ -208,6 +255,8 @@ class PyBulletPush(Engine):
         v, w = p.getBaseVelocity(body, physicsClientId=client)
         yaw = p.getEulerFromQuaternion(orn)[2]
         self.theta += math.remainder(yaw - self.theta, 2 * math.pi)
+        loads = self.foot_loads() if self.args.mode == "contact" else self.row_extras[:-1]
+        self.row_extras = (*loads, pos[2] - self.rest_height)
         return State(pos[0], pos[1], self.theta, w[2])
 
     def close(self):

@@ -71,8 +71,14 @@ What the kit does for every problem
   standard error); if even that is too large, the run fails with a message
   saying so instead of being killed. ``Engine.rows = "samples"`` asks for
   rows at the sample times always.
+* **Extra columns.** An engine that lists names in
+  `Engine.extra_columns` (e.g. ``load_1..load_n`` and ``rise``) gets them in
+  the header after ``omega``; the kit calls `Engine.extras` after `reset`
+  and after every step and writes its numbers on that row (at a sample time,
+  the values of the step holding it, as ω). Engines that list none write
+  exactly ``t,x,y,theta,omega``.
 * **Checks.** A state that is not four finite numbers fails the run, naming
-  the time.
+  the time; so do extras that are not finite or not one per column.
 * **Progress.** A run longer than a few seconds reports how far it is on
   standard error (pushval shows an engine's standard error when it fails).
 * **Output hygiene.** `main` points file descriptor 1 at standard error
@@ -125,7 +131,7 @@ __all__ = [
 #: The document formats the kit reads.
 FORMATS = ("pushval-problem/1", "pushval-problem/2")
 
-#: The CSV header the kit writes.
+#: The CSV header the kit writes (an engine's `Engine.extra_columns` follow it).
 HEADER = "t,x,y,theta,omega"
 
 #: What ω does where the pusher's velocity jumps (version 2's ``switching``).
@@ -591,17 +597,39 @@ class Engine:
         """Called after every problem, failed or not: release what `reset`
         built. Default: nothing."""
 
+    def extra_columns(self, problem: Problem) -> tuple[str, ...]:
+        """Names of columns written after ``omega`` for ``problem`` (called
+        after `reset`). The trajectory format defines ``load_1..load_n``
+        (normal force on support i in N, the problem's support order, the
+        step's value) and ``rise`` (m, the centre of mass's height above its
+        resting height); readers ignore columns they do not know. Default:
+        none."""
+        return ()
+
+    def extras(self) -> Sequence[float]:
+        """The values of `extra_columns` for the row just produced (after
+        `reset`: the state at t = 0; after a step: that step's). Called only
+        when `extra_columns` lists some."""
+        return ()
+
 
 @dataclass
 class Run:
     """What `simulate` produced."""
 
-    rows: list[tuple[float, float, float, float, float]]
-    """``(t, x, y, theta, omega)``: t = 0 first, then one per step."""
+    rows: list[tuple[float, ...]]
+    """``(t, x, y, theta, omega, *extras)``: t = 0 first, then one per step."""
     steps: int
     """The number of steps."""
     step_time_s: float
     """Wall time in `Engine.reset` and the steps (s)."""
+    columns: tuple[str, ...] = ()
+    """The engine's extra columns (`Engine.extra_columns`), after omega."""
+
+    @property
+    def header(self) -> str:
+        """The CSV header of these rows."""
+        return ",".join((HEADER, *self.columns))
 
 
 def _engine_name(engine: Engine) -> str:
@@ -621,6 +649,22 @@ def _state(value: Any, t: float) -> tuple[float, float, float, float]:
             f"x = {x!r}, y = {y!r}, theta = {theta!r}, omega = {omega!r}"
         )
     return x, y, theta, omega
+
+
+def _extras(value: Any, columns: Sequence[str], t: float) -> tuple[float, ...]:
+    try:
+        vals = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        raise AdapterError(f"the engine's extras at t = {t!r} s are not numbers: {value!r}") from None
+    if len(vals) != len(columns):
+        raise AdapterError(
+            f"the engine's extras at t = {t!r} s are {len(vals)} numbers for "
+            f"{len(columns)} columns ({','.join(columns)})"
+        )
+    for name, v in zip(columns, vals):
+        if not math.isfinite(v):
+            raise AdapterError(f"the engine's {name} at t = {t!r} s is not finite: {v!r}")
+    return vals
 
 
 def simulate(
@@ -643,7 +687,11 @@ def simulate(
     end = problem.duration
     started = time.perf_counter()
     try:
-        raw: list[tuple[float, Any]] = [(0.0, engine.reset(problem))]
+        raw: list[tuple[float, Any, Any]] = [(0.0, engine.reset(problem), ())]
+        columns = tuple(engine.extra_columns(problem))
+        extras = engine.extras if columns else tuple
+        if columns:
+            raw[0] = (0.0, raw[0][1], extras())
         before: Push | None = None
         step = engine.step
         for push in problem.pushes:
@@ -654,15 +702,15 @@ def simulate(
             h = push.duration / n
             t0 = push.t_start
             for j in range(1, n):
-                raw.append((t0 + j * h, step(push, h)))
+                raw.append((t0 + j * h, step(push, h), extras()))
                 if progress is not None and not j & 1023:
                     progress(t0 + j * h, end)
-            raw.append((t0 + push.duration, step(push, h)))
+            raw.append((t0 + push.duration, step(push, h), extras()))
         elapsed = time.perf_counter() - started
     finally:
         engine.close()
-    rows = [(t, *_state(s, t)) for t, s in raw]
-    return Run(rows=rows, steps=len(rows) - 1, step_time_s=elapsed)
+    rows = [(t, *_state(s, t), *_extras(e, columns, t)) for t, s, e in raw]
+    return Run(rows=rows, steps=len(rows) - 1, step_time_s=elapsed, columns=columns)
 
 
 # --------------------------------------------------------------------------
@@ -671,8 +719,8 @@ def simulate(
 
 def _sampled(problem: Problem, rows: Sequence[tuple[float, ...]]) -> list[tuple[float, ...]]:
     """The rows at the problem's sample times: the pose interpolated
-    linearly between the step ends around each, ω the one held over the step
-    holding it (at t = 0, the first row's)."""
+    linearly between the step ends around each, ω (and any extra column) the
+    one of the step holding it (at t = 0, the first row's)."""
     times = [r[0] for r in rows]
     out = []
     for t in problem.sample_times():
@@ -685,7 +733,7 @@ def _sampled(problem: Problem, rows: Sequence[tuple[float, ...]]) -> list[tuple[
             continue
         a, b = rows[k - 1], rows[k]
         s = (t - a[0]) / (b[0] - a[0])
-        out.append((t, a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]), a[3] + s * (b[3] - a[3]), b[4]))
+        out.append((t, a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]), a[3] + s * (b[3] - a[3]), *b[4:]))
     return out
 
 
@@ -704,11 +752,12 @@ def answer(
     sample for ``mode = "samples"``), then ``framing`` (``"#end\\n"`` in a
     session). Within the problem's `Limits`: rows per step that would exceed
     them are written per sample (``note`` says so); if those exceed them too,
-    `AdapterError`."""
+    `AdapterError`. The header is `HEADER` followed by the run's extra
+    columns, if any."""
     if mode not in ("steps", "samples"):
         raise ValueError(f"unknown row mode {mode!r} (steps, samples)")
     lim = problem.limits
-    head = HEADER + "\n"
+    head = run.header + "\n"
 
     def within(rows: Sequence[tuple[float, ...]]) -> tuple[str | None, str]:
         """Why ``rows`` exceed the limits (None: they fit), and their text."""

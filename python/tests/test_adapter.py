@@ -288,6 +288,72 @@ class ServeTest(unittest.TestCase):
         self.assertRegex(out, r"^#error .*bytes \(the limit is 40\)\n$")
 
 
+class Loaded(Recorder):
+    """The recorder with extra columns: load_1, load_2 and rise, the loads
+    being (step number, -step number) and the rise the time."""
+
+    def extra_columns(self, problem):
+        return tuple(f"load_{i + 1}" for i in range(len(problem.supports))) + ("rise",)
+
+    def reset(self, problem):
+        self.k = 0
+        return super().reset(problem)
+
+    def step(self, push, dt):
+        self.k += 1
+        return super().step(push, dt)
+
+    def extras(self):
+        return (float(self.k), -float(self.k), self.t)
+
+
+class ExtraColumnsTest(unittest.TestCase):
+    def serve(self, engine, d):
+        out, err = io.StringIO(), io.StringIO()
+        status = serve(engine, False, io.StringIO(json.dumps(d)), out, err)
+        return status, out.getvalue(), err.getvalue()
+
+    def test_extra_columns_follow_omega_on_every_row(self):
+        status, out, err = self.serve(Loaded(), DOC)
+        self.assertEqual(status, 0, err)
+        lines = out.splitlines()
+        self.assertEqual(lines[0], "t,x,y,theta,omega,load_1,load_2,rise")
+        self.assertEqual(len(lines), 1 + 1 + 13)
+        self.assertEqual(lines[1], "0.0,0.0,0.0,0.0,0.0,0.0,-0.0,0.0")
+        for k, line in enumerate(lines[1:]):
+            v = [float(x) for x in line.split(",")]
+            self.assertEqual(len(v), 8)
+            self.assertEqual((v[5], v[6]), (k, -k))
+            # The recorder's x and the rise are both the engine's clock.
+            self.assertEqual(v[7], v[1])
+
+    def test_sample_rows_carry_the_holding_steps_extras(self):
+        d = doc(format="pushval-problem/2", limits={"max_rows": 6})
+        status, out, err = self.serve(Loaded(), d)
+        self.assertEqual(status, 0, err)
+        lines = out.splitlines()
+        self.assertEqual(lines[0], "t,x,y,theta,omega,load_1,load_2,rise")
+        # Sample 0.1 s lies in the 4th step of 0.25/9 s (ends at 0.111 s).
+        v = [float(x) for x in lines[2].split(",")]
+        self.assertEqual(v[0], 0.1)
+        self.assertEqual(v[5], 4.0)
+        self.assertAlmostEqual(v[7], 4 * 0.25 / 9, places=12)
+
+    def test_wrong_or_non_finite_extras_fail_naming_the_column(self):
+        class Short(Loaded):
+            def extras(self):
+                return (1.0,)
+
+        class Nan(Loaded):
+            def extras(self):
+                return (1.0, 2.0, math.nan)
+
+        with self.assertRaisesRegex(AdapterError, r"1 numbers for 3 columns \(load_1,load_2,rise\)"):
+            simulate(Short(), parse_problem(DOC))
+        with self.assertRaisesRegex(AdapterError, r"rise at t = 0\.0 s is not finite"):
+            simulate(Nan(), parse_problem(DOC))
+
+
 class ProcessTest(unittest.TestCase):
     """`main` in a real process: the command line and output hygiene."""
 
