@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use pushval_engine::{rel_err, tail_loads, tail_mean_omega, Engine, EngineOptions, LawClass};
-use pushval_model::{Problem, Push};
+use pushval_model::{Problem, Push, Trajectory};
 
 use crate::outdir::Writer;
 use crate::parallel::par_rows;
@@ -453,11 +453,14 @@ fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
     // The last segment: the push, or the rest after a stop, where ω is the
     // mean |ω| over the tail (a signed mean hides a chattering stop).
     let seg = p.pushes.len() - 1;
+    let law = engine.law();
+    let period = law.and_then(|l| l.angle_period(p));
     let omega = run
         .as_ref()
         .and_then(|r| {
             if seg == 0 {
-                return tail_mean_omega(p, &r.trajectory, tail)[0];
+                let whole = period.and_then(|a| whole_period_omega(p, &r.trajectory, tail, a));
+                return whole.or_else(|| tail_mean_omega(p, &r.trajectory, tail)[0]);
             }
             let t1 = p.segment_times()[seg].1;
             let w: Vec<f64> = r
@@ -471,7 +474,6 @@ fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
         })
         .unwrap_or(f64::NAN);
     let coulomb = pushval_engine::coulomb_steady(p, seg).unwrap_or(f64::NAN);
-    let law = engine.law();
     let steady = law.and_then(|l| l.steady(p, seg, dt));
     let mut row = vec![omega, coulomb, steady.map_or(f64::NAN, |l| l.omega)];
     row.extend(class_code(steady.map(|l| l.class)));
@@ -498,6 +500,41 @@ fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
         contact.map_or(f64::NAN, |(_, c)| c.load_range[1]),
     ]);
     row
+}
+
+/// The mean ω (rad/s) of the first segment over the longest part of its
+/// tail (its last `tail` share) that ends at the segment's end and turns the
+/// object by a whole number of `period`s (rad): the mean a law that depends
+/// on the angle predicts (`FrictionLaw::angle_period`), which a tail cut
+/// mid-period misses by up to a few per cent. The start is interpolated
+/// linearly between samples. None where the tail turns less than a period.
+pub fn whole_period_omega(p: &Problem, traj: &Trajectory, tail: f64, period: f64) -> Option<f64> {
+    let (t0, t1) = p.segment_times()[0];
+    let from = t1 - tail * (t1 - t0);
+    let s: Vec<_> = traj
+        .samples
+        .iter()
+        .filter(|s| s.t >= from - 1e-12 && s.t <= t1 + 1e-12)
+        .collect();
+    let (first, last) = (s.first()?, s.last()?);
+    let turn = last.theta - first.theta;
+    let n = (turn.abs() / period).floor();
+    if n < 1.0 || !turn.is_finite() {
+        return None;
+    }
+    let target = n * period;
+    // The latest sample that has turned the target by the end, walking back.
+    let k = (0..s.len())
+        .rev()
+        .find(|&k| (last.theta - s[k].theta).abs() >= target)?;
+    let (a, b) = (s[k], s[(k + 1).min(s.len() - 1)]);
+    let (da, db) = ((last.theta - a.theta).abs(), (last.theta - b.theta).abs());
+    let start = if da > db {
+        a.t + (b.t - a.t) * (da - target) / (da - db)
+    } else {
+        a.t
+    };
+    (last.t > start).then(|| turn.signum() * target / (last.t - start))
 }
 
 /// The law on the run's own loads over the tail of segment `seg` (the

@@ -463,10 +463,16 @@ fn readme(
     let _ = write!(
         s,
         "Model: {}. Engine law in closed form: {law}. Scene: the seed paper's plate (0.25 m square, 1 kg, μ = 0.5 on four corner supports), \
-         pushed at a corner from ω = 0 for {} s; ω is the mean over the last {} % of the run, at Δt = {} s{}.\n\n",
+         pushed at a corner from ω = 0 for {} s; ω is the mean over the last {} % of the run{}, at Δt = {} s{}.\n\n",
         e.description(),
         plan.t_run,
         100.0 * plan.tail,
+        match e.law().and_then(|l| l.angle_period(&super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None))) {
+            Some(a) => format!(
+                ", cut to the whole number of the law's periods in the object's angle ({a:.4} rad) that the tail turns through, where it turns through one or more"
+            ),
+            None => String::new(),
+        },
         plan.dt,
         if plan.setups[0].options.values.is_empty() {
             String::new()

@@ -327,6 +327,17 @@ impl crate::FrictionLaw for DrakeConvex {
     fn loads(&self, problem: &Problem, segment: usize, dt: f64) -> Option<Vec<f64>> {
         self.lift(problem, segment, dt).map(|l| l.loads)
     }
+    /// The friction stays Coulomb's (μN along −slip, measured to 1e-4 of
+    /// the ratio): with the run's loads the law is Coulomb on them.
+    fn steady_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        dt: f64,
+        loads: &[f64],
+    ) -> Option<LawSteady> {
+        crate::COULOMB.steady(&crate::on_loads(problem, loads)?, segment, dt)
+    }
 }
 
 #[cfg(test)]

@@ -498,6 +498,27 @@ impl FrictionLaw for FrictionModel {
             _ => "Coulomb regularised below the slip speed (pushval_rapier2d::idioms)",
         }
     }
+    /// The per-axis laws repeat when the object turns by π (the world axes'
+    /// rows see `r_x², r_y²` again), by π/2 where the supports are symmetric
+    /// under a quarter turn about the centre of mass (the square plate).
+    fn angle_period(&self, problem: &Problem) -> Option<f64> {
+        if self.is_isotropic() {
+            return None;
+        }
+        let body = &problem.body;
+        let quarter = body.supports().all(|s| {
+            let q = Vec2::new(-s.position.y, s.position.x);
+            body.supports().any(|t| {
+                (t.position - q).norm() <= 1e-12 * (1.0 + q.norm())
+                    && (t.friction - s.friction).abs() <= 1e-12 * s.friction.abs().max(1e-300)
+            })
+        });
+        Some(if quarter {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            std::f64::consts::PI
+        })
+    }
     fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
         let model = *self;
         if model == FrictionModel::Coulomb {

@@ -85,6 +85,13 @@ pub trait FrictionLaw: Send + Sync {
     fn loads(&self, _problem: &Problem, _segment: usize, _dt: f64) -> Option<Vec<f64>> {
         None
     }
+    /// The angle (rad) over which the law repeats as the object turns, for a
+    /// law that depends on the object's angle and whose steady ω is the mean
+    /// over a turn: a run compares with it over a whole number of these
+    /// periods. None (the default) for laws that do not depend on the angle.
+    fn angle_period(&self, _problem: &Problem) -> Option<f64> {
+        None
+    }
     /// The steady state of segment `segment` with the supports carrying
     /// `loads` (N, the problem's support order) instead of the problem's
     /// statics: the law's friction rule fed a run's own loads. The default
