@@ -65,6 +65,10 @@ struct Row {
     kinematics: String,
     /// The run that measured the row (1, 2, …; see the summary).
     run: u32,
+    /// What the cost counts: `thread_cpu` (the engine runs in this
+    /// process's thread) or `wall` (an outside engine: its adapter process
+    /// and pushval's parsing, on an otherwise idle machine).
+    clock: String,
 }
 
 /// The rows of a written `engine_work_precision.csv` (for `--replot`).
@@ -91,6 +95,7 @@ fn read_rows(text: &str) -> Vec<Row> {
                     .get(5)
                     .map_or_else(|| default_kinematics(engine), |k| k.to_string()),
                 run: f.get(6).and_then(|r| r.parse().ok()).unwrap_or(1),
+                clock: f.get(7).map_or("thread_cpu".into(), |c| c.to_string()),
             })
         })
         .collect()
@@ -168,6 +173,9 @@ fn main() {
         .expect("write svg");
         return;
     }
+    // The outside engines of the repository's pushval.toml (those whose
+    // adapters are installed) are measured too, by wall time.
+    registry::use_engines_file(Some(&root.join("pushval.toml"))).expect("pushval.toml loads");
     let sc = registry::load(root.join("scenarios/friction-engines.toml")).expect("scenario loads");
     let problem = sc.problem();
     let duration = problem.duration();
@@ -228,13 +236,23 @@ fn main() {
         if only.as_ref().is_some_and(|o| !o.contains(&name)) {
             continue;
         }
+        let outside = engine.adapter().starts_with("outside");
         for &dt in &ladder {
             let mut times = Vec::new();
             let mut last = None;
+            // An outside engine's session starts on its first run: one run
+            // ahead, untimed.
+            if outside {
+                let _ = engine.run(&problem, dt);
+            }
             for _ in 0..repeats {
-                let t0 = thread_cpu_time();
+                let (t0, w0) = (thread_cpu_time(), std::time::Instant::now());
                 let r = engine.run(&problem, dt);
-                times.push((thread_cpu_time() - t0).as_secs_f64());
+                times.push(if outside {
+                    w0.elapsed().as_secs_f64()
+                } else {
+                    (thread_cpu_time() - t0).as_secs_f64()
+                });
                 last = Some(r);
             }
             let result = match last.expect("ran") {
@@ -263,6 +281,7 @@ fn main() {
                 steps: result.steps,
                 kinematics: kinematics(&*engine).to_string(),
                 run,
+                clock: if outside { "wall" } else { "thread_cpu" }.to_string(),
             };
             eprintln!(
                 "{:28} dt {:.3e}  {:.3e} s/s  omega {:.2e}  position {:.2e} m",
@@ -276,11 +295,11 @@ fn main() {
     }
     let rows = if merge { merged(old_rows, rows) } else { rows };
     let mut csv = String::from(
-        "engine,version,dt_s,cpu_s_per_simulated_s,omega_steady_rel_err,position_err_m,steps,kinematics,run\n",
+        "engine,version,dt_s,cpu_s_per_simulated_s,omega_steady_rel_err,position_err_m,steps,kinematics,run,clock\n",
     );
     for r in &rows {
         csv.push_str(&format!(
-            "{},\"{}\",{:.6e},{:.4e},{:.4e},{:.4e},{},{},{}\n",
+            "{},\"{}\",{:.6e},{:.4e},{:.4e},{:.4e},{},{},{},{}\n",
             r.engine,
             r.version,
             r.dt,
@@ -289,7 +308,8 @@ fn main() {
             r.position,
             r.steps,
             r.kinematics,
-            r.run
+            r.run,
+            r.clock
         ));
     }
     let mut names: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();

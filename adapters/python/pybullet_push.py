@@ -33,6 +33,11 @@ foot: loads 0, 0, 0 and 5 N instead of 2.45 N each). So the pusher is a
 fixed-base body with one light link on a free vertical prismatic joint (its
 weight cancelled each step), and the joint's pivot sits at the feet's
 contact height, so the pushing force does not tip the plate either.
+
+The `[engine]` option `pusher = "fixed_height"` (contact mode) builds that
+pitfall on purpose, for the study's variant that measures it: the pusher a
+plain kinematic point at the contact point's height, joined by the
+point-to-point constraint, which then carries part of the plate's weight.
 """
 
 import math
@@ -169,10 +174,15 @@ class PyBulletPush(Engine):
         # The pusher: a kinematic (mass 0) point moved each step, joined to the
         # contact point. In contact mode the joint acts at the feet's contact
         # height through a light link free to slide vertically (see the top).
-        zp = -(THICK / 2 + 2 * FOOT) if mode == "contact" else 0.0
+        pusher_kind = problem.options.get("pusher", "sliding")
+        if pusher_kind not in ("sliding", "fixed_height"):
+            raise AdapterError(f'[engine] pusher = "{pusher_kind}": expected "sliding" or "fixed_height"')
+        fixed = mode == "forces" or pusher_kind == "fixed_height"
+        zp = -(THICK / 2 + 2 * FOOT) if not fixed else 0.0
         base = self.contact_world()
         base[2] += zp
-        if mode == "contact":
+        self.slider = not fixed
+        if not fixed:
             pusher = p.createMultiBody(
                 0, -1, basePosition=base,
                 linkMasses=[SLIDER_MASS], linkCollisionShapeIndices=[-1], linkVisualShapeIndices=[-1],
@@ -248,7 +258,7 @@ class PyBulletPush(Engine):
         pp = p.getBasePositionAndOrientation(self.pusher, physicsClientId=client)[0]
         target = [pp[0] + h * push.speed * math.cos(a), pp[1] + h * push.speed * math.sin(a), pp[2]]
         p.resetBasePositionAndOrientation(self.pusher, target, [0, 0, 0, 1], physicsClientId=client)
-        if self.args.mode == "contact":
+        if self.slider:
             p.applyExternalForce(self.pusher, 0, [0, 0, SLIDER_MASS * self.g], [0, 0, 0], p.LINK_FRAME, physicsClientId=client)
         p.stepSimulation(physicsClientId=client)
         pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)

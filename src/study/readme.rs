@@ -50,6 +50,42 @@ fn pct(a: usize, b: usize) -> String {
     }
 }
 
+/// Where the law locks and the engine turns anyway: the cells of class
+/// `locked` whose engine |ω| exceeds 1e-2 |ω*| (Coulomb's), their share and
+/// median |ω|, and the range of φ they span. None without locked cells.
+fn locked_turning(map: &Records) -> Option<String> {
+    let locked: Vec<_> = map
+        .iter()
+        .filter(|r| r.get("class").map(String::as_str) == Some("locked"))
+        .collect();
+    if locked.is_empty() {
+        return None;
+    }
+    let mut turning: Vec<(f64, f64)> = locked
+        .iter()
+        .filter(|r| num(r, "omega_engine").abs() > 1e-2 * num(r, "omega_coulomb").abs())
+        .map(|r| (num(r, "omega_engine").abs(), num(r, "phi")))
+        .collect();
+    if turning.is_empty() {
+        return Some(format!(
+            "\nWhere the law locks ({} cells) the engine stays within 1e-2 |ω*| of rest in every one.\n",
+            locked.len()
+        ));
+    }
+    turning.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let median = turning[turning.len() / 2].0;
+    let (lo, hi) = turning
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| {
+            (a.min(t.1), b.max(t.1))
+        });
+    Some(format!(
+        "\nWhere the law locks, the engine turns anyway (|ω| above 1e-2 |ω*|) in {} of the cells, φ from {lo:.2} to {hi:.2} rad, at a median |ω| of {} rad/s: a creep the law does not predict.\n",
+        pct(turning.len(), locked.len()),
+        sig(median)
+    ))
+}
+
 /// A record's per-step load range, `min – max` (N), `–` where unknown.
 fn load_range(r: &std::collections::BTreeMap<String, String>) -> String {
     match (num(r, "load_min"), num(r, "load_max")) {
@@ -197,7 +233,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
         w.file("creep.csv", c.as_bytes())?;
     }
     let mut variants = format!(
-        "variant,options,supports_half,phi,dt,speed,omega_engine,omega_coulomb,omega_law,class,{LAW_RUN_HEAD}\n",
+        "variant,options,supports_half,phi,dt,speed,omega_engine,omega_coulomb,omega_law,class,{LAW_RUN_HEAD},theta_end\n",
     );
     let mut variant_maps = Vec::new();
     for (k, s) in plan.setups.iter().enumerate().skip(1) {
@@ -211,7 +247,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             if let Task::Table { v, .. } = t {
                 let _ = writeln!(
                     variants,
-                    "{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{}",
                     s.name,
                     options.join(" ").replace(',', ";"),
                     s.supports_half.map_or(String::new(), |h| h.to_string()),
@@ -220,7 +256,8 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
                     TABLE_SPEEDS[v],
                     run_line(r),
                     class_name(r[3]),
-                    law_run_line(r)
+                    law_run_line(r),
+                    opt(r[LAW_RUN - 1])
                 );
             }
         }
@@ -533,6 +570,9 @@ fn readme(
             st[5],
             st[6]
         );
+        if let Some(line) = locked_turning(&parse(text)) {
+            s.push_str(&line);
+        }
         if name.is_empty() {
             s.push_str("\nFigure: [`map.svg`](map.svg), drawn from `map.csv`: the error against Coulomb and against the law by decade; the law's locked cells outlined.\n");
         }
@@ -571,11 +611,11 @@ fn readme(
         ladder_table(&mut s, c);
     }
     if plan.setups.len() > 1 {
-        s.push_str("\n## Variants (`variants.csv`)\n\n| variant | options | supports half side (m) | φ (rad) | Δt (s) | v_c | ω engine | ω* Coulomb | ω law | class | ω law, run's loads | per-step loads (N) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        s.push_str("\n## Variants (`variants.csv`)\n\n| variant | options | supports half side (m) | φ (rad) | Δt (s) | v_c | ω engine | ω* Coulomb | ω law | class | ω law, run's loads | per-step loads (N) | θ at the end (rad) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for r in parse(variants) {
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 r["variant"],
                 r["options"],
                 r["supports_half"],
@@ -587,7 +627,8 @@ fn readme(
                 sig(num(&r, "omega_law")),
                 r["class"],
                 sig(num(&r, "omega_law_run")),
-                load_range(&r)
+                load_range(&r),
+                sig(num(&r, "theta_end"))
             );
         }
     }

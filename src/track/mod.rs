@@ -43,7 +43,10 @@
 //! rejecting sample, s); `diverged_at`: the time the filter's state left the
 //! finite numbers (the rest of the input is then not read; exit 1);
 //! `not_converged`: the parameters whose final std exceeds the tolerances
-//! below; `settings`: the noise levels, priors and numerics used.
+//! below; `degenerate`: why the final estimate explains nothing, by the
+//! rule `fit` applies (a μ scale or I_cm at or below 5 % of the file's
+//! value, or not positive: a frictionless or massless plate; exit 1);
+//! `settings`: the noise levels, priors and numerics used.
 //!
 //! `converged_at` (s): the first sample time after which the estimate stays
 //! within 1 % (`mu_scale`, `inertia_cm`) or 1 mm (each component of
@@ -413,14 +416,14 @@ pub fn converged_at(times: &[f64], series: &[f64], tol: f64) -> Option<f64> {
     at
 }
 
-/// `track.json` for `outcome`, and the names of the parameters that did
-/// not converge.
+/// `track.json` for `outcome`, the names of the parameters that did not
+/// converge, and why the final estimate is degenerate (empty when not).
 pub fn summary(
     sc: &Scenario,
     params: &[Param],
     settings: &EkfSettings,
     out: &Outcome,
-) -> (Value, Vec<String>) {
+) -> (Value, Vec<String>, Vec<String>) {
     let num = crate::outdir::json_num;
     let times: Vec<f64> = out.rows.iter().map(|r| r.t).collect();
     let last = out.rows.last().expect("at least one row");
@@ -472,8 +475,28 @@ pub fn summary(
     let mut times_u: Vec<f64> = out.rows.iter().map(|r| r.update_time).collect();
     times_u.sort_by(f64::total_cmp);
     let q = |f: f64| times_u[((times_u.len() - 1) as f64 * f).round() as usize];
-    let converged =
-        not_converged.is_empty() && !out.lack_at_end && out.episodes.len() <= MAX_EPISODES;
+    // The final μ scale and I_cm by the fit's degeneracy rule.
+    let scalar: Vec<(Param, usize)> = params
+        .iter()
+        .filter_map(|p| match p {
+            Param::MuScale => Some((*p, 0)),
+            Param::InertiaCm => Some((*p, 3)),
+            _ => None,
+        })
+        .collect();
+    let values: Vec<f64> = scalar.iter().map(|(_, i)| last.value[*i]).collect();
+    let file: Vec<f64> = scalar
+        .iter()
+        .map(|(p, _)| match p {
+            Param::InertiaCm => sc.problem().body.inertia_cm(),
+            _ => 1.0,
+        })
+        .collect();
+    let degenerate = crate::fit::degenerate_reasons(&scalar, &values, &file);
+    let converged = not_converged.is_empty()
+        && degenerate.is_empty()
+        && !out.lack_at_end
+        && out.episodes.len() <= MAX_EPISODES;
     let v = json!({
         "scenario": sc.name,
         "method": "ekf",
@@ -493,6 +516,7 @@ pub fn summary(
         "diverged_at": out.diverged.map_or(Value::Null, num),
         "converged": converged,
         "not_converged": not_converged,
+        "degenerate": degenerate,
         "settings": {
             "sigma_position": settings.sigma_position,
             "sigma_theta": settings.sigma_theta,
@@ -506,7 +530,7 @@ pub fn summary(
             "z": settings.z,
         },
     });
-    (v, not_converged)
+    (v, not_converged, degenerate)
 }
 
 /// `pushval track`: exit 0 converged, 1 not converged or the model does
@@ -565,7 +589,7 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
     if !out.omega_read {
         eprintln!("note: {src}: no `omega` column: the filter estimates omega from theta");
     }
-    let (json, not_converged) = summary(&sc, &params, &req.settings, &out);
+    let (json, not_converged, degenerate) = summary(&sc, &params, &req.settings, &out);
     std::fs::create_dir_all(&req.out).with_context(|| format!("creating {}", req.out.display()))?;
     let csv_path = req.out.join("track.csv");
     crate::atomic::write_atomic(&csv_path, &csv)?;
@@ -579,6 +603,10 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
             sc.name,
             not_converged.join(", ")
         );
+        code = ExitCode::from(1);
+    }
+    for why in &degenerate {
+        eprintln!("FAIL {}: degenerate estimate: {why}", sc.name);
         code = ExitCode::from(1);
     }
     if out.lack_at_end || out.diverged.is_some() || out.episodes.len() > MAX_EPISODES {

@@ -398,3 +398,48 @@ fn readme_track_numbers_come_from_the_results_files() {
     }
     assert!(checked >= 10, "only {checked} numbers checked");
 }
+
+/// `track`'s final estimate obeys the fit's degeneracy rule: a μ scale near
+/// zero (a frictionless plate) or an I_cm near zero explains nothing, and
+/// says which; the truth of the paper push (μ × 1.1, I_cm × 0.95) does not.
+#[test]
+fn a_degenerate_final_estimate_is_reported() {
+    use pushval::track::{summary, Outcome, Row};
+    let sc = paper();
+    let row = |mu: f64, inertia: f64| Row {
+        t: 1.0,
+        value: [mu, 0.0, 0.0, inertia],
+        std: [0.0; 4],
+        force: 0.0,
+        moment: 0.0,
+        point: pushval_model::Vec2::zeros(),
+        friction_std: [0.0; 4],
+        nis: 0.0,
+        lack_of_fit: false,
+        update_time: 1e-6,
+    };
+    let outcome = |r: Row| Outcome {
+        rows: vec![r],
+        episodes: vec![],
+        lack_at_end: false,
+        diverged: None,
+        omega_read: true,
+    };
+    let params = [Param::MuScale, Param::InertiaCm];
+    let settings = pushval_model::track::EkfSettings::default();
+    let (json, _, why) = summary(&sc, &params, &settings, &outcome(row(2.5e-9, 2.1e-9)));
+    assert_eq!(why.len(), 2, "{why:?}");
+    assert!(
+        why[0].starts_with("mu_scale") && why[1].starts_with("inertia_cm"),
+        "{why:?}"
+    );
+    assert_eq!(json["converged"], false);
+    let (json, _, why) = summary(
+        &sc,
+        &params,
+        &settings,
+        &outcome(row(1.1, 0.95 * sc.inertia_cm)),
+    );
+    assert!(why.is_empty(), "{why:?}");
+    assert_eq!(json["degenerate"], serde_json::json!([]));
+}
