@@ -537,8 +537,12 @@ pub fn whole_period_omega(p: &Problem, traj: &Trajectory, tail: f64, period: f64
     (last.t > start).then(|| turn.signum() * target / (last.t - start))
 }
 
+/// The most tail samples [`law_on_run_loads`] evaluates the law at.
+pub const LAW_RUN_SAMPLES: usize = 40;
+
 /// The law on the run's own loads over the tail of segment `seg` (the
-/// samples of its last `tail` share): the mean of the law's steady ω at
+/// samples of its last `tail` share, at most [`LAW_RUN_SAMPLES`] of them
+/// evenly spaced): the mean of the law's steady ω at
 /// each sample's loads (`omega_law_run`, rad/s) and the RMS of the engine's
 /// ω against those values (rad/s). The law is taken quasi-statically: at
 /// each sample, the steady ω its friction rule gives with that sample's
@@ -555,11 +559,25 @@ fn law_on_run_loads(
 ) -> (f64, f64) {
     let (t0, t1) = p.segment_times()[seg];
     let from = t1 - tail * (t1 - t0);
+    let tail: Vec<_> = run
+        .trajectory
+        .samples
+        .iter()
+        .zip(&contact.loads)
+        .filter(|(s, _)| s.t >= from - 1e-12 && s.t <= t1 + 1e-12)
+        .collect();
+    // At most LAW_RUN_SAMPLES of them, evenly spaced, the last included:
+    // an angle-dependent law's steady ω is a period mean that costs
+    // hundreds of roots.
+    let m = tail.len().min(LAW_RUN_SAMPLES);
     let (mut sum, mut sq, mut n) = (0.0, 0.0, 0usize);
-    for (s, loads) in run.trajectory.samples.iter().zip(&contact.loads) {
-        if s.t < from - 1e-12 || s.t > t1 + 1e-12 {
-            continue;
-        }
+    for j in 0..m {
+        let k = if m < 2 {
+            tail.len() - 1
+        } else {
+            j * (tail.len() - 1) / (m - 1)
+        };
+        let (s, loads) = tail[k];
         let Some(w) = law.steady_on_loads(p, seg, dt, loads) else {
             return (f64::NAN, f64::NAN);
         };

@@ -524,7 +524,7 @@ fn readme(
     let _ = write!(
         s,
         "## Paper plate (`paper_plate.csv`)\n\nφ = π/4 + 0.3 = {PHI_TABLE:.4} rad. Error against Coulomb: relative to ω*; against the law: relative, or |ω|/|ω*| where the law holds ω = 0.\n\n\
-         ω law is the law with the problem's statics (`omega_law`); ω law, run's loads (`omega_law_run`) is the law's steady ω at each sample's loads as the engine measured them, averaged over the tail, and RMS its RMS distance from the engine's ω(t) there (quasi-static: no transient between samples). \
+         ω law is the law with the problem's statics (`omega_law`); ω law, run's loads (`omega_law_run`) is the law's steady ω at each sample's loads as the engine measured them, averaged over the tail (at up to 40 samples evenly spaced), and RMS its RMS distance from the engine's ω(t) there (quasi-static: no transient between samples). \
          Rise: the centre of mass's largest height above its resting height; lost: the share of steps with a support carrying no load (≤ 1e-6 m g); per-step loads: the smallest and largest normal force of any support on any step (N; the plate's weight is 9.81 N). Empty where the engine measures no loads.\n\n\
          | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law | ω law, run's loads | vs it | RMS (rad/s) | rise (m) | lost | per-step loads (N) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
