@@ -675,4 +675,22 @@ mod tests {
             .is_none());
         assert!(crate::on_loads(&p, &[1.0, -1.0, 1.0, 1.0]).is_none());
     }
+
+    /// The per-axis laws, as the catalogue builds them, repeat every quarter
+    /// turn of the square plate (world-axis rows on a body symmetric under a
+    /// quarter turn); the isotropic ones do not depend on the angle.
+    #[test]
+    fn per_axis_laws_declare_their_period() {
+        let p = plate_problem();
+        for (name, period) in [
+            ("impulse_box", Some(std::f64::consts::FRAC_PI_2)),
+            ("impulse_rows_disk", Some(std::f64::consts::FRAC_PI_2)),
+            ("impulse_disk", None),
+            ("coulomb", None),
+            ("regularised_tanh", None),
+        ] {
+            let law = law_entry(name).unwrap().default_law();
+            assert_eq!(law.angle_period(&p), period, "{name}");
+        }
+    }
 }

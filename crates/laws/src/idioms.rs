@@ -600,6 +600,9 @@ macro_rules! idiom_law {
             fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
                 self.model().steady(problem, segment, dt)
             }
+            fn angle_period(&self, problem: &Problem) -> Option<f64> {
+                self.model().angle_period(problem)
+            }
         }
     };
 }
