@@ -224,12 +224,7 @@ pub const RULES: &[Rule] = &[
 /// Files of `results/` that no current command writes, with the evidence,
 /// kept out of the manifest until they are deleted (an entry whose file is
 /// gone fails `--check`: remove it here then).
-pub const STALE: &[(&str, &str)] = &[
-    (
-        "results/friction_models/drake/validate_paper_drake_tamsi_auto.json",
-        "`pushval validate --json` of /tmp/dv/drake_tamsi.toml (commit f4e45c6), a scenario file the repository does not hold",
-    ),
-];
+pub const STALE: &[(&str, &str)] = &[];
 
 /// An engine crate's model table (as [`crate::registry::ENGINE_CRATES`] holds it).
 pub type ModelTable = fn() -> Vec<ModelEntry>;
