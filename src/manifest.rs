@@ -214,10 +214,23 @@ pub const RULES: &[Rule] = &[
         ],
     },
     Rule {
-        // Its figures are read from the two CSVs beside it.
+        command: ".venv-adapters/bin/python adapters/python/drake_lift_study.py",
+        source: "adapters/python/drake_lift_study.py",
+        files: &["results/friction_models/drake/lift.csv"],
+    },
+    Rule {
+        command: ".venv-warp/bin/python scripts/compare_mujoco_warp.py --duration 1.0",
+        source: "scripts/compare_mujoco_warp.py",
+        files: &["results/friction_models/mujoco_warp/compare.csv"],
+    },
+    Rule {
+        // Their figures are read from the CSVs beside them.
         command: BY_HAND,
         source: "",
-        files: &["results/friction_models/drake/README.md"],
+        files: &[
+            "results/friction_models/drake/README.md",
+            "results/friction_models/mujoco_warp/README.md",
+        ],
     },
 ];
 
