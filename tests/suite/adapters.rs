@@ -310,7 +310,8 @@ fn an_outside_engine_study_fills_its_declared_law() {
         }
         // Where the law locks (φ = π/4 on the square) the engine creeps at
         // a few 1e-4 rad/s, as close to Coulomb's tiny ω* as to 0.
-        if line.ends_with(",turns") && (wl - wc).abs() > 0.02 * wc.abs() {
+        let turns = row.get(head.iter().position(|h| *h == "class").unwrap()) == Some(&"turns");
+        if turns && (wl - wc).abs() > 0.02 * wc.abs() {
             n += 1;
             nearer += usize::from((w - wl).abs() < (w - wc).abs());
         }
