@@ -52,6 +52,24 @@ fn thread_cpu_time() -> Duration {
     Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
 }
 
+/// CPU time (s) process `pid` has used, user and system, from
+/// `/proc/PID/stat` (fields 14 and 15, in USER_HZ ticks, which Linux's
+/// /proc ABI fixes at 100 a second); None where it cannot be read.
+fn process_cpu_time(pid: u64) -> Option<f64> {
+    let text = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // Fields after the command name, which is in parentheses and may hold
+    // spaces: the state is field 3, utime field 14.
+    let rest = &text[text.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// The pid of the session process that served an outside engine's run.
+fn session_pid(run: &pushval_engine::EngineRun) -> Option<u64> {
+    run.diagnostics.get("session")?.get("pid")?.as_u64()
+}
+
 struct Row {
     engine: String,
     version: String,
@@ -66,8 +84,8 @@ struct Row {
     /// The run that measured the row (1, 2, …; see the summary).
     run: u32,
     /// What the cost counts: `thread_cpu` (the engine runs in this
-    /// process's thread) or `wall` (an outside engine: its adapter process
-    /// and pushval's parsing, on an otherwise idle machine).
+    /// process's thread) or `process_cpu` (an outside engine: its session
+    /// process's CPU time over the run, from /proc, plus this thread's).
     clock: String,
 }
 
@@ -241,18 +259,24 @@ fn main() {
             let mut times = Vec::new();
             let mut last = None;
             // An outside engine's session starts on its first run: one run
-            // ahead, untimed.
-            if outside {
-                let _ = engine.run(&problem, dt);
-            }
+            // ahead, untimed, which names the session's process.
+            let pid = if outside {
+                engine.run(&problem, dt).ok().as_ref().and_then(session_pid)
+            } else {
+                None
+            };
             for _ in 0..repeats {
-                let (t0, w0) = (thread_cpu_time(), std::time::Instant::now());
+                let t0 = thread_cpu_time();
+                let c0 = pid.and_then(process_cpu_time);
                 let r = engine.run(&problem, dt);
-                times.push(if outside {
-                    w0.elapsed().as_secs_f64()
-                } else {
-                    (thread_cpu_time() - t0).as_secs_f64()
-                });
+                let own = (thread_cpu_time() - t0).as_secs_f64();
+                // Counted only when the same session served the run.
+                let same = r.as_ref().ok().and_then(session_pid) == pid;
+                let child = match (c0, pid.and_then(process_cpu_time)) {
+                    (Some(a), Some(b)) if same => b - a,
+                    _ => f64::NAN,
+                };
+                times.push(if outside { own + child } else { own });
                 last = Some(r);
             }
             let result = match last.expect("ran") {
@@ -281,7 +305,7 @@ fn main() {
                 steps: result.steps,
                 kinematics: kinematics(&*engine).to_string(),
                 run,
-                clock: if outside { "wall" } else { "thread_cpu" }.to_string(),
+                clock: if outside { "process_cpu" } else { "thread_cpu" }.to_string(),
             };
             eprintln!(
                 "{:28} dt {:.3e}  {:.3e} s/s  omega {:.2e}  position {:.2e} m",
