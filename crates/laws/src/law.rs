@@ -114,6 +114,12 @@ pub trait FrictionLaw: Send + Sync {
 /// `m g` whose statics give a problem's rest loads.
 pub const GRAVITY: f64 = 9.81;
 
+/// Whether `loads` (N) are one finite, non-negative number for each of `n`
+/// supports: what a law evaluated on a run's loads accepts.
+pub(crate) fn usable_loads(loads: &[f64], n: usize) -> bool {
+    loads.len() == n && loads.iter().all(|l| l.is_finite() && *l >= 0.0)
+}
+
 /// `problem` with its supports carrying `loads` (N) instead of their rest
 /// loads: each support's friction `μ_i N_i` is scaled by `N_i / N_i^rest`,
 /// the rest loads being the statics of the weight `m g`
@@ -123,7 +129,7 @@ pub const GRAVITY: f64 = 9.81;
 /// friction has no load at rest.
 pub fn on_loads(problem: &Problem, loads: &[f64]) -> Option<Problem> {
     let body = &problem.body;
-    if loads.len() != body.len() || loads.iter().any(|n| !n.is_finite() || *n < 0.0) {
+    if !usable_loads(loads, body.len()) {
         return None;
     }
     let rest = crate::mujoco::rest_loads(body, body.mass() * GRAVITY)?;

@@ -694,7 +694,7 @@ impl FrictionLaw for PhysxClamp {
     ) -> Option<LawSteady> {
         let push = problem.pushes.get(segment)?;
         let body = &problem.body;
-        if loads.len() != body.len() || loads.iter().any(|n| !n.is_finite() || *n < 0.0) {
+        if !crate::law::usable_loads(loads, body.len()) {
             return None;
         }
         let mu = body.total_friction() / (body.mass() * self.gravity);

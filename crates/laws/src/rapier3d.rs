@@ -674,7 +674,7 @@ impl FrictionLaw for Rapier3dTilt {
     ) -> Option<LawSteady> {
         let push = problem.pushes.get(segment)?;
         let scene = Scene::of(problem, &self.scene).ok()?;
-        if loads.len() != scene.points.len() || loads.iter().any(|n| !n.is_finite() || *n < 0.0) {
+        if !crate::law::usable_loads(loads, scene.points.len()) {
             return None;
         }
         let (omega, _) = omega_at_loads(&scene, push, self.law, loads).ok()?;
