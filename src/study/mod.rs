@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use pushval_engine::{rel_err, tail_loads, tail_mean_omega, Engine, EngineOptions, LawClass};
-use pushval_model::{Problem, Push, Trajectory};
+use pushval_model::{Problem, Push, SegmentDynamics, Trajectory};
 
 use crate::outdir::Writer;
 use crate::parallel::par_rows;
@@ -537,18 +537,26 @@ pub fn whole_period_omega(p: &Problem, traj: &Trajectory, tail: f64, period: f64
     (last.t > start).then(|| turn.signum() * target / (last.t - start))
 }
 
-/// The most tail samples [`law_on_run_loads`] evaluates the law at.
+/// The most tail samples [`law_on_run_loads`] evaluates a law without
+/// dynamics at (quasi-statically).
 pub const LAW_RUN_SAMPLES: usize = 40;
 
-/// The law on the run's own loads over the tail of segment `seg` (the
-/// samples of its last `tail` share, at most [`LAW_RUN_SAMPLES`] of them
-/// evenly spaced): the mean of the law's steady ω at
-/// each sample's loads (`omega_law_run`, rad/s) and the RMS of the engine's
-/// ω against those values (rad/s). The law is taken quasi-statically: at
-/// each sample, the steady ω its friction rule gives with that sample's
-/// loads (no transient between samples). NaN where the engine's loads do
-/// not cover the supports or the law has no steady state on them.
-fn law_on_run_loads(
+/// The law on the run's own loads over the tail of segment `seg` (its
+/// last `tail` share): the mean of the law's ω over the tail samples
+/// (`omega_law_run`, rad/s) and the RMS of the engine's ω against it
+/// (`law_run_rms`, rad/s). NaN where the engine's loads do not cover the
+/// supports or the law has no value on them.
+///
+/// A law with dynamics ([`pushval_engine::FrictionLaw::dynamics_on_loads`],
+/// Coulomb on the loads) is integrated in time: from the engine's ω at the
+/// tail's first sample, each interval between samples under the loads the
+/// engine carried over it (the recorder's interval means), so loads that
+/// change faster than the law settles act through its transient. Any other
+/// law is taken quasi-statically, at most [`LAW_RUN_SAMPLES`] samples evenly
+/// spaced: at each, the steady ω its friction rule gives with that sample's
+/// loads (an angle-dependent law's steady ω is a period mean that costs
+/// hundreds of roots).
+pub fn law_on_run_loads(
     law: &dyn pushval_engine::FrictionLaw,
     p: &Problem,
     seg: usize,
@@ -566,29 +574,65 @@ fn law_on_run_loads(
         .zip(&contact.loads)
         .filter(|(s, _)| s.t >= from - 1e-12 && s.t <= t1 + 1e-12)
         .collect();
-    // At most LAW_RUN_SAMPLES of them, evenly spaced, the last included:
-    // an angle-dependent law's steady ω is a period mean that costs
-    // hundreds of roots.
-    let m = tail.len().min(LAW_RUN_SAMPLES);
-    let (mut sum, mut sq, mut n) = (0.0, 0.0, 0usize);
-    for j in 0..m {
-        let k = if m < 2 {
-            tail.len() - 1
-        } else {
-            j * (tail.len() - 1) / (m - 1)
-        };
-        let (s, loads) = tail[k];
-        let Some(w) = law.steady_on_loads(p, seg, dt, loads) else {
-            return (f64::NAN, f64::NAN);
-        };
-        sum += w.omega;
-        sq += (s.omega - w.omega).powi(2);
-        n += 1;
-    }
-    if n == 0 {
+    let Some(&(first, _)) = tail.first() else {
         return (f64::NAN, f64::NAN);
+    };
+    let mut pairs = Vec::with_capacity(tail.len());
+    if law_integrates(law, p, seg, dt) {
+        // Without load the law applies no friction: ω̇ = k ω / I_P, the
+        // inertial term alone, exactly e^(k t / I_P).
+        let free = SegmentDynamics::new(&p.body, &p.pushes[seg]);
+        let rate = free.inertial_slope() / free.inertia_contact();
+        let mut w = first.omega;
+        pairs.push((first.omega, w));
+        for pair in tail.windows(2) {
+            let ((a, _), (b, loads)) = (pair[0], pair[1]);
+            let span = b.t - a.t;
+            let next = if loads.len() == p.body.len() && loads.iter().all(|&l| l == 0.0) {
+                Some(w * (rate * span).exp())
+            } else {
+                law.dynamics_on_loads(p, seg, dt, loads)
+                    .and_then(|d| d.advance(w, span))
+            };
+            let Some(next) = next else {
+                return (f64::NAN, f64::NAN);
+            };
+            w = next;
+            pairs.push((b.omega, w));
+        }
+    } else {
+        let m = tail.len().min(LAW_RUN_SAMPLES);
+        for j in 0..m {
+            let k = if m < 2 {
+                tail.len() - 1
+            } else {
+                j * (tail.len() - 1) / (m - 1)
+            };
+            let (s, loads) = tail[k];
+            let Some(w) = law.steady_on_loads(p, seg, dt, loads) else {
+                return (f64::NAN, f64::NAN);
+            };
+            pairs.push((s.omega, w.omega));
+        }
     }
-    (sum / n as f64, (sq / n as f64).sqrt())
+    let n = pairs.len() as f64;
+    let mean = pairs.iter().map(|(_, w)| w).sum::<f64>() / n;
+    let rms = (pairs.iter().map(|(e, w)| (e - w).powi(2)).sum::<f64>() / n).sqrt();
+    (mean, rms)
+}
+
+/// Whether `law` has dynamics a study integrates along a run's loads
+/// ([`pushval_engine::FrictionLaw::dynamics_on_loads`] on the problem's
+/// rest loads, the statics of its weight).
+pub(crate) fn law_integrates(
+    law: &dyn pushval_engine::FrictionLaw,
+    p: &Problem,
+    seg: usize,
+    dt: f64,
+) -> bool {
+    let body = &p.body;
+    pushval_laws::mujoco::rest_loads(body, body.mass() * pushval_engine::GRAVITY)
+        .is_some_and(|rest| law.dynamics_on_loads(p, seg, dt, &rest).is_some())
 }
 
 /// The engine against a reference ω: relative with the gate's floor

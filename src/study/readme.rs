@@ -521,12 +521,27 @@ fn readme(
         s.push_str(a.trim());
         s.push_str("\n\n");
     }
+    // A law with dynamics is integrated along the run's loads where the
+    // engine measured them (the rows' rise), else taken quasi-statically.
+    let integrated = parse(paper)
+        .iter()
+        .any(|r| num(r, "max_rise_m").is_finite())
+        && e.law().is_some_and(|l| {
+            let p = super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None);
+            super::law_integrates(l, &p, 0, plan.dt)
+        });
     let _ = write!(
         s,
         "## Paper plate (`paper_plate.csv`)\n\nφ = π/4 + 0.3 = {PHI_TABLE:.4} rad. Error against Coulomb: relative to ω*; against the law: relative, or |ω|/|ω*| where the law holds ω = 0.\n\n\
-         ω law is the law with the problem's statics (`omega_law`); ω law, run's loads (`omega_law_run`) is the law's steady ω at each sample's loads as the engine measured them, averaged over the tail (at up to 40 samples evenly spaced), and RMS its RMS distance from the engine's ω(t) there (quasi-static: no transient between samples). \
+         ω law is the law with the problem's statics (`omega_law`); ω law, run's loads (`omega_law_run`) is {}, and RMS its RMS distance from the engine's ω(t) there{}. \
          Rise: the centre of mass's largest height above its resting height; lost: the share of steps with a support carrying no load (≤ 1e-6 m g); per-step loads: the smallest and largest normal force of any support on any step (N; the plate's weight is 9.81 N). Empty where the engine measures no loads.\n\n\
-         | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law | ω law, run's loads | vs it | RMS (rad/s) | rise (m) | lost | per-step loads (N) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n"
+         | v_c (m/s) | ω engine (rad/s) | ω* Coulomb | ω law | vs Coulomb | vs law | ω law, run's loads | vs it | RMS (rad/s) | rise (m) | lost | per-step loads (N) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        if integrated {
+            "the law integrated in time along the tail with the loads the engine carried between samples (from the engine's ω at the tail's first sample; this law is Coulomb on the loads, with the analytic model's transient), averaged over the tail"
+        } else {
+            "the law's steady ω at each sample's loads as the engine measured them, averaged over the tail (at up to 40 samples evenly spaced)"
+        },
+        if integrated { "" } else { " (quasi-static: no transient between samples)" },
     );
     for r in parse(paper) {
         let (v, we, wc, wl, wr) = (

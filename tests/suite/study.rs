@@ -888,3 +888,72 @@ fn whole_period_tails_give_the_period_mean() {
     // Less than one period in the tail: no whole-period mean.
     assert!(pushval::study::whole_period_omega(&p, &traj, 0.05, 2.0).is_none());
 }
+
+/// The law on a run's loads, integrated in time: fed the analytic model's
+/// own trajectory (Coulomb, from rest, the transient included) and the loads
+/// it was computed with, Coulomb reproduces it sample by sample; with the
+/// supports' loads doubled it reproduces the model run on doubled friction
+/// and misses the first one. A law with steady states only, taken
+/// quasi-statically, misses the transient.
+#[test]
+fn the_law_integrated_on_a_runs_loads_follows_its_transient() {
+    use pushval_engine::{ContactRecord, EngineRun, FrictionLaw, LawSteady, COULOMB};
+    struct SteadyOnly;
+    impl FrictionLaw for SteadyOnly {
+        fn law_name(&self) -> &'static str {
+            "Coulomb's steady states, no dynamics (test)"
+        }
+        fn steady(&self, p: &Problem, seg: usize, dt: f64) -> Option<LawSteady> {
+            COULOMB.steady(p, seg, dt)
+        }
+    }
+    let p = problem(0.5, 1.0, 1.5, None);
+    let body = &p.body;
+    let rest = pushval_laws::mujoco::rest_loads(body, body.mass() * 9.81).unwrap();
+    let model = crate::common::adaptive(1e-11, false);
+    let judge = |law: &dyn FrictionLaw, traj: &pushval_model::Trajectory, scale: f64| {
+        let loads: Vec<Vec<f64>> = traj
+            .samples
+            .iter()
+            .map(|_| rest.iter().map(|l| scale * l).collect())
+            .collect();
+        let contact = ContactRecord {
+            loads,
+            max_rise_m: 0.0,
+            contact_lost_share: 0.0,
+            load_range: [0.0, 0.0],
+        };
+        let run = EngineRun {
+            trajectory: traj.clone(),
+            dt: 1e-3,
+            steps: 0,
+            wall_time: Default::default(),
+            diagnostics: serde_json::json!({}),
+            contact: Some(contact.clone()),
+        };
+        pushval::study::law_on_run_loads(law, &p, 0, 1e-3, 1.0, &run, &contact)
+    };
+    let traj = crate::common::run(&model, &p);
+    let w_star = coulomb(&p).abs();
+    let mean = traj.samples.iter().map(|s| s.omega).sum::<f64>() / traj.samples.len() as f64;
+    let (law_mean, rms) = judge(&COULOMB, &traj, 1.0);
+    assert!(rms < 1e-6 * w_star, "rms {rms}");
+    assert!(
+        (law_mean - mean).abs() < 1e-6 * w_star,
+        "{law_mean} vs {mean}"
+    );
+    // Doubled loads: the model on a plate with twice the friction.
+    let doubled =
+        pushval_laws::on_loads(&p, &rest.iter().map(|l| 2.0 * l).collect::<Vec<_>>()).unwrap();
+    let traj2 = crate::common::run(&model, &doubled);
+    let (_, rms2) = judge(&COULOMB, &traj2, 2.0);
+    assert!(rms2 < 1e-6 * w_star, "rms {rms2}");
+    let (_, wrong) = judge(&COULOMB, &traj2, 1.0);
+    assert!(wrong > 1e3 * rms2, "loads ignored: {wrong} vs {rms2}");
+    // Quasi-static: the steady ω at every sample, the transient missed.
+    let (_, quasi) = judge(&SteadyOnly, &traj, 1.0);
+    assert!(
+        quasi > 1e3 * rms,
+        "quasi-static {quasi} vs integrated {rms}"
+    );
+}

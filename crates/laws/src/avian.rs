@@ -319,6 +319,16 @@ impl FrictionLaw for Avian3dTilt {
     ) -> Option<LawSteady> {
         crate::COULOMB.steady(&crate::on_loads(problem, loads)?, segment, dt)
     }
+    /// Coulomb's dynamics on the given loads.
+    fn dynamics_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        dt: f64,
+        loads: &[f64],
+    ) -> Option<pushval_model::SegmentDynamics> {
+        crate::COULOMB.dynamics_on_loads(problem, segment, dt, loads)
+    }
 }
 
 #[cfg(test)]

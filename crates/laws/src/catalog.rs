@@ -676,6 +676,41 @@ mod tests {
         assert!(crate::on_loads(&p, &[1.0, -1.0, 1.0, 1.0]).is_none());
     }
 
+    /// A law with dynamics on a run's loads settles, from rest, where its
+    /// steady state on those loads lies: the transient the study integrates
+    /// and the steady ω it compares are one law. Checked on loads moved onto
+    /// the pushed side for every catalogue law that has dynamics; Coulomb
+    /// and the laws that are Coulomb on a run's loads must have them.
+    #[test]
+    fn a_laws_dynamics_settle_at_its_steady_state() {
+        let p = plate_problem();
+        let moved = [3.0, 2.5, 1.905, 2.405];
+        let mut with = vec![];
+        for e in catalog() {
+            let law = e.default_law();
+            let Some(seg) = law.dynamics_on_loads(&p, 0, 1e-3, &moved) else {
+                continue;
+            };
+            let steady = law.steady_on_loads(&p, 0, 1e-3, &moved).unwrap().omega;
+            let settled = seg.advance(0.0, 5.0).unwrap();
+            assert!(
+                (settled - steady).abs() < 1e-9 * steady.abs().max(1e-3),
+                "{}: settles at {settled}, steady {steady}",
+                e.name
+            );
+            with.push(e.name);
+        }
+        for name in [
+            "coulomb",
+            "mujoco_elliptic",
+            "avian3d_tilt",
+            "drake_sap",
+            "drake_similar",
+        ] {
+            assert!(with.contains(&name), "{name} has no dynamics: {with:?}");
+        }
+    }
+
     /// The per-axis laws, as the catalogue builds them, repeat every quarter
     /// turn of the square plate (world-axis rows on a body symmetric under a
     /// quarter turn); the isotropic ones do not depend on the angle.

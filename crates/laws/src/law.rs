@@ -108,6 +108,22 @@ pub trait FrictionLaw: Send + Sync {
     ) -> Option<LawSteady> {
         self.steady(&on_loads(problem, loads)?, segment, dt)
     }
+    /// The law's own ω dynamics for segment `segment` with the supports
+    /// carrying `loads` (N), for a law that is Coulomb at every support on
+    /// some loads: the analytic model's segment on them. A study integrates
+    /// it between a run's samples ([`SegmentDynamics::advance`]), so loads
+    /// that change faster than the law settles (a hopping plate) are judged
+    /// with the law's transient. None by default: the law has steady states
+    /// only and is taken quasi-statically.
+    fn dynamics_on_loads(
+        &self,
+        _problem: &Problem,
+        _segment: usize,
+        _dt: f64,
+        _loads: &[f64],
+    ) -> Option<SegmentDynamics> {
+        None
+    }
 }
 
 /// Gravity (m/s²) of every engine scene pushval builds, and so the weight
@@ -178,6 +194,16 @@ impl FrictionLaw for Coulomb {
                 LawClass::Turns
             },
         })
+    }
+    fn dynamics_on_loads(
+        &self,
+        problem: &Problem,
+        segment: usize,
+        _dt: f64,
+        loads: &[f64],
+    ) -> Option<SegmentDynamics> {
+        let push = problem.pushes.get(segment)?;
+        Some(SegmentDynamics::new(&on_loads(problem, loads)?.body, push))
     }
 }
 

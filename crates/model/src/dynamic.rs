@@ -714,6 +714,63 @@ impl SegmentDynamics {
         }
     }
 
+    /// ω (rad/s) after `duration` (s) of the segment's flow ω̇ = G(ω)/I_P
+    /// from `omega`: the dynamic model's transient with the push held. ω
+    /// may run away (no steady state ahead): it is still followed for
+    /// `duration`. None where it leaves the finite numbers.
+    ///
+    /// The flow is one-dimensional and autonomous, so ω moves monotonically
+    /// towards [`Self::attractor_from`] and never passes it. Adaptive
+    /// Dormand–Prince 5(4) steps ([`crate::integrate`]) evaluate G only on
+    /// the stretch between the start and that steady state: at a pivot G
+    /// jumps, and an integrator that stepped past it would chatter; clamped,
+    /// ω reaches the pivot in finite time and stays.
+    pub fn advance(&self, omega: f64, duration: f64) -> Option<f64> {
+        use crate::integrate::{dp5_attempt, initial_step, next_step, State};
+        if duration <= 0.0 {
+            return Some(omega);
+        }
+        // Without a steady state ahead, ω runs away: nothing to stop at.
+        let target = self.attractor_from(omega).map(|r| r.omega);
+        if target == Some(omega) {
+            return target;
+        }
+        let (lo, hi) = match target {
+            Some(t) => (omega.min(t), omega.max(t)),
+            None => (f64::NEG_INFINITY, f64::INFINITY),
+        };
+        let mut f = |y: &State| [0.0, self.omega_dot(y[1].clamp(lo, hi)), 0.0, 0.0];
+        let rtol = [0.0, 1e-10, 0.0, 0.0];
+        let atol = 1e-12 * (1.0 + omega.abs().max(target.unwrap_or(0.0).abs()));
+        let mut y = [0.0, omega, 0.0, 0.0];
+        let mut k1 = f(&y);
+        let mut h = initial_step(&mut f, &y, &k1, atol, &rtol, 5, duration);
+        let mut t = 0.0;
+        // A bound on the work, never reached by a flow that settles: each
+        // accepted step is at least as long as the flow's fastest time scale.
+        for _ in 0..1_000_000 {
+            if t >= duration {
+                return Some(y[1]);
+            }
+            let step = h.min(duration - t);
+            let a = dp5_attempt(&mut f, &y, &k1, step, atol, &rtol);
+            if a.err <= 1.0 {
+                t = if step == duration - t {
+                    duration
+                } else {
+                    t + step
+                };
+                y[1] = a.y1[1].clamp(lo, hi);
+                if Some(y[1]) == target || !y[1].is_finite() {
+                    return y[1].is_finite().then_some(y[1]);
+                }
+                k1 = f(&y);
+            }
+            h = next_step(step, a.err);
+        }
+        y[1].is_finite().then_some(y[1])
+    }
+
     /// Sum of the support friction forces in the object frame (N).
     pub fn friction_force(&self, omega: f64) -> Vec2 {
         let v = self.speed;
@@ -838,6 +895,135 @@ mod tests {
             let r = seg.attractor_from(w).expect("a stable root");
             assert!(r.omega.abs() <= 1e-14 * scale, "from {w}: {r:?}");
             assert_eq!(r.kind, RootKind::Stable);
+        }
+    }
+
+    /// Near a stable smooth root the flow is linear: a small offset decays
+    /// as e^(−t/τ) with the root's own relaxation time τ = −I_P/G'(ω*).
+    #[test]
+    fn advance_decays_with_the_roots_relaxation_time() {
+        let b = body(&[(0.1, 0.08), (0.12, -0.07), (-0.05, 0.02)]);
+        let push = Push {
+            duration: 1.0,
+            speed: 0.7,
+            phi: 0.4,
+        };
+        let seg = SegmentDynamics::new(&b, &push);
+        let root = seg.attractor_from(0.0).expect("a steady state");
+        let tau = root.tau.expect("a smooth stable root");
+        let eps = 1e-6 * (1.0 + root.omega.abs());
+        for sign in [1.0, -1.0] {
+            for k in [0.5, 1.0, 3.0] {
+                let w = seg.advance(root.omega + sign * eps, k * tau).unwrap();
+                let ratio = (w - root.omega) / (sign * eps);
+                assert!(
+                    (ratio - (-k).exp()).abs() < 1e-4,
+                    "t = {k} τ: ratio {ratio}, e^-t/τ {}",
+                    (-k).exp()
+                );
+            }
+        }
+    }
+
+    /// The transient composes (a then b is a + b), moves monotonically
+    /// towards the attractor without passing it, and reaches it.
+    #[test]
+    fn advance_composes_and_settles_monotonically() {
+        let b = body(&[(0.1, 0.08), (0.12, -0.07), (-0.05, 0.02), (0.0, -0.1)]);
+        let push = Push {
+            duration: 1.0,
+            speed: 0.3,
+            phi: -0.7,
+        };
+        let seg = SegmentDynamics::new(&b, &push);
+        let root = seg.attractor_from(0.0).expect("a steady state");
+        let tau = root.tau.expect("a smooth stable root");
+        let scale = 1.0 + root.omega.abs();
+        let (a, c) = (0.37 * tau, 1.9 * tau);
+        let two = seg.advance(seg.advance(0.0, a).unwrap(), c).unwrap();
+        let one = seg.advance(0.0, a + c).unwrap();
+        assert!((two - one).abs() < 1e-8 * scale, "{two} vs {one}");
+        let mut prev = 0.0;
+        for j in 1..=40 {
+            let w = seg.advance(0.0, 0.25 * tau * j as f64).unwrap();
+            assert!(
+                (w - prev) * root.omega.signum() >= 0.0,
+                "step {j}: {prev} → {w}"
+            );
+            assert!(
+                (w - 0.0) * (w - root.omega) <= 0.0,
+                "passed ω* = {}: {w}",
+                root.omega
+            );
+            prev = w;
+        }
+        let late = seg.advance(0.0, 60.0 * tau).unwrap();
+        assert!(
+            (late - root.omega).abs() < 1e-9 * scale,
+            "{late} vs {}",
+            root.omega
+        );
+    }
+
+    /// A pivot is reached in finite time (G does not vanish there) and held:
+    /// ω equals the pivot's rate exactly, without chattering about it.
+    #[test]
+    fn advance_reaches_a_pivot_and_stays() {
+        // A heavily loaded support straight beside the contact point across
+        // the push: the plate turns about it at ω = v / 0.1.
+        let sup = [
+            Support {
+                position: Vec2::new(-0.1, 0.1),
+                friction: 5.0,
+            },
+            Support {
+                position: Vec2::new(0.1, -0.1),
+                friction: 0.05,
+            },
+        ];
+        let b = Body::new(1.0, 0.01, Vec2::new(-0.1, 0.0), &sup).unwrap();
+        let push = Push {
+            duration: 1.0,
+            speed: 0.2,
+            phi: 0.0,
+        };
+        let seg = SegmentDynamics::new(&b, &push);
+        let root = seg.attractor_from(0.0).expect("a steady state");
+        assert!(
+            matches!(root.kind, RootKind::Pivot { stable: true, .. }),
+            "{root:?}"
+        );
+        let pivot = root.omega;
+        assert!((pivot.abs() - 0.2 / 0.1).abs() < 1e-9, "{pivot}");
+        let early = seg.advance(0.0, 1e-4).unwrap();
+        assert!(early.abs() > 0.0 && early.abs() < pivot.abs(), "{early}");
+        assert_eq!(seg.advance(0.0, 10.0), Some(pivot));
+    }
+
+    /// With its one support under the contact point friction has no moment
+    /// about it: ω̇ = k ω / I_P, which runs away as e^(k t / I_P) when the
+    /// contact lies ahead of the centre of mass along the push (a pull,
+    /// k > 0).
+    #[test]
+    fn advance_follows_a_runaway_exactly() {
+        let sup = [Support {
+            position: Vec2::new(-0.1, 0.0),
+            friction: 0.5,
+        }];
+        let b = Body::new(1.0, 0.01, Vec2::new(-0.1, 0.0), &sup).unwrap();
+        let push = Push {
+            duration: 1.0,
+            speed: 0.4,
+            phi: std::f64::consts::PI - 0.3,
+        };
+        let seg = SegmentDynamics::new(&b, &push);
+        let rate = seg.inertial_slope() / seg.inertia_contact();
+        assert!(rate > 0.0, "{rate}");
+        assert!(seg.attractor_from(0.2).is_none());
+        for t in [0.01, 0.3, 2.0] {
+            let want = 0.2 * (rate * t).exp();
+            let got = seg.advance(0.2, t).unwrap();
+            assert!((got - want).abs() < 1e-8 * want, "t {t}: {got} vs {want}");
         }
     }
 
