@@ -742,7 +742,14 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
             ));
             continue;
         }
+        let started = std::time::Instant::now();
         let one = run_model(m, &root.join(m), opts)?;
+        // Progress of a long `all`: which model took how long.
+        eprintln!(
+            "study {m}: {} tasks, {:.1} s",
+            one.tasks,
+            started.elapsed().as_secs_f64()
+        );
         sum.files.extend(one.files);
         sum.tasks += one.tasks;
     }
