@@ -310,24 +310,8 @@ impl FrictionLaw for Avian3dTilt {
         scene.steady(push, 0.0).map(|(_, loads)| loads)
     }
     /// Coulomb along −u at every foot with the given loads.
-    fn steady_on_loads(
-        &self,
-        problem: &Problem,
-        segment: usize,
-        dt: f64,
-        loads: &[f64],
-    ) -> Option<LawSteady> {
-        crate::COULOMB.steady(&crate::on_loads(problem, loads)?, segment, dt)
-    }
-    /// Coulomb's dynamics on the given loads.
-    fn dynamics_on_loads(
-        &self,
-        problem: &Problem,
-        segment: usize,
-        dt: f64,
-        loads: &[f64],
-    ) -> Option<pushval_model::SegmentDynamics> {
-        crate::COULOMB.dynamics_on_loads(problem, segment, dt, loads)
+    fn coulomb_on_run_loads(&self) -> bool {
+        true
     }
 }
 

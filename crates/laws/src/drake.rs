@@ -329,24 +329,8 @@ impl crate::FrictionLaw for DrakeConvex {
     }
     /// The friction stays Coulomb's (μN along −slip, measured to 1e-4 of
     /// the ratio): with the run's loads the law is Coulomb on them.
-    fn steady_on_loads(
-        &self,
-        problem: &Problem,
-        segment: usize,
-        dt: f64,
-        loads: &[f64],
-    ) -> Option<LawSteady> {
-        crate::COULOMB.steady(&crate::on_loads(problem, loads)?, segment, dt)
-    }
-    /// Coulomb's dynamics on the given loads.
-    fn dynamics_on_loads(
-        &self,
-        problem: &Problem,
-        segment: usize,
-        dt: f64,
-        loads: &[f64],
-    ) -> Option<pushval_model::SegmentDynamics> {
-        crate::COULOMB.dynamics_on_loads(problem, segment, dt, loads)
+    fn coulomb_on_run_loads(&self) -> bool {
+        true
     }
 }
 

@@ -92,12 +92,21 @@ pub trait FrictionLaw: Send + Sync {
     fn angle_period(&self, _problem: &Problem) -> Option<f64> {
         None
     }
+    /// Whether the law's friction is Coulomb's once the supports carry a
+    /// run's own loads (its departures from Coulomb are all in how it
+    /// predicts the loads: MuJoCo's and avian3d's load transfer, Drake's
+    /// lift). Such a law is judged on a run's loads as Coulomb on them, with
+    /// Coulomb's dynamics; false by default.
+    fn coulomb_on_run_loads(&self) -> bool {
+        false
+    }
     /// The steady state of segment `segment` with the supports carrying
     /// `loads` (N, the problem's support order) instead of the problem's
     /// statics: the law's friction rule fed a run's own loads. The default
-    /// suits laws that take their loads from the problem: it evaluates
-    /// [`FrictionLaw::steady`] on [`on_loads`]. A law that predicts its own
-    /// loads overrides it (with its friction rule at the given loads) or
+    /// is Coulomb on [`on_loads`] for a law that is Coulomb on a run's loads
+    /// ([`FrictionLaw::coulomb_on_run_loads`]), else [`FrictionLaw::steady`]
+    /// on [`on_loads`], which suits laws that take their loads from the
+    /// problem. A law with another rule at given loads overrides it or
     /// returns None.
     fn steady_on_loads(
         &self,
@@ -106,23 +115,33 @@ pub trait FrictionLaw: Send + Sync {
         dt: f64,
         loads: &[f64],
     ) -> Option<LawSteady> {
-        self.steady(&on_loads(problem, loads)?, segment, dt)
+        let p = on_loads(problem, loads)?;
+        if self.coulomb_on_run_loads() {
+            COULOMB.steady(&p, segment, dt)
+        } else {
+            self.steady(&p, segment, dt)
+        }
     }
     /// The law's own ω dynamics for segment `segment` with the supports
-    /// carrying `loads` (N), for a law that is Coulomb at every support on
-    /// some loads: the analytic model's segment on them. A study integrates
-    /// it between a run's samples ([`SegmentDynamics::advance`]), so loads
-    /// that change faster than the law settles (a hopping plate) are judged
-    /// with the law's transient. None by default: the law has steady states
-    /// only and is taken quasi-statically.
+    /// carrying `loads` (N), for a law that is Coulomb on a run's loads
+    /// ([`FrictionLaw::coulomb_on_run_loads`]): the analytic model's segment
+    /// on them. A study integrates it between a run's samples
+    /// ([`SegmentDynamics::advance`]), so loads that change faster than the
+    /// law settles (a hopping plate) are judged with the law's transient.
+    /// None for any other law: it has steady states only and is taken
+    /// quasi-statically.
     fn dynamics_on_loads(
         &self,
-        _problem: &Problem,
-        _segment: usize,
+        problem: &Problem,
+        segment: usize,
         _dt: f64,
-        _loads: &[f64],
+        loads: &[f64],
     ) -> Option<SegmentDynamics> {
-        None
+        if !self.coulomb_on_run_loads() {
+            return None;
+        }
+        let push = problem.pushes.get(segment)?;
+        Some(SegmentDynamics::new(&on_loads(problem, loads)?.body, push))
     }
 }
 
@@ -195,15 +214,8 @@ impl FrictionLaw for Coulomb {
             },
         })
     }
-    fn dynamics_on_loads(
-        &self,
-        problem: &Problem,
-        segment: usize,
-        _dt: f64,
-        loads: &[f64],
-    ) -> Option<SegmentDynamics> {
-        let push = problem.pushes.get(segment)?;
-        Some(SegmentDynamics::new(&on_loads(problem, loads)?.body, push))
+    fn coulomb_on_run_loads(&self) -> bool {
+        true
     }
 }
 

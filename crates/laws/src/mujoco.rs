@@ -322,23 +322,7 @@ impl crate::FrictionLaw for MujocoElliptic {
     }
     /// Coulomb at every foot with the given loads (the transfer is what the
     /// run's loads already hold).
-    fn steady_on_loads(
-        &self,
-        problem: &Problem,
-        segment: usize,
-        dt: f64,
-        loads: &[f64],
-    ) -> Option<LawSteady> {
-        COULOMB.steady(&crate::on_loads(problem, loads)?, segment, dt)
-    }
-    /// Coulomb's dynamics on the given loads.
-    fn dynamics_on_loads(
-        &self,
-        problem: &Problem,
-        segment: usize,
-        dt: f64,
-        loads: &[f64],
-    ) -> Option<pushval_model::SegmentDynamics> {
-        crate::COULOMB.dynamics_on_loads(problem, segment, dt, loads)
+    fn coulomb_on_run_loads(&self) -> bool {
+        true
     }
 }
