@@ -24,6 +24,7 @@ use pushval_model::{ModelError, Problem, Trajectory};
 mod contact;
 mod options;
 mod resample;
+mod session;
 pub mod stepping;
 
 pub use contact::{ContactRecord, LoadRecorder, LOST_SHARE_OF_WEIGHT};
@@ -36,6 +37,9 @@ pub use pushval_laws::{
 pub use resample::{
     resample, sample, segment_reports, step_tail_omega, tail_mean_omega, trajectory_from_steps,
     StepRecord,
+};
+pub use session::{
+    rigid_cm_velocity, run_via_session, with_pushes, EngineSession, EngineState, ReplaySession,
 };
 
 /// What one engine run produced.
@@ -203,8 +207,20 @@ pub trait Engine: Send + Sync {
     /// The settings that produce a run at `dt`, as JSON for the outputs
     /// (includes `"engine"`: the version, and `"dt"`).
     fn settings(&self, dt: f64) -> serde_json::Value;
-    /// Runs the problem at time step `dt` (s).
+    /// Runs the problem at time step `dt` (s). An engine with its own
+    /// session implements this as [`run_via_session`]: `start`, one
+    /// `advance` per push, `finish`.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError>;
+    /// The engine's own session for `problem` at `dt`, where it can keep its
+    /// world between pushes; None (the default) when it cannot, and
+    /// [`start`](dyn Engine::start) falls back on a [`ReplaySession`].
+    fn session<'a>(
+        &'a self,
+        _problem: &Problem,
+        _dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        None
+    }
     /// The engine's own friction law in closed form, if it declares one
     /// ([`FrictionLaw`]; [`COULOMB`] for an engine that applies Coulomb
     /// friction at every support). None by default.
@@ -213,8 +229,30 @@ pub trait Engine: Send + Sync {
     }
 }
 
-/// Shorthands for the fields of [`Engine::info`].
+/// Shorthands for the fields of [`Engine::info`], and the session.
 impl dyn Engine + '_ {
+    /// Builds the engine's world for `problem` (its schedule is not applied)
+    /// at time step `dt` (s), the only place the step is given, and hands the
+    /// loop to the caller ([`EngineSession`]): the engine's own session, or
+    /// a [`ReplaySession`] that re-runs the schedule applied so far at every
+    /// `advance`.
+    pub fn start<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Result<Box<dyn EngineSession + 'a>, ModelError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(ModelError::Parameter {
+                name: "dt",
+                requirement: "finite and > 0",
+                value: dt,
+            });
+        }
+        match self.session(problem, dt) {
+            Some(session) => session,
+            None => Ok(Box::new(ReplaySession::new(self, problem, dt))),
+        }
+    }
     /// [`EngineInfo::name`].
     pub fn name(&self) -> &str {
         &self.info().name
