@@ -3,6 +3,7 @@
 //! `trajectory.csv`). The command line in `main.rs` is a thin layer over this.
 
 pub mod atomic;
+pub mod control;
 pub mod fit;
 pub mod harness;
 pub mod init;

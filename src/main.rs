@@ -274,6 +274,92 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// A push schedule that takes the object from the scenario's start to a
+    /// goal pose on a model: DIR/plan.toml (a scenario: `run`, `validate`
+    /// and `study` take it) and DIR/plan.json (errors, solve time, the
+    /// model's assumption checks along the plan, each switch's impulse
+    /// against the contact's friction cone). Exit 1 when no plan reaches
+    /// the goal (the nearest pose and why are printed).
+    Plan {
+        file: PathBuf,
+        #[command(flatten)]
+        goal: GoalArgs,
+    },
+    /// Model-predictive control: every period, re-plan from the engine's
+    /// measured state (pose, ω, the centre of mass's velocity) and apply
+    /// the next period in the engine. Writes DIR/trajectory.csv (with the
+    /// applied push) and DIR/loop.json. Exit 1 on a miss.
+    Loop {
+        file: PathBuf,
+        #[command(flatten)]
+        goal: GoalArgs,
+        /// The plant: an engine of `pushval engines`.
+        #[arg(long, value_name = "NAME")]
+        engine: String,
+        /// Control period (s).
+        #[arg(long, default_value_t = 0.02, value_name = "S")]
+        period: f64,
+        /// Perturb the engine's scene only: mu_scale=A,inertia_scale=B.
+        #[arg(long, value_name = "mu_scale=A,inertia_scale=B")]
+        plant: Option<String>,
+    },
+    /// Plans and MPC in every engine of the build and of the project:
+    /// goals x speeds x engines x plan predictor x open loop or MPC x
+    /// nominal or perturbed plant; writes results/closed_loop/.
+    ControlStudy {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "results/closed_loop")]
+        out: PathBuf,
+        /// A few goals, one speed (for CI).
+        #[arg(long)]
+        quick: bool,
+        /// Compute only part K of N of the runs into parts/.
+        #[arg(long, value_name = "[hash:]K/N", conflicts_with = "merge")]
+        shard: Option<pushval::shard::Shard>,
+        /// Build the outputs from the part files.
+        #[arg(long)]
+        merge: bool,
+        /// Only these engines (comma-separated; default every available one).
+        #[arg(long = "only", value_name = "NAME[,NAME...]")]
+        only: Option<String>,
+    },
+}
+
+/// The goal and the plan's shape.
+#[derive(clap::Args)]
+struct GoalArgs {
+    /// The goal: the centre of mass's world position and the angle (m, m, rad).
+    #[arg(long, value_name = "X,Y,THETA", allow_hyphen_values = true)]
+    goal: String,
+    /// Pusher speed (m/s); default the file's first push speed.
+    #[arg(long, value_name = "V")]
+    speed: Option<f64>,
+    /// Number of pushes of equal duration.
+    #[arg(long, default_value_t = 6, value_name = "N")]
+    segments: usize,
+    /// The model the plan is made on: dynamic, kinematic or limit_surface.
+    #[arg(long, default_value = "dynamic")]
+    predictor: String,
+    /// Success: final position and angle within POS (m) and ANGLE (rad).
+    #[arg(long, value_name = "POS,ANGLE")]
+    tolerance: Option<String>,
+    /// Output folder (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+impl GoalArgs {
+    fn common(self, file: PathBuf) -> pushval::control::cli::Common {
+        pushval::control::cli::Common {
+            file,
+            goal: self.goal,
+            speed: self.speed,
+            segments: self.segments,
+            predictor: self.predictor,
+            tolerance: self.tolerance,
+            out: self.out,
+        }
+    }
 }
 
 /// The scenarios the main job validates when no file is named: every
@@ -506,6 +592,21 @@ fn main() -> ExitCode {
             deny_loose,
         }) => validate(files, json, junit, deny_loose),
         Some(Command::Run { file, out }) => run(file, out),
+        Some(Command::Plan { file, goal }) => pushval::control::cli::plan(&goal.common(file)),
+        Some(Command::Loop {
+            file,
+            goal,
+            engine,
+            period,
+            plant,
+        }) => pushval::control::cli::run(&goal.common(file), &engine, period, plant.as_deref()),
+        Some(Command::ControlStudy {
+            out,
+            quick,
+            shard,
+            merge,
+            only,
+        }) => pushval::control::study::cli(&out, quick, shard, merge, only.as_deref()),
         Some(Command::Manifest { check, root }) => pushval::manifest::cli(&root, check),
         Some(Command::Init { force }) => pushval::init::cli(Path::new("."), force),
         Some(Command::Shipped { out, force }) => {
