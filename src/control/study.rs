@@ -1,15 +1,859 @@
-//! `pushval control-study`: plans and MPC in every engine.
+//! `pushval control-study`: do plans and MPC made on a model work in each
+//! engine, and where do they break?
+//!
+//! The scene is the seed paper's plate (shipped `paper-square-v1.0.toml`,
+//! started from rest). Goals are drawn from a fixed generator (0.3–1 m away,
+//! turns up to ±90°) and kept when the dynamic model reaches them at every
+//! speed of the grid; the first 20 (3 with `--quick`) are the study's. For
+//! every engine, speed, goal and plan predictor (dynamic, kinematic) the
+//! plan made on the predictor runs open loop and under MPC, on the nominal
+//! plant and on the perturbed one (μ × 0.8, I_cm × 1.2). Every run is one
+//! task of the shard list; `runs.csv` has one row per run, `success.csv`
+//! the counts, `success.svg` and `paths.svg` the figures, README.md why
+//! each engine succeeds or fails, from its friction law.
 
+use std::collections::BTreeMap;
+use std::f64::consts::FRAC_PI_2;
 use std::path::Path;
 use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+use pushval_engine::Engine;
+use pushval_model::{Problem, Push};
+
+use super::mpc::{median_p99, open_loop, run_loop, LoopSpec, PlantScale};
+use super::plan::{straight_time, PlanSpec, Planner, Start};
+use super::{Goal, Predictor, Reach};
+use crate::outdir::{num, Csv, Writer as OutDir};
+use crate::plot::{self, Axis, Figure, Legend, MapCell, Panel, Scale, Series, Stroke};
+use crate::shard::{grid_hash, grid_name, Parts, Shard};
+use pushval_engine::FrictionLaw;
+
+/// The study's scene: a shipped scenario.
+pub const SCENE: &str = "paper-square-v1.0.toml";
+/// The speeds of the full grid (m/s).
+pub const SPEEDS: [f64; 3] = [0.1, 0.5, 1.0];
+/// The speed of the quick grid (m/s).
+pub const QUICK_SPEEDS: [f64; 1] = [1.0];
+/// Goals of the full grid.
+pub const GOALS: usize = 20;
+/// Goals of the quick grid.
+pub const QUICK_GOALS: usize = 3;
+/// Pushes per plan.
+pub const SEGMENTS: usize = 6;
+/// The MPC's control period (s).
+pub const PERIOD: f64 = 0.02;
+
+/// Open loop or MPC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// The plan as made, replayed in the engine.
+    Open,
+    /// Re-planned every period from the engine's state.
+    Mpc,
+}
+
+impl Mode {
+    fn as_str(self) -> &'static str {
+        match self {
+            Mode::Open => "open",
+            Mode::Mpc => "mpc",
+        }
+    }
+}
+
+/// One run of the study.
+#[derive(Debug, Clone)]
+pub struct Task {
+    /// The engine model.
+    pub engine: String,
+    /// Pusher speed (m/s).
+    pub speed: f64,
+    /// Index into the goals.
+    pub goal: usize,
+    /// What the plan (and the MPC) is made on.
+    pub predictor: Predictor,
+    /// Open loop or MPC.
+    pub mode: Mode,
+    /// Whether the plant is perturbed.
+    pub perturbed: bool,
+}
+
+impl Task {
+    fn key(&self) -> String {
+        format!(
+            "{}/{}/{}/{}/{}/{}",
+            self.engine,
+            self.speed,
+            self.goal,
+            self.predictor.as_str(),
+            self.mode.as_str(),
+            if self.perturbed {
+                "perturbed"
+            } else {
+                "nominal"
+            }
+        )
+    }
+    fn plant(&self) -> PlantScale {
+        if self.perturbed {
+            PlantScale::PERTURBED
+        } else {
+            PlantScale::default()
+        }
+    }
+}
+
+/// The numbers of one run: success (0/1), position error (m), angle error
+/// (rad), predictor median and p99 (µs; NaN open loop), whether the engine
+/// replayed its schedule (0/1), whether the run failed with an error (0/1),
+/// the wall time (s).
+const ROW: usize = 8;
+
+/// The study's scene problem, from rest.
+pub fn scene() -> anyhow::Result<Problem> {
+    let text = crate::shipped::scenario_text(SCENE).context("the shipped scene is missing")?;
+    let sc =
+        pushval_scenario::Scenario::from_toml(text, &crate::shipped::label("scenarios", SCENE))?;
+    let mut p = sc.problem();
+    p.initial.from_rest = true;
+    Ok(p)
+}
+
+/// A small linear congruential generator (Knuth's MMIX constants): the goal
+/// list must be the same on every machine and every version of any crate,
+/// so it is written here rather than taken from a random-number crate.
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The study's goals: drawn 0.3–1 m from the start, in the half-plane the
+/// corner push moves the plate into (bearing −30° to 120°), turned by up to
+/// ±90°, and kept when the dynamic model's plan reaches each at every speed.
+pub fn goals(problem: &Problem, speeds: &[f64], count: usize) -> Vec<Goal> {
+    let mut rng = Lcg(0x5eed_0f_c0_47_201);
+    let mut out = Vec::new();
+    let start = Start::of_problem(problem);
+    let reach = Reach::default();
+    for _ in 0..40 * count {
+        if out.len() == count {
+            break;
+        }
+        let d = 0.3 + 0.7 * rng.next();
+        let bearing = (-30.0 + 150.0 * rng.next()).to_radians();
+        let turn = (rng.next() * 2.0 - 1.0) * FRAC_PI_2;
+        let goal = Goal {
+            x: start.position.x + d * bearing.cos(),
+            y: start.position.y + d * bearing.sin(),
+            theta: start.theta + turn,
+        };
+        let reached = speeds.iter().all(|&v| {
+            let spec = PlanSpec {
+                segments: SEGMENTS,
+                speed: v,
+                predictor: Predictor::Dynamic,
+            };
+            let mut planner =
+                Planner::new(problem, goal, spec, straight_time(&start, &goal, v), reach);
+            planner.plan(&start).is_some_and(|s| s.converged)
+        });
+        if reached {
+            out.push(goal);
+        }
+    }
+    out
+}
+
+/// Every engine of the build and of the project that this build can run
+/// (or those of `only`).
+pub fn engines(only: Option<&str>) -> anyhow::Result<Vec<String>> {
+    let all: Vec<String> = crate::registry::entries()
+        .into_iter()
+        .filter(|e| e.default_engine().availability().is_ok())
+        .map(|e| e.name)
+        .collect();
+    match only {
+        None => Ok(all),
+        Some(list) => {
+            let mut out = Vec::new();
+            for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+                if !all.iter().any(|a| a == name) {
+                    bail!(
+                        "--only: `{name}` is not an available engine of this build or of {} (see `pushval engines`)",
+                        crate::registry::engines_file()
+                    );
+                }
+                out.push(name.to_string());
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// The task list: engines × speeds × goals × predictors × modes × plants.
+pub fn tasks(engines: &[String], speeds: &[f64], goals: usize) -> Vec<Task> {
+    let mut out = Vec::new();
+    for e in engines {
+        for &speed in speeds {
+            for goal in 0..goals {
+                for predictor in [Predictor::Dynamic, Predictor::Kinematic] {
+                    for mode in [Mode::Open, Mode::Mpc] {
+                        for perturbed in [false, true] {
+                            out.push(Task {
+                                engine: e.clone(),
+                                speed,
+                                goal,
+                                predictor,
+                                mode,
+                                perturbed,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The plans from rest, one per (speed, goal, predictor).
+type Plans = BTreeMap<(u64, usize, &'static str), Vec<Push>>;
+
+fn plans(problem: &Problem, speeds: &[f64], goals: &[Goal]) -> Plans {
+    let start = Start::of_problem(problem);
+    let mut out = Plans::new();
+    for &v in speeds {
+        for (i, g) in goals.iter().enumerate() {
+            for predictor in [Predictor::Dynamic, Predictor::Kinematic] {
+                let spec = PlanSpec {
+                    segments: SEGMENTS,
+                    speed: v,
+                    predictor,
+                };
+                let mut planner = Planner::new(
+                    problem,
+                    *g,
+                    spec,
+                    straight_time(&start, g, v),
+                    Reach::default(),
+                );
+                if let Some(s) = planner.plan(&start) {
+                    out.insert((v.to_bits(), i, predictor.as_str()), s.pushes);
+                }
+            }
+        }
+    }
+    out
+}
+
+fn run_task(
+    problem: &Problem,
+    engine: &dyn Engine,
+    goals: &[Goal],
+    plans: &Plans,
+    t: &Task,
+) -> Vec<f64> {
+    let clock = Instant::now();
+    let dt = engine.default_dt();
+    let goal = goals[t.goal];
+    let reach = Reach::default();
+    let result: anyhow::Result<Vec<f64>> = (|| match t.mode {
+        Mode::Open => {
+            let pushes = plans
+                .get(&(t.speed.to_bits(), t.goal, t.predictor.as_str()))
+                .context("no plan from rest")?;
+            let (_, pe, ae) = open_loop(problem, engine, dt, pushes, t.plant(), &goal)?;
+            Ok(vec![
+                f64::from(u8::from(reach.holds(pe, ae))),
+                pe,
+                ae,
+                f64::NAN,
+                f64::NAN,
+                0.0,
+                0.0,
+            ])
+        }
+        Mode::Mpc => {
+            let spec = LoopSpec {
+                plan: PlanSpec {
+                    segments: SEGMENTS,
+                    speed: t.speed,
+                    predictor: t.predictor,
+                },
+                period: PERIOD,
+                plant: t.plant(),
+                reach,
+            };
+            let out = run_loop(problem, engine, dt, goal, spec)?;
+            let (med, p99) = median_p99(&out.predictor_us);
+            Ok(vec![
+                f64::from(u8::from(out.success)),
+                out.position_error,
+                out.angle_error,
+                med,
+                p99,
+                f64::from(u8::from(out.replayed)),
+                0.0,
+            ])
+        }
+    })();
+    let mut row = result.unwrap_or_else(|e| {
+        eprintln!("control-study: {}: {e:#}", t.key());
+        vec![0.0, f64::NAN, f64::NAN, f64::NAN, f64::NAN, 0.0, 1.0]
+    });
+    row.push(clock.elapsed().as_secs_f64());
+    row
+}
 
 /// `pushval control-study`.
 pub fn cli(
-    _out: &Path,
-    _quick: bool,
-    _shard: Option<crate::shard::Shard>,
-    _merge: bool,
-    _only: Option<&str>,
+    out: &Path,
+    quick: bool,
+    shard: Option<Shard>,
+    merge: bool,
+    only: Option<&str>,
 ) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not yet")
+    let shard = match shard {
+        Some(s) => Some(s),
+        None if merge => None,
+        None => Shard::from_env()?,
+    };
+    let problem = scene()?;
+    let speeds: &[f64] = if quick { &QUICK_SPEEDS } else { &SPEEDS };
+    let count = if quick { QUICK_GOALS } else { GOALS };
+    let clock = Instant::now();
+    let goals = goals(&problem, speeds, count);
+    if goals.len() < count {
+        bail!(
+            "only {} of {count} goals are reachable on the dynamic model at every speed (a bug in the planner or the scene)",
+            goals.len()
+        );
+    }
+    let names = engines(only)?;
+    if names.is_empty() {
+        bail!("no engine to study (every engine of this build is unavailable)");
+    }
+    let list = tasks(&names, speeds, goals.len());
+    let keys: Vec<String> = list.iter().map(Task::key).collect();
+    let parts = Parts {
+        tag: "control-study",
+        stem: "control",
+        grid: grid_name(quick),
+        hash: grid_hash(&keys),
+    };
+    eprintln!(
+        "control-study: {} goals, {} engines, {} runs",
+        goals.len(),
+        names.len(),
+        list.len()
+    );
+    let rows: Vec<Vec<f64>> = if merge {
+        parts.merge(out, list.len(), |_| Some(ROW))?
+    } else {
+        let indices: Vec<usize> = match shard {
+            Some(s) => s.indices(&keys),
+            None => (0..list.len()).collect(),
+        };
+        let plans = plans(&problem, speeds, &goals);
+        let built: BTreeMap<String, Box<dyn Engine>> = names
+            .iter()
+            .map(|n| {
+                let e = crate::registry::entry(n).expect("listed above");
+                (n.clone(), e.default_engine())
+            })
+            .collect();
+        let mine: Vec<&Task> = indices.iter().map(|&i| &list[i]).collect();
+        let computed = crate::parallel::par_rows(&mine, true, "runs", |t| {
+            run_task(&problem, built[&t.engine].as_ref(), &goals, &plans, t)
+        });
+        if let Some(s) = shard {
+            std::fs::create_dir_all(out.join("parts"))?;
+            crate::atomic::write_atomic(
+                &out.join(parts.file_name(s)),
+                parts.text(list.len(), &indices, &computed, s).as_bytes(),
+            )?;
+            eprintln!(
+                "control-study: part {}/{} ({} runs) in {:.1} s: {}",
+                s.k,
+                s.n,
+                computed.len(),
+                clock.elapsed().as_secs_f64(),
+                out.join(parts.file_name(s)).display()
+            );
+            return Ok(ExitCode::SUCCESS);
+        }
+        computed
+    };
+    let failed = rows.iter().filter(|r| r[6] == 1.0).count();
+    write_outputs(out, &problem, &names, speeds, &goals, &list, &rows, quick)?;
+    println!(
+        "control-study: {} runs in {:.1} s; wrote {}",
+        rows.len(),
+        clock.elapsed().as_secs_f64(),
+        out.display()
+    );
+    if failed > 0 {
+        eprintln!(
+            "control-study: {failed} of {} runs failed with an engine error (runs.csv column `error`; the messages are above)",
+            rows.len()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// One success.csv row's key.
+type Group = (String, u64, &'static str, &'static str, &'static str);
+
+#[allow(clippy::too_many_arguments)]
+fn write_outputs(
+    out: &Path,
+    problem: &Problem,
+    names: &[String],
+    speeds: &[f64],
+    goals: &[Goal],
+    list: &[Task],
+    rows: &[Vec<f64>],
+    quick: bool,
+) -> anyhow::Result<()> {
+    let mut dir = OutDir::new(out)?;
+    // runs.csv
+    let mut runs = Csv::new(&[
+        "engine",
+        "speed",
+        "goal",
+        "goal_x",
+        "goal_y",
+        "goal_theta",
+        "predictor",
+        "mode",
+        "plant",
+        "success",
+        "position_error_m",
+        "angle_error_rad",
+        "predictor_us_median",
+        "predictor_us_p99",
+        "engine_replayed",
+        "error",
+        "wall_s",
+    ]);
+    for (t, r) in list.iter().zip(rows) {
+        let g = goals[t.goal];
+        runs.row(&[
+            t.engine.clone(),
+            num(t.speed),
+            t.goal.to_string(),
+            num(g.x),
+            num(g.y),
+            num(g.theta),
+            t.predictor.as_str().into(),
+            t.mode.as_str().into(),
+            if t.perturbed { "perturbed" } else { "nominal" }.into(),
+            num(r[0]),
+            num(r[1]),
+            num(r[2]),
+            num(r[3]),
+            num(r[4]),
+            num(r[5]),
+            num(r[6]),
+            num(r[7]),
+        ]);
+    }
+    dir.file("runs.csv", runs.as_bytes())?;
+    // success.csv
+    let mut groups: BTreeMap<Group, Vec<&Vec<f64>>> = BTreeMap::new();
+    let mut order: Vec<Group> = Vec::new();
+    for (t, r) in list.iter().zip(rows) {
+        let k: Group = (
+            t.engine.clone(),
+            t.speed.to_bits(),
+            t.predictor.as_str(),
+            t.mode.as_str(),
+            if t.perturbed { "perturbed" } else { "nominal" },
+        );
+        if !groups.contains_key(&k) {
+            order.push(k.clone());
+        }
+        groups.entry(k).or_default().push(r);
+    }
+    let mut success = Csv::new(&[
+        "engine",
+        "speed",
+        "predictor",
+        "mode",
+        "plant",
+        "successes",
+        "goals",
+        "median_position_error_m",
+        "median_angle_error_rad",
+        "failed_runs",
+    ]);
+    let med = |v: Vec<f64>| median_p99(&v).0;
+    let mut summary: BTreeMap<Group, (usize, usize, f64, f64)> = BTreeMap::new();
+    for k in &order {
+        let rs = &groups[k];
+        let ok = rs.iter().filter(|r| r[0] == 1.0).count();
+        let pe = med(rs.iter().map(|r| r[1]).filter(|v| v.is_finite()).collect());
+        let ae = med(rs.iter().map(|r| r[2]).filter(|v| v.is_finite()).collect());
+        let failed = rs.iter().filter(|r| r[6] == 1.0).count();
+        summary.insert(k.clone(), (ok, rs.len(), pe, ae));
+        success.row(&[
+            k.0.clone(),
+            num(f64::from_bits(k.1)),
+            k.2.into(),
+            k.3.into(),
+            k.4.into(),
+            ok.to_string(),
+            rs.len().to_string(),
+            num(pe),
+            num(ae),
+            failed.to_string(),
+        ]);
+    }
+    dir.file("success.csv", success.as_bytes())?;
+    let mut goals_csv = Csv::new(&["goal", "x", "y", "theta"]);
+    for (i, g) in goals.iter().enumerate() {
+        goals_csv.row(&[i.to_string(), num(g.x), num(g.y), num(g.theta)]);
+    }
+    dir.file("goals.csv", goals_csv.as_bytes())?;
+    dir.figure("success.svg", &success_figure(names, speeds, &summary))?;
+    let paths = paths_figure(problem, names, goals, speeds)?;
+    dir.figure("paths.svg", &paths)?;
+    let readme = readme(problem, names, speeds, goals.len(), &summary, quick);
+    dir.file("README.md", readme.as_bytes())?;
+    Ok(())
+}
+
+const COLUMNS: [(&str, &str, &str); 8] = [
+    ("dynamic", "open", "nominal"),
+    ("dynamic", "mpc", "nominal"),
+    ("dynamic", "open", "perturbed"),
+    ("dynamic", "mpc", "perturbed"),
+    ("kinematic", "open", "nominal"),
+    ("kinematic", "mpc", "nominal"),
+    ("kinematic", "open", "perturbed"),
+    ("kinematic", "mpc", "perturbed"),
+];
+
+fn short(c: &(&str, &str, &str)) -> String {
+    format!(
+        "{}·{}·{}",
+        if c.0 == "dynamic" { "dyn" } else { "kin" },
+        c.1,
+        if c.2 == "nominal" { "nom" } else { "pert" }
+    )
+}
+
+fn success_figure(
+    names: &[String],
+    speeds: &[f64],
+    summary: &BTreeMap<Group, (usize, usize, f64, f64)>,
+) -> Figure {
+    let colors = vec![
+        plot::RED_,
+        plot::ORANGE,
+        plot::OLIVE,
+        plot::CYAN_,
+        plot::GREEN_,
+    ];
+    let scale = Scale::Classes(colors);
+    let mut panels = Vec::new();
+    for &v in speeds {
+        let mut cells = Vec::new();
+        let n = names.len();
+        for (row, name) in names.iter().enumerate() {
+            let y = (n - 1 - row) as f64;
+            for (col, c) in COLUMNS.iter().enumerate() {
+                let k: Group = (name.clone(), v.to_bits(), c.0, c.1, c.2);
+                let (value, mark) = match summary.get(&k) {
+                    Some(&(ok, total, _, _)) if total > 0 => {
+                        let share = ok as f64 / total as f64;
+                        let class = if share >= 0.95 {
+                            4.0
+                        } else if share >= 0.75 {
+                            3.0
+                        } else if share >= 0.5 {
+                            2.0
+                        } else if share >= 0.25 {
+                            1.0
+                        } else {
+                            0.0
+                        };
+                        (class, format!("{ok}/{total}"))
+                    }
+                    _ => (f64::NAN, String::new()),
+                };
+                cells.push(MapCell {
+                    x: (col as f64 + 3.0, col as f64 + 4.0),
+                    y: (y, y + 1.0),
+                    value,
+                    mark,
+                });
+            }
+            // The engine's name in a white column on the left.
+            cells.push(MapCell {
+                x: (0.0, 3.0),
+                y: (y, y + 1.0),
+                value: 5.0,
+                mark: name.clone(),
+            });
+        }
+        for (col, c) in COLUMNS.iter().enumerate() {
+            cells.push(MapCell {
+                x: (col as f64 + 3.0, col as f64 + 4.0),
+                y: (n as f64, n as f64 + 1.0),
+                value: 5.0,
+                mark: short(c),
+            });
+        }
+        let mut with_white = scale.clone();
+        if let Scale::Classes(c) = &mut with_white {
+            c.push(plotters::style::RGBColor(255, 255, 255));
+        }
+        let panel = plot::heat_map(
+            format!("goals reached at {v} m/s"),
+            Axis::lin("plan predictor · open loop or MPC · plant").range(0.0, 11.0),
+            Axis::lin("engine").range(0.0, n as f64 + 1.0),
+            &cells,
+            &with_white,
+        )
+        .legend(Legend::None);
+        panels.push(panel);
+    }
+    let labels = ["< 25 %", "25–50 %", "50–75 %", "75–95 %", "≥ 95 %"];
+    let notes = vec![
+        "goals reached (20 mm, 5°)".to_string(),
+        "dyn/kin: plan made on the".to_string(),
+        "dynamic / kinematic model;".to_string(),
+        "pert: plant μ × 0.8, I_cm × 1.2".to_string(),
+    ];
+    let key = scale.key("success", &labels, &notes);
+    let rows = names.len().max(4) as u32;
+    Figure {
+        size: (1500, 120 + 34 * (rows + 1) * speeds.len() as u32),
+        cols: 1,
+        panels,
+        key: Some(key),
+    }
+}
+
+/// The first goal's paths (dynamic plan, open loop, nominal plant, at the
+/// grid's fastest speed) in every engine, drawn over the goal and the
+/// dynamic model's prediction.
+fn paths_figure(
+    problem: &Problem,
+    names: &[String],
+    goals: &[Goal],
+    speeds: &[f64],
+) -> anyhow::Result<Figure> {
+    let v = speeds.iter().copied().fold(f64::MIN, f64::max);
+    let goal = goals[0];
+    let start = Start::of_problem(problem);
+    let spec = PlanSpec {
+        segments: SEGMENTS,
+        speed: v,
+        predictor: Predictor::Dynamic,
+    };
+    let mut planner = Planner::new(
+        problem,
+        goal,
+        spec,
+        straight_time(&start, &goal, v),
+        Reach::default(),
+    );
+    let plan = planner.plan(&start).context("the first goal's plan")?;
+    let mut p = problem.clone();
+    p.pushes = plan.pushes.clone();
+    p.sample_dt = p.duration() / 200.0;
+    let labels: Vec<&str> = names.iter().map(String::as_str).collect();
+    let styles = plot::family_styles(&labels);
+    let mut panel = Panel::new(
+        format!("goal 0 ({goal}) at {v} m/s: the dynamic plan replayed open loop"),
+        Axis::lin("x (m)"),
+        Axis::lin("y (m)"),
+    )
+    .legend(Legend::Outside)
+    .equal_aspect();
+    let model = pushval_model::DynamicModel::default();
+    let traj = pushval_model::Simulator::simulate(&model, &p)?;
+    panel = panel.series(
+        Series::new("dynamic model", plot::DARK, Stroke::Solid)
+            .width(3)
+            .points(traj.samples.iter().map(|s| (s.x, s.y)).collect()),
+    );
+    for (name, (color, stroke)) in names.iter().zip(styles) {
+        let e = crate::registry::entry(name)
+            .expect("listed")
+            .default_engine();
+        match e.run(&p, e.default_dt()) {
+            Ok(run) => {
+                panel = panel.series(
+                    Series::new(name.clone(), color, stroke)
+                        .points(run.trajectory.samples.iter().map(|s| (s.x, s.y)).collect()),
+                );
+            }
+            Err(err) => eprintln!("control-study: paths: {name}: {err}"),
+        }
+    }
+    // The goal: a cross of the plate's half-width, and its heading.
+    let a = 0.05;
+    let (s, c) = goal.theta.sin_cos();
+    panel = panel
+        .series(
+            Series::new("goal (heading)", plot::RED_, Stroke::Solid)
+                .width(3)
+                .points(vec![
+                    (goal.x, goal.y),
+                    (goal.x + 2.0 * a * c, goal.y + 2.0 * a * s),
+                ]),
+        )
+        .series(Series::new("goal", plot::RED_, Stroke::Dots).points(vec![(goal.x, goal.y)]));
+    Ok(Figure {
+        size: (1400, 900),
+        cols: 1,
+        panels: vec![panel],
+        key: None,
+    })
+}
+
+/// The law's steady ω against Coulomb's for the scene's middle push at
+/// `speed`: (law name, law ω, Coulomb ω, class).
+fn law_line(problem: &Problem, engine: &dyn Engine, speed: f64) -> Option<String> {
+    let law = engine.law()?;
+    let mut p = problem.clone();
+    p.pushes = vec![Push {
+        duration: 2.0,
+        speed,
+        phi: std::f64::consts::FRAC_PI_4 + 0.3,
+    }];
+    let dt = engine.default_dt();
+    let w_law = law.steady(&p, 0, dt)?;
+    let w_c = pushval_engine::COULOMB.steady(&p, 0, dt)?;
+    Some(format!(
+        "its law ({}) turns at {:.3} rad/s where Coulomb's turns at {:.3} rad/s (φ = π/4 + 0.3, {speed} m/s; ω = 0 {})",
+        law.law_name(),
+        w_law.omega,
+        w_c.omega,
+        match w_law.class {
+            pushval_engine::LawClass::Turns => "is not held".to_string(),
+            other => format!("is {}", other.as_str()),
+        }
+    ))
+}
+
+fn readme(
+    problem: &Problem,
+    names: &[String],
+    speeds: &[f64],
+    goals: usize,
+    summary: &BTreeMap<Group, (usize, usize, f64, f64)>,
+    quick: bool,
+) -> String {
+    let vmax = speeds.iter().copied().fold(f64::MIN, f64::max);
+    let get = |n: &str, v: f64, pr: &'static str, m: &'static str, pl: &'static str| {
+        summary
+            .get(&(n.to_string(), v.to_bits(), pr, m, pl))
+            .copied()
+            .unwrap_or((0, 0, f64::NAN, f64::NAN))
+    };
+    let mut s = String::new();
+    s.push_str("# Closed loop: plans and MPC made on the model, in every engine\n\n");
+    s.push_str("Written by `pushval control-study");
+    if quick {
+        s.push_str(" --quick");
+    }
+    s.push_str("` (docs/closed-loop.md); do not edit.\n\n");
+    s.push_str(&format!(
+        "The seed paper's plate (`{SCENE}`, from rest), {goals} goals 0.3–1 m away with turns up to ±90° (`goals.csv`), each reachable by the dynamic model at every speed ({}). A plan is {SEGMENTS} pushes of equal duration; success is the final centre of mass within 20 mm and the angle within 5°. MPC re-plans every {PERIOD} s from the engine's state. The perturbed plant has μ × 0.8 and I_cm × 1.2; the predictor keeps the nominal values.\n\n",
+        speeds.iter().map(|v| format!("{v} m/s")).collect::<Vec<_>>().join(", ")
+    ));
+    s.push_str("Files: `success.csv` (one row per engine, speed, plan predictor, mode and plant), `runs.csv` (every run), `success.svg`, `paths.svg` (goal 0 in every engine).\n\n");
+    s.push_str(&format!("## Per engine, at {vmax} m/s\n\n"));
+    s.push_str("| engine | dynamic plan, open | MPC | open, perturbed | MPC, perturbed | kinematic plan, open | kinematic MPC |\n|---|---|---|---|---|---|---|\n");
+    for n in names {
+        let c = |pr, m, pl| {
+            let (ok, tot, _, _) = get(n, vmax, pr, m, pl);
+            format!("{ok}/{tot}")
+        };
+        s.push_str(&format!(
+            "| {n} | {} | {} | {} | {} | {} | {} |\n",
+            c("dynamic", "open", "nominal"),
+            c("dynamic", "mpc", "nominal"),
+            c("dynamic", "open", "perturbed"),
+            c("dynamic", "mpc", "perturbed"),
+            c("kinematic", "open", "nominal"),
+            c("kinematic", "mpc", "nominal"),
+        ));
+    }
+    s.push_str("\n## Why each engine succeeds or fails\n\n");
+    for n in names {
+        let e = crate::registry::entry(n).expect("listed").default_engine();
+        let (ok_open, tot, pe_open, ae_open) = get(n, vmax, "dynamic", "open", "nominal");
+        let (ok_mpc, _, _, _) = get(n, vmax, "dynamic", "mpc", "nominal");
+        let (ok_mpc_p, _, _, _) = get(n, vmax, "dynamic", "mpc", "perturbed");
+        let share = |k: usize| if tot == 0 { 0.0 } else { k as f64 / tot as f64 };
+        let law = law_line(problem, e.as_ref(), vmax);
+        let coulomb = e
+            .law()
+            .is_some_and(|l| l.law_name() == pushval_engine::COULOMB.law_name());
+        let why = if tot == 0 {
+            "no runs.".to_string()
+        } else if share(ok_open) >= 0.95 {
+            if coulomb {
+                "it applies Coulomb friction at every support, the model's law, so the plan made on the dynamic model works as it is".to_string()
+            } else {
+                format!(
+                    "the plan works as it is: on this scene its friction moves the plate as Coulomb's does{}",
+                    law.as_ref().map(|l| format!(" ({l})")).unwrap_or_default()
+                )
+            }
+        } else if share(ok_mpc) >= 0.95 {
+            format!(
+                "open-loop plans miss (median {:.1} mm, {:.3} rad): {}; feedback every {PERIOD} s corrects the drift",
+                pe_open * 1e3,
+                ae_open,
+                law.clone().unwrap_or_else(|| "it declares no law in closed form, and its turn rate differs from the model's".into())
+            )
+        } else {
+            format!(
+                "plans miss open loop (median {:.1} mm, {:.3} rad) and MPC reaches only {ok_mpc}/{tot}: {}; a controller whose predictor has the model's law cannot steer a plate that turns otherwise",
+                pe_open * 1e3,
+                ae_open,
+                law.clone().unwrap_or_else(|| "it declares no law in closed form".into())
+            )
+        };
+        s.push_str(&format!(
+            "- **{n}** ({}/{tot} open, {}/{tot} MPC, {}/{tot} MPC on the perturbed plant): {why}.\n",
+            ok_open, ok_mpc, ok_mpc_p
+        ));
+    }
+    s.push_str("\n## The kinematic plan against speed\n\n| engine | ");
+    s.push_str(
+        &speeds
+            .iter()
+            .map(|v| format!("{v} m/s"))
+            .collect::<Vec<_>>()
+            .join(" | "),
+    );
+    s.push_str(" |\n|---|");
+    s.push_str(&"---|".repeat(speeds.len()));
+    s.push('\n');
+    for n in names {
+        s.push_str(&format!("| {n} |"));
+        for &v in speeds {
+            let (ok, tot, pe, _) = get(n, v, "kinematic", "open", "nominal");
+            s.push_str(&format!(" {ok}/{tot} ({:.1} mm) |", pe * 1e3));
+        }
+        s.push('\n');
+    }
+    s.push_str("\nA plan made on the quasi-static model ignores the plate's inertia: the faster the push, the further it misses (median final position error in brackets).\n");
+    s
 }
