@@ -7,6 +7,7 @@ mod assumptions;
 mod bad_input;
 mod cli;
 mod common;
+mod control;
 mod corpus;
 mod engines;
 mod fit;

@@ -1,0 +1,357 @@
+//! Closed loop: `plan`, `loop`, the sessions they stand on, and the switch
+//! checks. Expected values come from the model itself run independently
+//! (the written plan re-loaded and simulated at the default tolerance),
+//! from the plate's mirror symmetry, from the quasi-static limit, and from
+//! closed forms of the switch impulse.
+
+use std::f64::consts::FRAC_PI_2;
+use std::process::Command;
+
+use pushval::control::mpc::{open_loop, run_loop, LoopSpec, PlantScale};
+use pushval::control::plan::{make_plan, straight_time, switch_checks, PlanSpec, Planner, Start};
+use pushval::control::{Goal, Predictor, Reach};
+use pushval_model::{DynamicModel, Problem, Push, Simulator};
+
+use crate::common::root;
+
+fn pushval() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_pushval"))
+}
+
+/// The seed's plate from rest, pushed at its corner.
+fn plate() -> Problem {
+    let sc = pushval::registry::load(root().join("scenarios/paper-square-v1.0.toml")).unwrap();
+    let mut p = sc.problem();
+    p.initial.from_rest = true;
+    p
+}
+
+fn final_pose(p: &Problem, pushes: &[Push]) -> [f64; 3] {
+    let mut q = p.clone();
+    q.pushes = pushes.to_vec();
+    let s = *DynamicModel::default()
+        .simulate(&q)
+        .unwrap()
+        .samples
+        .last()
+        .unwrap();
+    [s.x, s.y, s.theta]
+}
+
+fn spec(speed: f64, predictor: Predictor) -> PlanSpec {
+    PlanSpec {
+        segments: 6,
+        speed,
+        predictor,
+    }
+}
+
+const GOAL: Goal = Goal {
+    x: 0.8,
+    y: 0.2,
+    theta: -0.5,
+};
+
+#[test]
+fn a_dynamic_plan_reaches_its_goal_when_the_model_runs_it_at_full_accuracy() {
+    let p = plate();
+    for v in [0.1, 0.5, 1.0] {
+        let out = make_plan(&p, GOAL, spec(v, Predictor::Dynamic), Reach::default()).unwrap();
+        assert!(out.solution.converged, "{v} m/s: did not converge");
+        // The planner's predictor runs at 1e-9; the default model at 1e-10
+        // must land on the goal too, well inside the success tolerance.
+        let f = final_pose(&p, &out.solution.pushes);
+        let d = (f[0] - GOAL.x).hypot(f[1] - GOAL.y);
+        assert!(d < 2e-3, "{v} m/s: {d} m from the goal");
+        assert!((f[2] - GOAL.theta).abs() < 5e-3, "{v} m/s: {f:?}");
+        // Every push points into the object (the pushing cone of the corner).
+        for q in &out.solution.pushes {
+            assert!((-1e-9..=FRAC_PI_2 + 1e-9).contains(&q.phi), "{q:?}");
+        }
+    }
+}
+
+#[test]
+fn the_mirror_image_of_a_plan_reaches_the_mirror_image_of_its_goal() {
+    // The square plate pushed at its corner (−a, −a) is symmetric about the
+    // diagonal y = x: reflecting it maps φ to π/2 − φ, (x, y) to (y, x) and
+    // θ to −θ. So a plan's reflection reaches the reflected goal.
+    let p = plate();
+    let out = make_plan(&p, GOAL, spec(0.5, Predictor::Dynamic), Reach::default()).unwrap();
+    let mirrored: Vec<Push> = out
+        .solution
+        .pushes
+        .iter()
+        .map(|q| Push {
+            phi: FRAC_PI_2 - q.phi,
+            ..*q
+        })
+        .collect();
+    let a = final_pose(&p, &out.solution.pushes);
+    let b = final_pose(&p, &mirrored);
+    assert!(
+        (a[0] - b[1]).abs() < 1e-8 && (a[1] - b[0]).abs() < 1e-8,
+        "{a:?} {b:?}"
+    );
+    assert!((a[2] + b[2]).abs() < 1e-8, "{a:?} {b:?}");
+}
+
+#[test]
+fn a_kinematic_plan_misses_more_the_faster_the_push() {
+    // The quasi-static model is the dynamic one's limit of small Froude
+    // number: slow, its plan works in the dynamic model; fast, it misses.
+    let p = plate();
+    let miss = |v: f64| {
+        let out = make_plan(&p, GOAL, spec(v, Predictor::Kinematic), Reach::default()).unwrap();
+        assert!(
+            out.solution.converged,
+            "{v} m/s: the kinematic plan did not converge"
+        );
+        let f = final_pose(&p, &out.solution.pushes);
+        (f[0] - GOAL.x).hypot(f[1] - GOAL.y)
+    };
+    let (slow, mid, fast) = (miss(0.05), miss(0.5), miss(1.0));
+    assert!(
+        slow < 0.02,
+        "at 0.05 m/s the kinematic plan misses by {slow} m"
+    );
+    assert!(slow < mid && mid < fast, "{slow} {mid} {fast}");
+    assert!(fast > 0.02, "at 1 m/s it should miss: {fast}");
+}
+
+#[test]
+fn a_switch_impulse_and_its_ramp_meet_the_friction_cone_exactly() {
+    let p = plate();
+    let out = make_plan(&p, GOAL, spec(1.0, Predictor::Dynamic), Reach::default()).unwrap();
+    let mut q = p.clone();
+    q.pushes = out.solution.pushes.clone();
+    let traj = DynamicModel::default().simulate(&q).unwrap();
+    let checks = switch_checks(&q, &traj, true);
+    assert_eq!(checks.len(), 6, "the start and five switches");
+    let mu = q.limits.mu.unwrap();
+    // The start from rest: H = 0 before, so the impulse is m v_cm just after,
+    // v_cm = v_P − ω⁺ perp(p_c) with ω⁺ = m (p_c × v_P) / I_P.
+    let first = &q.pushes[0];
+    let pc = q.body.contact();
+    let vp = first.velocity();
+    let w = q.body.mass() * (pc.x * vp.y - pc.y * vp.x) / q.body.inertia_contact();
+    let j = (vp - pushval_model::perp(&pc) * w) * q.body.mass();
+    assert!((checks[0].impulse[0] - j.x).abs() < 1e-9 && (checks[0].impulse[1] - j.y).abs() < 1e-9);
+    for c in &checks {
+        assert_eq!(
+            c.inside,
+            c.cone_angle_rad <= mu.atan() + 1e-12 || (c.impulse[0].hypot(c.impulse[1]) < 1e-12)
+        );
+        if let (false, Some(tau)) = (c.inside, c.ramp_s) {
+            // The ramp found puts the force on the cone's edge.
+            let k = c.segment;
+            let w1 = traj.segments[k].omega_start;
+            let steady =
+                pushval_model::SegmentDynamics::new(&q.body, &q.pushes[k]).pusher_force(w1);
+            let f = steady + pushval_model::Vec2::new(c.impulse[0], c.impulse[1]) / tau;
+            assert!((q.limits.cone_angle(&f) - mu.atan()).abs() < 1e-6, "{c:?}");
+        }
+    }
+}
+
+#[test]
+fn mpc_reaches_on_a_perturbed_rapier2d_plant_where_the_open_loop_plan_misses() {
+    let p = plate();
+    let engine = pushval::registry::engine("rapier2d", &Default::default());
+    let dt = engine.default_dt();
+    let reach = Reach::default();
+    let start = Start::of_problem(&p);
+    let mut planner = Planner::new(
+        &p,
+        GOAL,
+        spec(1.0, Predictor::Dynamic),
+        straight_time(&start, &GOAL, 1.0),
+        reach,
+    );
+    let plan = planner.plan(&start).unwrap();
+    let (_, pe_nom, ae_nom) = open_loop(
+        &p,
+        engine.as_ref(),
+        dt,
+        &plan.pushes,
+        PlantScale::default(),
+        &GOAL,
+    )
+    .unwrap();
+    assert!(
+        reach.holds(pe_nom, ae_nom),
+        "open loop, nominal: {pe_nom} m {ae_nom} rad"
+    );
+    let (_, pe, ae) = open_loop(
+        &p,
+        engine.as_ref(),
+        dt,
+        &plan.pushes,
+        PlantScale::PERTURBED,
+        &GOAL,
+    )
+    .unwrap();
+    assert!(
+        !reach.holds(pe, ae),
+        "open loop on the perturbed plant: {pe} m {ae} rad"
+    );
+    let spec = LoopSpec {
+        plan: spec(1.0, Predictor::Dynamic),
+        period: 0.02,
+        plant: PlantScale::PERTURBED,
+        reach,
+    };
+    let out = run_loop(&p, engine.as_ref(), dt, GOAL, spec).unwrap();
+    assert!(
+        out.success,
+        "MPC: {} m {} rad",
+        out.position_error, out.angle_error
+    );
+    assert!(out.position_error < pe && out.angle_error < ae);
+    assert!(out.steps > 10);
+    // The applied pushes tile the run: their durations add up to its end.
+    let total: f64 = out.applied.iter().map(|a| a.push.duration).sum();
+    let end = out.run.trajectory.samples.last().unwrap().t;
+    assert!((total - end).abs() < 1e-9, "{total} {end}");
+}
+
+#[test]
+fn plan_writes_a_scenario_every_command_takes_and_its_checks() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("plan");
+    let st = pushval()
+        .args(["plan"])
+        .arg(root().join("scenarios/paper-square-v1.0.toml"))
+        .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(doc["converged"], true);
+    assert_eq!(doc["segments"].as_array().unwrap().len(), 6);
+    assert!(doc["position_error_m"].as_f64().unwrap() < 1e-3);
+    assert_eq!(doc["checks"]["switches"].as_array().unwrap().len(), 6);
+    // The plan runs in an engine like any scenario and ends at the goal.
+    let run = dir.path().join("run");
+    let st = pushval()
+        .args(["run"])
+        .arg(out.join("plan.toml"))
+        .arg("--out")
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let csv = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
+    let last = csv
+        .lines()
+        .filter(|l| l.starts_with("rapier2d,"))
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|f| f.parse::<f64>().unwrap_or(f64::NAN))
+        .collect::<Vec<_>>();
+    assert!((last[2] - 0.8).hypot(last[3] - 0.2) < 0.02, "{last:?}");
+}
+
+#[test]
+fn an_unreachable_goal_exits_1_naming_the_nearest_pose() {
+    let dir = tempfile::tempdir().unwrap();
+    // Behind the start: the pusher only pushes.
+    let st = pushval()
+        .args(["plan"])
+        .arg(root().join("scenarios/paper-square-v1.0.toml"))
+        .args(["--goal=-0.6,-0.6,0", "--speed", "0.5", "--out"])
+        .arg(dir.path().join("p"))
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(err.contains("nearest pose"), "{err}");
+}
+
+#[test]
+fn bad_goal_and_plant_exit_2_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, flag) in [
+        (vec!["plan", "--goal=1,2"], "--goal"),
+        (vec!["plan", "--goal=1,2,x"], "--goal"),
+        (
+            vec!["plan", "--goal=1,0,0", "--predictor", "magic"],
+            "--predictor",
+        ),
+        (
+            vec![
+                "loop",
+                "--goal=1,0,0",
+                "--engine",
+                "rapier2d",
+                "--plant",
+                "mu_scale=-1",
+            ],
+            "--plant",
+        ),
+        (
+            vec!["loop", "--goal=1,0,0", "--engine", "no_such_engine"],
+            "--engine",
+        ),
+    ] {
+        let out = dir.path().join("o");
+        let st = pushval()
+            .arg(args[0])
+            .arg(root().join("scenarios/paper-square-v1.0.toml"))
+            .args(&args[1..])
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(st.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert!(err.contains(flag), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    }
+}
+
+#[test]
+fn loop_writes_the_applied_push_and_loop_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("loop");
+    let st = pushval()
+        .args(["loop"])
+        .arg(root().join("scenarios/paper-square-v1.0.toml"))
+        .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--engine", "box2d"])
+        .args(["--plant", "mu_scale=0.8,inertia_scale=1.2", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
+    assert_eq!(doc["success"], true);
+    assert_eq!(doc["engine"], "box2d");
+    assert_eq!(doc["plant"]["mu_scale"], 0.8);
+    assert!(doc["predictor_us_median"].as_f64().unwrap() > 0.0);
+    let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next().unwrap(), "model,t,x,y,theta,omega,speed,phi");
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        let speed: f64 = f[6].parse().unwrap();
+        let phi: f64 = f[7].parse().unwrap();
+        assert_eq!(speed, 1.0, "{l}");
+        assert!((-1e-9..=FRAC_PI_2 + 1e-9).contains(&phi), "{l}");
+    }
+}
