@@ -85,6 +85,7 @@ pub struct PlanSpec {
 /// A predictor of final poses for one problem: the model, a working copy of
 /// the problem (only its schedule and start change between calls), and the
 /// count of model runs.
+#[derive(Clone)]
 pub struct Predict {
     problem: Problem,
     model: DynamicModel,
@@ -212,6 +213,7 @@ pub struct Params {
 
 /// The solver of one goal: the predictor, the goal, the cone, the scale of
 /// the duration, and the Jacobian it carries between calls (warm starts).
+#[derive(Clone)]
 pub struct Planner {
     /// The model runs.
     pub predict: Predict,

@@ -1,0 +1,125 @@
+//! The closed loop's costs: one plan from rest (6 pushes and the duration,
+//! Levenberg–Marquardt on the dynamic model's final pose; target median
+//! ≤ 1 ms) and one MPC period's re-plan from a measured state, warm-started
+//! from the last plan and its Jacobian (target median ≤ 100 µs, p99 ≤ 1 ms;
+//! the control study's loop.json rows give the p99 over whole runs).
+//!
+//! Goals: the control study's first three (0.3–1 m away, turns up to
+//! ±90°), at 0.5 and 1 m/s. The MPC period re-plans at t = 0.2 s of the plan
+//! after a 0.02 s period on a plant with μ × 0.8 (the dynamic model as the
+//! plant), so the warm start has something to correct.
+//!
+//! `cargo bench --bench control`
+
+use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
+use pushval::control::mpc::PlantScale;
+use pushval::control::plan::{straight_time, Motion, PlanSpec, Planner, Start};
+use pushval::control::study::{goals, scene};
+use pushval::control::{Predictor, Reach};
+use pushval_engine::EngineState;
+use pushval_model::{DynamicModel, Simulator, Vec2};
+
+fn control(c: &mut Criterion) {
+    let problem = scene().unwrap();
+    let speeds = [0.5, 1.0];
+    let goals = goals(&problem, &speeds, 3);
+    let start = Start::of_problem(&problem);
+    let reach = Reach::default();
+    let mut g = c.benchmark_group("plan");
+    g.sample_size(30);
+    for &v in &speeds {
+        for (i, goal) in goals.iter().enumerate() {
+            let spec = PlanSpec {
+                segments: 6,
+                speed: v,
+                predictor: Predictor::Dynamic,
+            };
+            let planner =
+                Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
+            assert!(planner.clone().plan(&start).unwrap().converged);
+            g.bench_with_input(
+                BenchmarkId::new("from_rest_6_segments", format!("goal{i}_{v}mps")),
+                &planner,
+                |b, planner| {
+                    b.iter_batched(
+                        || planner.clone(),
+                        |mut p| p.plan(&start),
+                        BatchSize::SmallInput,
+                    )
+                },
+            );
+        }
+    }
+    g.finish();
+
+    let mut g = c.benchmark_group("mpc_period");
+    g.sample_size(50);
+    for &v in &speeds {
+        for (i, goal) in goals.iter().enumerate() {
+            let spec = PlanSpec {
+                segments: 6,
+                speed: v,
+                predictor: Predictor::Dynamic,
+            };
+            let mut planner =
+                Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
+            let plan = planner.plan(&start).unwrap();
+            // The plant (μ × 0.8) runs the plan's first push for 0.2 s.
+            let mut plant = PlantScale {
+                mu_scale: 0.8,
+                inertia_scale: 1.0,
+            }
+            .apply(&problem)
+            .unwrap();
+            plant.pushes = vec![pushval_model::Push {
+                duration: 0.2,
+                ..plan.pushes[0]
+            }];
+            let s = *DynamicModel::default()
+                .simulate(&plant)
+                .unwrap()
+                .samples
+                .last()
+                .unwrap();
+            let v_cm = pushval_engine::rigid_cm_velocity(
+                &problem,
+                Some(&plant.pushes[0]),
+                s.theta,
+                s.omega,
+            );
+            let st = EngineState {
+                t: s.t,
+                x: s.x,
+                y: s.y,
+                theta: s.theta,
+                omega: s.omega,
+                v_cm,
+            };
+            let from = Start {
+                theta: s.theta,
+                position: Vec2::new(s.x, s.y),
+                motion: Motion::Moving {
+                    omega: s.omega,
+                    momentum: st.contact_momentum(&problem),
+                },
+            };
+            let remaining = planner.duration(&plan.params) - 0.2;
+            let warm = planner.with_duration(&plan.params, remaining);
+            g.bench_with_input(
+                BenchmarkId::new("replan_warm", format!("goal{i}_{v}mps")),
+                &planner,
+                |b, planner| {
+                    b.iter_batched(
+                        || (planner.clone(), warm.clone()),
+                        |(mut p, w)| p.solve(&from, w, 4),
+                        BatchSize::SmallInput,
+                    )
+                },
+            );
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, control);
+criterion_main!(benches);
