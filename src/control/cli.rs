@@ -251,6 +251,7 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         "angle_error_rad": json_num(out.angle_error),
         "final_pose": {"t": last.t, "x": last.x, "y": last.y, "theta": last.theta},
         "steps": out.steps,
+        "gave_up_at_twice_the_plan": out.gave_up,
         "predictor_us_median": json_num(med),
         "predictor_us_p99": json_num(p99),
         "plan_from_rest_converged": out.plan_converged,

@@ -131,6 +131,9 @@ pub struct LoopOutcome {
     pub angle_error: f64,
     /// Whether the goal was reached.
     pub success: bool,
+    /// Whether the loop stopped at twice the first plan's duration (the
+    /// re-plans kept growing: the plant does not move as predicted).
+    pub gave_up: bool,
     /// Control periods (re-plans).
     pub steps: usize,
     /// Wall time of each re-plan (µs).
@@ -200,11 +203,28 @@ pub fn run_loop(
     let mut params = first.params.clone();
     let mut pushes = first.pushes.clone();
     let mut remaining = planner.duration(&params);
+    // The loop gives up (a miss) at twice the first plan's duration.
+    let give_up = 2.0 * remaining;
     let mut applied: Vec<Applied> = Vec::new();
     let mut t = 0.0;
     let mut predictor_us = Vec::new();
     let mut steps = 0;
+    let mut gave_up = false;
     loop {
+        if t + remaining > give_up {
+            // The plan keeps growing: the plant does not move as predicted.
+            let rest = (give_up - t).max(0.0);
+            if rest > 0.0 {
+                let p = Push {
+                    duration: rest,
+                    ..pushes[0]
+                };
+                session.advance(&p)?;
+                applied.push(Applied { t0: t, push: p });
+            }
+            gave_up = true;
+            break;
+        }
         if remaining <= n as f64 * spec.period * (1.0 + 1e-9) {
             // Too little time left to re-plan per period: the rest as planned.
             for p in &pushes {
@@ -248,17 +268,6 @@ pub fn run_loop(
                 solved = nearest(solved, fresh);
             }
         }
-        if std::env::var_os("PUSHVAL_DEBUG_MPC").is_some() {
-            eprintln!(
-                "t {t:.3} state {st:?} rem {remaining:.4} -> {:?}",
-                solved.as_ref().map(|s| (
-                    s.position_error,
-                    s.angle_error,
-                    s.iterations,
-                    planner.duration(&s.params)
-                ))
-            );
-        }
         predictor_us.push(clock.elapsed().as_secs_f64() * 1e6);
         match solved {
             Some(s) => {
@@ -285,6 +294,7 @@ pub fn run_loop(
         position_error: pe,
         angle_error: ae,
         success: spec.reach.holds(pe, ae),
+        gave_up,
         steps,
         predictor_us,
         plan_converged,

@@ -202,6 +202,9 @@ fn placeholder() -> Problem {
     }
 }
 
+/// The longest plan, in straight-line times.
+pub const MAX_TIME: f64 = 4.0;
+
 /// The plan's unknowns and how they map to pushes.
 #[derive(Debug, Clone)]
 pub struct Params {
@@ -283,7 +286,7 @@ impl Planner {
         let (lo, hi) = self.cone;
         let (c, h) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
         let n = params.u.len();
-        let duration = self.t_ref * params.s.exp() / n as f64;
+        let duration = self.duration(params) / n as f64;
         params
             .u
             .iter()
@@ -295,9 +298,11 @@ impl Planner {
             .collect()
     }
 
-    /// The duration of `params` (s).
+    /// The duration of `params` (s): at most [`MAX_TIME`] times the
+    /// straight-line time, so that a plan cannot wander (a plant that does
+    /// not turn as predicted would otherwise be sent round ever longer loops).
     pub fn duration(&self, params: &Params) -> f64 {
-        self.t_ref * params.s.exp()
+        self.t_ref * params.s.min(MAX_TIME.ln()).exp()
     }
 
     /// The unknowns of a total duration `t` (s) with every direction at the

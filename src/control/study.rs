@@ -372,8 +372,22 @@ pub fn cli(
             })
             .collect();
         let mine: Vec<&Task> = indices.iter().map(|&i| &list[i]).collect();
+        // Progress on stderr (a bar on a terminal; a line per tenth
+        // elsewhere, e.g. in CI logs).
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let quiet_bar = !std::io::IsTerminal::is_terminal(&std::io::stderr());
         let computed = crate::parallel::par_rows(&mine, true, "runs", |t| {
-            run_task(&problem, built[&t.engine].as_ref(), &goals, &plans, t)
+            let row = run_task(&problem, built[&t.engine].as_ref(), &goals, &plans, t);
+            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            if quiet_bar && (k * 10 / mine.len() != (k - 1) * 10 / mine.len() || k == mine.len()) {
+                eprintln!(
+                    "control-study: {k}/{} runs done ({:.0} s; last {})",
+                    mine.len(),
+                    clock.elapsed().as_secs_f64(),
+                    t.key()
+                );
+            }
+            row
         });
         if let Some(s) = shard {
             std::fs::create_dir_all(out.join("parts"))?;
