@@ -90,9 +90,11 @@ impl DynamicModel {
     /// `omega`: the root ω tends to (a runaway or a pivot is recorded in
     /// `checker`), the runaway limit, the series tail's hand-over rule.
     /// `r_min`: the shortest nonzero distance from the contact to a support (m).
+    /// `spare`: the previous segment's dynamics, whose arrays are reused.
     #[allow(clippy::too_many_arguments)]
     fn segment(
         &self,
+        spare: Option<SegmentDynamics>,
         body: &Body,
         push: &Push,
         index: usize,
@@ -102,7 +104,13 @@ impl DynamicModel {
         r_min: f64,
         checker: &mut Checker,
     ) -> SegmentRun {
-        let dynamics = SegmentDynamics::with_inertial_term(body, push, self.inertial_term);
+        let dynamics = match spare {
+            Some(mut d) => {
+                d.reset(body, push, self.inertial_term);
+                d
+            }
+            None => SegmentDynamics::with_inertial_term(body, push, self.inertial_term),
+        };
         let target = if push.speed > 0.0 {
             dynamics.attractor_from(omega)
         } else {
@@ -258,12 +266,15 @@ impl Simulator for DynamicModel {
             .filter(|r| *r > 0.0)
             .fold(f64::INFINITY, f64::min);
         let n_seg = problem.pushes.len();
-        for (j, (push, span)) in problem
-            .pushes
-            .iter()
-            .zip(problem.segment_times())
-            .enumerate()
-        {
+        rec.out.segments.reserve_exact(n_seg);
+        // One set of per-support arrays for the whole run.
+        let mut spare: Option<SegmentDynamics> = None;
+        // Segment spans as `Problem::segment_times` gives them (the same
+        // running sum), without collecting them.
+        let mut t_end = 0.0;
+        for (j, push) in problem.pushes.iter().enumerate() {
+            let span = (t_end, t_end + push.duration);
+            t_end = span.1;
             if j > 0 || init.from_rest {
                 let w1 = problem.omega_after_switch(prev.as_ref(), push, omega);
                 rec.checker
@@ -272,6 +283,7 @@ impl Simulator for DynamicModel {
             }
             prev = Some(*push);
             let seg = self.segment(
+                spare.take(),
                 body,
                 push,
                 j,
@@ -305,6 +317,7 @@ impl Simulator for DynamicModel {
             }
             report.omega_end = omega;
             rec.out.segments.push(report);
+            spare = Some(seg.dynamics);
         }
         rec.out.assumptions = rec.checker.finish();
         Ok(rec.out)
