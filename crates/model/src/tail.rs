@@ -65,6 +65,18 @@ const DROP_FLOOR: f64 = 1e-18;
 /// Terms kept of the series in `E`.
 pub(crate) const ORDER: usize = 20;
 
+/// `1/m` for `m = 0 ..= ORDER` (`INV[0]` unused): the same values as the
+/// divisions, taken from a table so none sits in a recurrence.
+const INV: [f64; ORDER + 1] = {
+    let mut t = [0.0; ORDER + 1];
+    let mut m = 1;
+    while m <= ORDER {
+        t[m] = 1.0 / m as f64;
+        m += 1;
+    }
+    t
+};
+
 /// The coefficients `a_1 … a_ORDER` of the linearising map `h` (index
 /// `k − 1`) from the Taylor coefficients `g_0 … g_ORDER` of `g` at a root
 /// (`g_1 < 0`). Writing `[h^j]_k` for the `k`-th coefficient of `h^j`, each
@@ -411,7 +423,7 @@ impl TailCursor {
                 *a += gamma[m - k - l] * ta[k + l - 1];
             }
             let acc = (acc4[0] + acc4[1]) + (acc4[2] + acc4[3]);
-            gamma[m] = C::new(acc.im, -acc.re) * (1.0 / m as f64);
+            gamma[m] = C::new(acc.im, -acc.re) * INV[m];
         }
         let n = (n_alpha..=n)
             .rev()
@@ -419,14 +431,13 @@ impl TailCursor {
             .unwrap_or(0);
         // κ_m = W γ_m / z_m, 1/z_m = conj(z_m)/|z_m|²; the divisions are
         // independent of each other, so they go first.
-        let inv_z2: [f64; ORDER] = std::array::from_fn(|k| {
-            let re = (k + 1) as f64 / tau;
-            1.0 / (re * re + tail.omega * tail.omega)
-        });
+        let rate: [f64; ORDER] = std::array::from_fn(|k| (k + 1) as f64 / tau);
+        let inv_z2: [f64; ORDER] =
+            std::array::from_fn(|k| 1.0 / (rate[k] * rate[k] + tail.omega * tail.omega));
         let mut kappa = [C::new(0.0, 0.0); ORDER];
         let mut sum_kappa = C::new(0.0, 0.0);
         for m in (1..=n).rev() {
-            let z = C::new(-(m as f64) / tau, -tail.omega);
+            let z = C::new(-rate[m - 1], -tail.omega);
             kappa[m - 1] = w * gamma[m] * z * inv_z2[m - 1];
             sum_kappa += kappa[m - 1];
         }
@@ -537,10 +548,9 @@ impl TailCursor {
         };
         let all_even = spacing(times);
         let mut nb = n;
-        // Written per block straight into `out` (`extend` from an iterator
-        // of known length): a block assembled on the stack and then copied
-        // would be read back before its narrow stores retire, and writing
-        // in place would first need the whole output zeroed.
+        // Written per block straight into `out` (zeroed, then overwritten):
+        // a block assembled on the stack and then copied would be read back
+        // before its narrow stores retire.
         out.reserve(times.len());
         for block in times.chunks(BLOCK) {
             let len = block.len();
@@ -649,15 +659,19 @@ impl TailCursor {
                     (xs[j], ys[j]) = (q.re, q.im);
                 }
             }
-            // One reservation for the block (the iterator's length is
-            // known), then plain stores.
-            out.extend(block.iter().enumerate().map(|(j, &t)| crate::Sample {
-                t,
-                x: xs[j],
-                y: ys[j],
-                theta: theta0 + tl.omega * s[j] - ba[j],
-                omega: tl.omega + wa[j],
-            }));
+            // Zeroed in place, then overwritten: plain stores, no
+            // capacity check per sample.
+            let base = out.len();
+            out.resize(base + len, crate::Sample::default());
+            for (j, (o, &t)) in out[base..].iter_mut().zip(block).enumerate() {
+                *o = crate::Sample {
+                    t,
+                    x: xs[j],
+                    y: ys[j],
+                    theta: theta0 + tl.omega * s[j] - ba[j],
+                    omega: tl.omega + wa[j],
+                };
+            }
         }
     }
 
