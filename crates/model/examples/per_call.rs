@@ -66,6 +66,7 @@ fn main() {
     let m = DynamicModel {
         integrator: Integrator::Dop853 { tol },
         check_assumptions: false,
+        skip_settled: std::env::var_os("NO_SKIP").is_none(),
         ..Default::default()
     };
     let mut evals = 0;
