@@ -158,13 +158,18 @@ impl SegmentDynamics {
     /// a run of many segments allocates them once (what
     /// [`SegmentDynamics::with_inertial_term`] returns, bit for bit).
     pub(crate) fn reset(&mut self, body: &Body, push: &Push, term: InertialTerm) {
+        self.reset_along(body, push, push.direction(), term);
+    }
+
+    /// [`SegmentDynamics::reset`] with the push direction `dir = n_φ` the
+    /// caller already has.
+    pub(crate) fn reset_along(&mut self, body: &Body, push: &Push, dir: Vec2, term: InertialTerm) {
         let sign = match term {
             InertialTerm::Derived => 1.0,
             InertialTerm::Flipped => -1.0,
         };
         let (sx, sy, fr) = body.arrays();
         let pc = body.contact();
-        let dir = push.direction();
         self.speed = push.speed;
         self.dir = dir;
         self.k = sign * body.mass() * push.speed * pc.dot(&dir);
