@@ -2,9 +2,13 @@
 //! `paper` runs the 10 s paper trajectory (five segments, 1,001 samples) at
 //! the tolerance the work–precision bench picks for 1e-9 m; `short` runs a
 //! model-predictive controller's unit of work, a 6-segment horizon from rest
-//! with two samples (its start and end). Assumption checks are off in both.
+//! at 1 m/s with two samples (its start and end), the problem of
+//! `benches/short_horizon` on the same plate. Assumption checks are off in
+//! both.
 //!
-//! `cargo run --release -p pushval-model --example per_call -- paper|short [runs]`
+//! `cargo run --release -p pushval-model --example per_call -- paper|short [runs [sample_dt]]`;
+//! `NO_SKIP=1` integrates every segment (no series tail), `SEGMENTS=1`
+//! prints the solver work and each segment's report.
 use pushval_model::*;
 
 fn plate() -> Body {
@@ -43,7 +47,7 @@ fn main() {
                 .iter()
                 .map(|&phi| Push {
                     duration: 0.1,
-                    speed: 0.5,
+                    speed: 1.0,
                     phi,
                 })
                 .collect(),
@@ -78,6 +82,13 @@ fn main() {
         last = tr.samples.last().map_or(0.0, |s| s.x);
     }
     let per = t0.elapsed().as_secs_f64() / runs as f64;
+    if std::env::var_os("SEGMENTS").is_some() {
+        let tr = m.simulate(&pb).unwrap();
+        println!("{:?}", tr.stats);
+        for r in &tr.segments {
+            println!("{r:?}");
+        }
+    }
     println!(
         "{which}: {runs} runs, {evals} rhs evaluations per run, {:.2} us per run (wall), last x {last}",
         per * 1e6
