@@ -7,8 +7,8 @@
 //! both.
 //!
 //! `cargo run --release -p pushval-model --example per_call -- paper|short [runs [sample_dt]]`;
-//! `NO_SKIP=1` integrates every segment (no series tail), `SEGMENTS=1`
-//! prints the solver work and each segment's report.
+//! `NO_SKIP=1` integrates every segment (no series tail), `TOL=…` sets the
+//! tolerance, `SEGMENTS=1` prints the solver work and each segment's report.
 use pushval_model::*;
 
 fn plate() -> Body {
@@ -67,6 +67,11 @@ fn main() {
         switching: Switching::Impulsive,
         sample_dt: dt_override.unwrap_or(sample_dt),
     };
+    // `TOL=…` overrides the tolerance.
+    let tol = std::env::var("TOL")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(tol);
     let m = DynamicModel {
         integrator: Integrator::Dop853 { tol },
         check_assumptions: false,
