@@ -112,18 +112,20 @@ pub(crate) fn linearising_map(
         let mut o = 0;
         while o + 1 < k {
             let mut acc = [0.0; 4];
-            for i in 1..k - o {
-                let s: &[f64; 4] = (&lo[k - i][o + 1..o + 5]).try_into().expect("in the row");
+            // i = 1, 2, … against rows k − 1, k − 2, …, o + 1.
+            for (ai, row) in a[1..k - o].iter().zip(lo[o + 1..].iter().rev()) {
+                let s: &[f64; 4] = row[o + 1..o + 5].try_into().expect("in the row");
                 for l in 0..4 {
-                    acc[l] += a[i] * s[l];
+                    acc[l] += ai * s[l];
                 }
             }
             dst[o + 2..o + 6].copy_from_slice(&acc);
             o += 4;
         }
-        // Σ_j g_j [h^j]_k in four partial sums (the row is zero past k).
+        // Σ_j g_j [h^j]_k in four partial sums, over the chunks that reach
+        // j = k (the row is zero past k).
         let mut part = [0.0; 4];
-        for c in 0..(ROW - 2) / 4 {
+        for c in 0..(k + 2) / 4 {
             for l in 0..4 {
                 part[l] += gp[2 + 4 * c + l] * dst[2 + 4 * c + l];
             }
