@@ -3,7 +3,10 @@
 //! one process. Writes `results/work_precision.csv`, the figure
 //! `results/work_precision.svg`, and `results/work_precision_target.csv`: the
 //! cheapest pushval and ode_solvers Dop853 settings at 1e-9 m maximum
-//! position error, timed alternately and compared.
+//! position error, timed alternately and compared, and on its last line the
+//! median of the model-predictive controller's unit of work
+//! (`model_short_horizon`: 6 segments from rest, two samples, assumption
+//! checks off; `short_horizon/mod.rs`).
 //!
 //! `cargo bench --bench work_precision` (add `-- --quick` for fewer repeats).
 //!
@@ -27,6 +30,8 @@ use pushval_model::{
     Vec2,
 };
 use pushval_scenario::Scenario;
+
+mod short_horizon;
 
 struct Row {
     method: String,
@@ -243,13 +248,14 @@ fn main() {
         }
         eprint!(".");
     }
-    let target = target_comparison(
+    let mut target = target_comparison(
         &sc,
         &segs,
         &problem,
         &reference,
         if quick { 21 } else { 61 },
     );
+    target.push_str(&short_horizon_line(root, if quick { 201 } else { 2001 }));
     if model_only {
         eprintln!();
         print!("{target}");
@@ -425,6 +431,27 @@ fn target_comparison(
     }
     out.push_str(&format!("# speed-up at the target: {:.2}x\n", mb / ma));
     out
+}
+
+/// The median thread CPU time of `runs` dynamic-model runs of the
+/// short horizon (`short_horizon/mod.rs`), as a comment line of
+/// `work_precision_target.csv`.
+fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
+    let problem = short_horizon::problem(root);
+    let model = short_horizon::model();
+    let tol = match model.integrator {
+        Integrator::Dop853 { tol } => tol,
+        other => panic!("the short horizon runs DOP853, not {other:?}"),
+    };
+    let (d, tr) = time(runs, || model.simulate(&problem).unwrap());
+    format!(
+        "# model_short_horizon ({} segments from rest, {:.2} s, {} samples, checks off, DOP853 tol {tol:e}): median {:.6e} s, {} RHS evaluations\n",
+        short_horizon::SEGMENTS,
+        problem.duration(),
+        tr.samples.len(),
+        d.as_secs_f64(),
+        tr.stats.rhs_evals
+    )
 }
 
 /// Log–log work–precision figure: error against median run time, one line per

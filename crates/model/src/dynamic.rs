@@ -133,13 +133,6 @@ impl SegmentDynamics {
 
     /// As [`SegmentDynamics::new`], with a chosen reading of the inertial term.
     pub fn with_inertial_term(body: &Body, push: &Push, term: InertialTerm) -> Self {
-        let sign = match term {
-            InertialTerm::Derived => 1.0,
-            InertialTerm::Flipped => -1.0,
-        };
-        let (sx, sy, fr) = body.arrays();
-        let pc = body.contact();
-        let dir = push.direction();
         let n = body.len();
         let mut me = Self {
             f: Vec::with_capacity(n),
@@ -148,29 +141,66 @@ impl SegmentDynamics {
             index: Vec::with_capacity(n),
             rx: Vec::with_capacity(n),
             ry: Vec::with_capacity(n),
-            speed: push.speed,
-            dir,
-            k: sign * body.mass() * push.speed * pc.dot(&dir),
-            inertia_contact: body.inertia_contact(),
-            inv_inertia_contact: 1.0 / body.inertia_contact(),
-            mass: body.mass(),
-            contact: pc,
+            speed: 0.0,
+            dir: Vec2::zeros(),
+            k: 0.0,
+            inertia_contact: 1.0,
+            inv_inertia_contact: 1.0,
+            mass: 1.0,
+            contact: Vec2::zeros(),
             max_moment: 0.0,
         };
-        for i in 0..n {
+        me.reset(body, push, term);
+        me
+    }
+
+    /// Makes `self` the segment for `body` and `push`, reusing its arrays:
+    /// a run of many segments allocates them once (what
+    /// [`SegmentDynamics::with_inertial_term`] returns, bit for bit).
+    pub(crate) fn reset(&mut self, body: &Body, push: &Push, term: InertialTerm) {
+        self.reset_along(body, push, push.direction(), term);
+    }
+
+    /// [`SegmentDynamics::reset`] with the push direction `dir = n_φ` the
+    /// caller already has.
+    pub(crate) fn reset_along(&mut self, body: &Body, push: &Push, dir: Vec2, term: InertialTerm) {
+        let sign = match term {
+            InertialTerm::Derived => 1.0,
+            InertialTerm::Flipped => -1.0,
+        };
+        let (sx, sy, fr) = body.arrays();
+        let pc = body.contact();
+        self.speed = push.speed;
+        self.dir = dir;
+        self.k = sign * body.mass() * push.speed * pc.dot(&dir);
+        self.inertia_contact = body.inertia_contact();
+        self.inv_inertia_contact = 1.0 / body.inertia_contact();
+        self.mass = body.mass();
+        self.contact = pc;
+        self.max_moment = 0.0;
+        for v in [
+            &mut self.f,
+            &mut self.s,
+            &mut self.b,
+            &mut self.rx,
+            &mut self.ry,
+        ] {
+            v.clear();
+        }
+        self.index.clear();
+        for i in 0..body.len() {
             if fr[i] == 0.0 {
                 continue;
             }
             let r = Vec2::new(sx[i] - pc.x, sy[i] - pc.y);
-            me.f.push(fr[i]);
-            me.s.push(cross(&r, &dir));
-            me.b.push(r.norm_squared());
-            me.index.push(i);
-            me.rx.push(r.x);
-            me.ry.push(r.y);
-            me.max_moment += fr[i] * r.norm();
+            self.f.push(fr[i]);
+            self.s.push(cross(&r, &dir));
+            self.b.push(r.norm_squared());
+            self.index.push(i);
+            self.rx.push(r.x);
+            self.ry.push(r.y);
+            self.max_moment += fr[i] * r.norm();
         }
-        me
     }
 
     /// Pusher speed (m/s).
@@ -860,6 +890,40 @@ mod tests {
                     "n {n}, ω {omega}: {got} against {want}"
                 );
             }
+        }
+    }
+
+    /// A segment re-made in place from another segment's arrays (another
+    /// body, more supports, a zero-friction support, the flipped inertial
+    /// term before) is the segment made afresh: the same ω̇, roots and
+    /// pusher force.
+    #[test]
+    fn a_reset_segment_is_a_fresh_one() {
+        let mut b = body(&[(0.1, 0.08), (0.12, -0.07), (-0.05, 0.02), (0.0, -0.1)]);
+        let small = body(&[(0.1, 0.1), (-0.1, 0.1)]);
+        let push = Push {
+            duration: 1.0,
+            speed: 0.7,
+            phi: 0.4,
+        };
+        let other = Push {
+            duration: 1.0,
+            speed: 0.2,
+            phi: -1.1,
+        };
+        let mut sup: Vec<Support> = b.supports().collect();
+        sup[1].friction = 0.0;
+        b = Body::new(1.3, 0.02, b.contact(), &sup).unwrap();
+        for (before, term) in [(&small, InertialTerm::Flipped), (&b, InertialTerm::Derived)] {
+            let mut seg = SegmentDynamics::with_inertial_term(before, &other, term);
+            seg.reset(&b, &push, InertialTerm::Derived);
+            let fresh = SegmentDynamics::new(&b, &push);
+            for w in [-3.0, -0.2, 0.0, 0.5, 4.0] {
+                assert_eq!(seg.omega_dot(w), fresh.omega_dot(w), "ω {w}");
+                assert_eq!(seg.pusher_force(w), fresh.pusher_force(w), "ω {w}");
+            }
+            assert_eq!(seg.steady_states(), fresh.steady_states());
+            assert_eq!(seg.max_moment(), fresh.max_moment());
         }
     }
 

@@ -180,11 +180,24 @@ impl Problem {
         after: &Push,
         omega_before: f64,
     ) -> f64 {
+        self.omega_after_switch_at(before.map(Push::velocity), after.velocity(), omega_before)
+    }
+
+    /// [`Problem::omega_after_switch`] from the contact velocities
+    /// (`None`: at rest) the caller already has (object frame, m/s).
+    pub(crate) fn omega_after_switch_at(
+        &self,
+        before: Option<Vec2>,
+        after: Vec2,
+        omega_before: f64,
+    ) -> f64 {
         match self.switching {
             Switching::Continuous => omega_before,
             Switching::Impulsive => {
-                let h = Self::contact_momentum(&self.body, before, omega_before);
-                let lin = self.body.mass() * crate::cross(&self.body.contact(), &after.velocity());
+                let pc = self.body.contact();
+                let lin_before = before.map(|v| crate::cross(&pc, &v)).unwrap_or(0.0);
+                let h = self.body.inertia_contact() * omega_before - self.body.mass() * lin_before;
+                let lin = self.body.mass() * crate::cross(&pc, &after);
                 (h + lin) / self.body.inertia_contact()
             }
         }

@@ -52,8 +52,30 @@ type C = Complex<f64>;
 /// Share of the tolerance the tail may leave out.
 pub(crate) const SETTLE_FRACTION: f64 = 0.03;
 
+/// Share of the tolerance (as an angle, rad) below which a term of the
+/// series is left out of a block of samples: a thousandth of what the
+/// hand-over itself may leave out ([`SETTLE_FRACTION`]), so the terms dropped
+/// stay far below the tolerance.
+pub(crate) const DROP_FRACTION: f64 = 1e-3 * SETTLE_FRACTION;
+
+/// Terms below this size (rad, as an angle) are always left out of samples:
+/// at rounding level for any angle the series could reach.
+const DROP_FLOOR: f64 = 1e-18;
+
 /// Terms kept of the series in `E`.
 pub(crate) const ORDER: usize = 20;
+
+/// `1/m` for `m = 0 ..= ORDER` (`INV[0]` unused): the same values as the
+/// divisions, taken from a table so none sits in a recurrence.
+const INV: [f64; ORDER + 1] = {
+    let mut t = [0.0; ORDER + 1];
+    let mut m = 1;
+    while m <= ORDER {
+        t[m] = 1.0 / m as f64;
+        m += 1;
+    }
+    t
+};
 
 /// The coefficients `a_1 … a_ORDER` of the linearising map `h` (index
 /// `k − 1`) from the Taylor coefficients `g_0 … g_ORDER` of `g` at a root
@@ -80,6 +102,8 @@ pub(crate) fn linearising_map(
     let mut pw = [[0.0; ROW]; ORDER + 1];
     pw[1][1] = 1.0;
     let gp: [f64; ROW] = std::array::from_fn(|j| if j <= ORDER { g[j] } else { 0.0 });
+    // reach^(k−1), kept as a running product for the stopping test.
+    let mut reach_km1 = reach;
     for k in 2..=ORDER {
         let (lo, hi) = pw.split_at_mut(k);
         let dst = &mut hi[0];
@@ -88,18 +112,20 @@ pub(crate) fn linearising_map(
         let mut o = 0;
         while o + 1 < k {
             let mut acc = [0.0; 4];
-            for i in 1..k - o {
-                let s: &[f64; 4] = (&lo[k - i][o + 1..o + 5]).try_into().expect("in the row");
+            // i = 1, 2, … against rows k − 1, k − 2, …, o + 1.
+            for (ai, row) in a[1..k - o].iter().zip(lo[o + 1..].iter().rev()) {
+                let s: &[f64; 4] = row[o + 1..o + 5].try_into().expect("in the row");
                 for l in 0..4 {
-                    acc[l] += a[i] * s[l];
+                    acc[l] += ai * s[l];
                 }
             }
             dst[o + 2..o + 6].copy_from_slice(&acc);
             o += 4;
         }
-        // Σ_j g_j [h^j]_k in four partial sums (the row is zero past k).
+        // Σ_j g_j [h^j]_k in four partial sums, over the chunks that reach
+        // j = k (the row is zero past k).
         let mut part = [0.0; 4];
-        for c in 0..(ROW - 2) / 4 {
+        for c in 0..(k + 2) / 4 {
             for l in 0..4 {
                 part[l] += gp[2 + 4 * c + l] * dst[2 + 4 * c + l];
             }
@@ -107,11 +133,11 @@ pub(crate) fn linearising_map(
         let sum = (part[0] + part[1]) + (part[2] + part[3]);
         a[k] = -tau / (k as f64 - 1.0) * sum;
         dst[1] = a[k];
-        if k >= 4
-            && a[k].abs() * reach.powi(k as i32) + a[k - 1].abs() * reach.powi(k as i32 - 1) < small
-        {
+        let reach_k = reach_km1 * reach;
+        if k >= 4 && a[k].abs() * reach_k + a[k - 1].abs() * reach_km1 < small {
             return (std::array::from_fn(|i| a[i + 1]), k);
         }
+        reach_km1 = reach_k;
     }
     (std::array::from_fn(|k| a[k + 1]), ORDER)
 }
@@ -231,6 +257,7 @@ impl SettleRule {
         }
         let mut tail = Tail::arc(t, c, theta, self.omega, vel);
         tail.tau = self.tau;
+        tail.drop = (DROP_FRACTION * self.tol).max(DROP_FLOOR);
         if d == 0.0 {
             return Some(tail);
         }
@@ -280,6 +307,9 @@ pub(crate) struct Tail {
     pub alpha: [f64; ORDER],
     /// Contact-point velocity in the object frame (m/s).
     pub vel: Vec2,
+    /// Size (rad, as an angle) below which a term of the series no longer
+    /// counts in a sample.
+    pub drop: f64,
 }
 
 impl Tail {
@@ -293,6 +323,7 @@ impl Tail {
             tau: 1.0,
             alpha: [0.0; ORDER],
             vel,
+            drop: DROP_FLOOR,
         }
     }
 }
@@ -315,7 +346,9 @@ const LANES: usize = 4;
 struct StepPowers {
     dt: f64,
     s: [f64; BLOCK],
-    p: [C; BLOCK],
+    /// `P^j`, real and imaginary parts apart, so the products vectorise.
+    pr: [f64; BLOCK],
+    pi: [f64; BLOCK],
     e: [f64; BLOCK],
 }
 
@@ -392,7 +425,7 @@ impl TailCursor {
                 *a += gamma[m - k - l] * ta[k + l - 1];
             }
             let acc = (acc4[0] + acc4[1]) + (acc4[2] + acc4[3]);
-            gamma[m] = C::new(acc.im, -acc.re) * (1.0 / m as f64);
+            gamma[m] = C::new(acc.im, -acc.re) * INV[m];
         }
         let n = (n_alpha..=n)
             .rev()
@@ -400,14 +433,13 @@ impl TailCursor {
             .unwrap_or(0);
         // κ_m = W γ_m / z_m, 1/z_m = conj(z_m)/|z_m|²; the divisions are
         // independent of each other, so they go first.
-        let inv_z2: [f64; ORDER] = std::array::from_fn(|k| {
-            let re = (k + 1) as f64 / tau;
-            1.0 / (re * re + tail.omega * tail.omega)
-        });
+        let rate: [f64; ORDER] = std::array::from_fn(|k| (k + 1) as f64 / tau);
+        let inv_z2: [f64; ORDER] =
+            std::array::from_fn(|k| 1.0 / (rate[k] * rate[k] + tail.omega * tail.omega));
         let mut kappa = [C::new(0.0, 0.0); ORDER];
         let mut sum_kappa = C::new(0.0, 0.0);
         for m in (1..=n).rev() {
-            let z = C::new(-(m as f64) / tau, -tail.omega);
+            let z = C::new(-rate[m - 1], -tail.omega);
             kappa[m - 1] = w * gamma[m] * z * inv_z2[m - 1];
             sum_kappa += kappa[m - 1];
         }
@@ -471,7 +503,7 @@ impl TailCursor {
         let mut lam = [C::new(0.0, 0.0); ORDER];
         // Size of a term as an angle (rad): the λ terms over the lengths they
         // scale, |V| τ for the path and |p_c| for the lever. A block drops
-        // the terms that stay below 1e-18 rad.
+        // the terms that stay below the tail's `drop` (rad).
         let mut mag = self.mag;
         let len_scale = tl.vel.norm() * tl.tau + pc.norm();
         for m in 0..n {
@@ -494,7 +526,8 @@ impl TailCursor {
         // Every block computes all BLOCK lanes (a short last block repeats
         // its last sample), so the loops below have a fixed length.
         let mut s = [0.0; BLOCK];
-        let mut p = [C::new(1.0, 0.0); BLOCK];
+        let mut pr = [1.0; BLOCK];
+        let mut pi = [0.0; BLOCK];
         let mut e = [1.0; BLOCK];
         // Powers of the phasor steps for evenly spaced samples, so a block's
         // samples do not wait on each other.
@@ -517,14 +550,14 @@ impl TailCursor {
         };
         let all_even = spacing(times);
         let mut nb = n;
-        // Pushed one by one: a block assembled on the stack and then copied
-        // would be read back before its narrow stores retire, and writing
-        // in place would first need the whole output zeroed.
+        // Written per block straight into `out` (zeroed, then overwritten):
+        // a block assembled on the stack and then copied would be read back
+        // before its narrow stores retire.
         out.reserve(times.len());
         for block in times.chunks(BLOCK) {
             let len = block.len();
             self.advance(block[0]);
-            (s[0], p[0], e[0]) = (self.s, self.p, self.e);
+            (s[0], pr[0], pi[0], e[0]) = (self.s, self.p.re, self.p.im, self.e);
             let even = match all_even {
                 Some(dt) if len > 1 => Some(dt),
                 Some(_) => None,
@@ -548,28 +581,35 @@ impl TailCursor {
                     pows = Some(StepPowers {
                         dt,
                         s: std::array::from_fn(|j| j as f64 * dt),
-                        p: pp,
+                        pr: pp.map(|z| z.re),
+                        pi: pp.map(|z| z.im),
                         e: ep,
                     });
                 }
                 let w = pows.as_ref().expect("just set");
-                for j in 1..BLOCK {
-                    s[j] = s[0] + w.s[j];
-                    p[j] = p[0] * w.p[j];
-                    e[j] = e[0] * w.e[j];
+                // P_j = P_0 P^j written out, the same products as `C`'s
+                // (lane 0 reproduces itself: P^0 = 1, E^0 = 1), over the
+                // whole block so the loop vectorises.
+                let (s0, p0r, p0i, e0) = (s[0], pr[0], pi[0], e[0]);
+                for j in 0..BLOCK {
+                    s[j] = s0 + w.s[j];
+                    pr[j] = p0r * w.pr[j] - p0i * w.pi[j];
+                    pi[j] = p0r * w.pi[j] + p0i * w.pr[j];
+                    e[j] = e0 * w.e[j];
                 }
-                (self.s, self.p, self.e) = (s[len - 1], p[len - 1], e[len - 1]);
+                (self.s, self.p, self.e) =
+                    (s[len - 1], C::new(pr[len - 1], pi[len - 1]), e[len - 1]);
             } else {
                 for j in 1..BLOCK {
                     if j < len {
                         self.advance(block[j]);
                     }
-                    (s[j], p[j], e[j]) = (self.s, self.p, self.e);
+                    (s[j], pr[j], pi[j], e[j]) = (self.s, self.p.re, self.p.im, self.e);
                 }
             }
             // Terms that still count at the block's largest E (E only
             // decreases, so neither do the terms beyond the last block's).
-            while nb > 0 && mag[nb - 1] * e[0].powi(nb as i32) <= 1e-18 {
+            while nb > 0 && mag[nb - 1] * e[0].powi(nb as i32) <= tl.drop {
                 nb -= 1;
             }
             // The four sums LANES samples at a time, so the accumulators
@@ -597,7 +637,7 @@ impl TailCursor {
                 // Branch-free over the block, so the poses vectorise.
                 for j in 0..BLOCK {
                     let (ir, ii) = (mu_far.re + lr[j], mu_far.im + li[j]);
-                    let (pr, pi) = (p[j].re, p[j].im);
+                    let (pr, pi) = (pr[j], pi[j]);
                     xs[j] = c_far.re + (pr * ir - pi * ii);
                     ys[j] = c_far.im + (pr * ii + pi * ir);
                 }
@@ -605,29 +645,34 @@ impl TailCursor {
                 for j in 0..BLOCK {
                     let a0 = self.w * self.a0_short(s[j]);
                     let (ir, ii) = (lr[j] - r.re, li[j] - r.im);
-                    let (pr, pi) = (p[j].re, p[j].im);
+                    let (pr, pi) = (pr[j], pi[j]);
                     xs[j] = (self.c_base.re + a0.re) + (pr * ir - pi * ii);
                     ys[j] = (self.c_base.im + a0.im) + (pr * ii + pi * ir);
                 }
             } else {
                 for j in 0..BLOCK {
+                    let pj = C::new(pr[j], pi[j]);
                     let a0 = if (tl.omega * s[j]).abs() < 1e-3 {
                         self.a0_short(s[j])
                     } else {
-                        (p[j] - 1.0) * self.inv_iw
+                        (pj - 1.0) * self.inv_iw
                     };
-                    let q = self.c_base + self.w * a0 + p[j] * (C::new(lr[j], li[j]) - r);
+                    let q = self.c_base + self.w * a0 + pj * (C::new(lr[j], li[j]) - r);
                     (xs[j], ys[j]) = (q.re, q.im);
                 }
             }
-            for (j, &t) in block.iter().enumerate() {
-                out.push(crate::Sample {
+            // Zeroed in place, then overwritten: plain stores, no
+            // capacity check per sample.
+            let base = out.len();
+            out.resize(base + len, crate::Sample::default());
+            for (j, (o, &t)) in out[base..].iter_mut().zip(block).enumerate() {
+                *o = crate::Sample {
                     t,
                     x: xs[j],
                     y: ys[j],
                     theta: theta0 + tl.omega * s[j] - ba[j],
                     omega: tl.omega + wa[j],
-                });
+                };
             }
         }
     }

@@ -90,11 +90,15 @@ impl DynamicModel {
     /// `omega`: the root ω tends to (a runaway or a pivot is recorded in
     /// `checker`), the runaway limit, the series tail's hand-over rule.
     /// `r_min`: the shortest nonzero distance from the contact to a support (m).
+    /// `spare`: the previous segment's dynamics, whose arrays are reused;
+    /// `dir`: the push direction `n_φ`.
     #[allow(clippy::too_many_arguments)]
     fn segment(
         &self,
+        spare: Option<SegmentDynamics>,
         body: &Body,
         push: &Push,
+        dir: Vec2,
         index: usize,
         (t0, t1): (f64, f64),
         last: bool,
@@ -102,7 +106,13 @@ impl DynamicModel {
         r_min: f64,
         checker: &mut Checker,
     ) -> SegmentRun {
-        let dynamics = SegmentDynamics::with_inertial_term(body, push, self.inertial_term);
+        let dynamics = match spare {
+            Some(mut d) => {
+                d.reset_along(body, push, dir, self.inertial_term);
+                d
+            }
+            None => SegmentDynamics::with_inertial_term(body, push, self.inertial_term),
+        };
         let target = if push.speed > 0.0 {
             dynamics.attractor_from(omega)
         } else {
@@ -153,7 +163,7 @@ impl DynamicModel {
             t0,
             t1,
             last,
-            vel: push.velocity(),
+            vel: dir * push.speed,
             tol,
             settle,
             pivot,
@@ -251,6 +261,9 @@ impl Simulator for DynamicModel {
         let mut c = init.position + rotate(theta, &pc);
         let mut omega = if init.from_rest { 0.0 } else { init.omega };
         let mut prev: Option<Push> = (!init.from_rest).then(|| problem.pushes[0]);
+        // The contact velocity of `prev` (object frame, m/s): each push's
+        // direction is computed once.
+        let mut prev_vel: Option<Vec2> = prev.as_ref().map(Push::velocity);
         let mut h_carry: Option<(f64, f64)> = None;
         let r_min = body
             .supports()
@@ -258,22 +271,30 @@ impl Simulator for DynamicModel {
             .filter(|r| *r > 0.0)
             .fold(f64::INFINITY, f64::min);
         let n_seg = problem.pushes.len();
-        for (j, (push, span)) in problem
-            .pushes
-            .iter()
-            .zip(problem.segment_times())
-            .enumerate()
-        {
+        rec.out.segments.reserve_exact(n_seg);
+        // One set of per-support arrays for the whole run.
+        let mut spare: Option<SegmentDynamics> = None;
+        // Segment spans as `Problem::segment_times` gives them (the same
+        // running sum), without collecting them.
+        let mut t_end = 0.0;
+        for (j, push) in problem.pushes.iter().enumerate() {
+            let span = (t_end, t_end + push.duration);
+            t_end = span.1;
+            let dir = push.direction();
+            let vel = dir * push.speed;
             if j > 0 || init.from_rest {
-                let w1 = problem.omega_after_switch(prev.as_ref(), push, omega);
+                let w1 = problem.omega_after_switch_at(prev_vel, vel, omega);
                 rec.checker
                     .switch(prev.as_ref(), omega, push, w1, span.0, j);
                 omega = w1;
             }
             prev = Some(*push);
+            prev_vel = Some(vel);
             let seg = self.segment(
+                spare.take(),
                 body,
                 push,
+                dir,
                 j,
                 span,
                 j + 1 == n_seg,
@@ -305,6 +326,7 @@ impl Simulator for DynamicModel {
             }
             report.omega_end = omega;
             rec.out.segments.push(report);
+            spare = Some(seg.dynamics);
         }
         rec.out.assumptions = rec.checker.finish();
         Ok(rec.out)

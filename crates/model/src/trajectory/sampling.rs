@@ -66,6 +66,8 @@ pub(super) fn sample_tail(
     // Every sample `due` would hand out up to t1 (times increase).
     let (eps, times) = (sampler.eps, &sampler.times[first..]);
     sampler.next += times.partition_point(|&ts| (last || ts < t1 - eps) && ts <= t1 + eps);
-    cursor.fill(&sampler.times[first..sampler.next], pc, out);
+    if sampler.next > first {
+        cursor.fill(&sampler.times[first..sampler.next], pc, out);
+    }
     cursor.eval(t1)
 }
