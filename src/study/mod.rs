@@ -415,8 +415,19 @@ impl Plan {
     /// [`fit::WIDTH`] (NaN where the engine or the fit fails).
     pub fn eval(&self, t: &Task) -> Vec<f64> {
         if let Task::Fit { k } = *t {
-            return fit::fit_engine(self.setups[0].engine.as_ref(), k, self.dt)
-                .unwrap_or_else(|_| vec![f64::NAN; fit::WIDTH]);
+            return fit::fit_engine(self.setups[0].engine.as_ref(), k, self.dt).unwrap_or_else(
+                |(stage, e)| {
+                    // The row keeps the stage (its reason column); the
+                    // error itself is said here.
+                    eprintln!(
+                        "study {}: coulomb fit of {}: {}: {e:#}",
+                        self.model,
+                        fit::SCHEDULES[k],
+                        stage.reason()
+                    );
+                    fit::failed_row(stage)
+                },
+            );
         }
         if let Task::Sweep { w, i, v } = *t {
             let sw = &self.sweeps[w];

@@ -285,12 +285,17 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             } else {
                 fit::verdict(r)
             };
+            let reason = match verdict {
+                "failed" => fit::failure_reason(r).unwrap_or_default(),
+                "degenerate" => fit::degenerate_reason(r),
+                _ => String::new(),
+            };
             let _ = writeln!(
                 fits,
                 "{},{},{fitted},{verdict},{}",
                 fit::SCHEDULES[k],
                 vals.join(","),
-                fit::degenerate_reason(r)
+                reason.replace(',', ";")
             );
         }
     }

@@ -12,6 +12,95 @@ fn pushval_in(dir: &Path) -> Command {
     c
 }
 
+/// The exit code and standard output + error of pushval run in `dir` with
+/// `args`, with `TMPDIR` and `XDG_CACHE_HOME` set to `tmp` and `cache`.
+fn run_with(dir: &Path, tmp: &Path, cache: &Path, args: &[&str]) -> (Option<i32>, String) {
+    let out = pushval_in(dir)
+        .args(args)
+        .env("TMPDIR", tmp)
+        .env("XDG_CACHE_HOME", cache)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.code(), text)
+}
+
+/// The init adapter's Heun step (`step` in assets/init/adapter.py) replaced
+/// by explicit Euler: first order in dt, everything else the same.
+fn switch_init_adapter_to_euler(dir: &Path) {
+    let p = dir.join("adapter.py");
+    let text = std::fs::read_to_string(&p).unwrap();
+    let heun = "        b = self.rates(self.theta + dt * a[0], self.omega + dt * a[1], push)
+        self.theta += 0.5 * dt * (a[0] + b[0])
+        self.omega += 0.5 * dt * (a[1] + b[1])
+        self.x += 0.5 * dt * (a[2] + b[2])
+        self.y += 0.5 * dt * (a[3] + b[3])";
+    let euler = "        self.theta += dt * a[0]
+        self.omega += dt * a[1]
+        self.x += dt * a[2]
+        self.y += dt * a[3]";
+    assert!(
+        text.contains(heun),
+        "the init adapter's step changed: {text}"
+    );
+    std::fs::write(&p, text.replace(heun, euler)).unwrap();
+}
+
+/// The order the row reports as observed (`order P observed`).
+fn observed_order(text: &str) -> f64 {
+    let at = text.find(" observed, ").unwrap_or_else(|| panic!("{text}"));
+    let head = &text[..at];
+    let start = head.rfind("order ").unwrap() + "order ".len();
+    head[start..]
+        .parse()
+        .unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+/// Issue 40, item 1: the order is measured on the trajectory, not trusted.
+/// Heun's method (the init adapter) is second order and shows it; explicit
+/// Euler (first order, a truncation error O(dt) per unit time) declared as
+/// order 2 fails the gate on the init scenario, naming both orders, where
+/// the ladder's Richardson estimate (divided by 2^2 − 1 = 3 instead of 1)
+/// would otherwise back a tolerance three times too tight for its error and
+/// let it pass. Declared honestly, the order no longer fails it.
+#[test]
+fn a_first_order_step_declaring_order_2_fails_naming_both_orders() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tmp, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let d = dir.path();
+    let run = |args: &[&str]| run_with(d, tmp.path(), cache.path(), args);
+    let (code, text) = run(&["init"]);
+    assert_eq!(code, Some(0), "{text}");
+    let (code, text) = run(&[]);
+    assert_eq!(code, Some(0), "{text}");
+    let heun = observed_order(&text);
+    assert!((1.8..=2.2).contains(&heun), "Heun: {heun}: {text}");
+
+    switch_init_adapter_to_euler(d);
+    let (code, text) = run(&[]);
+    assert_eq!(code, Some(1), "{text}");
+    let fail = text
+        .lines()
+        .find(|l| l.starts_with("FAIL my-engine-square / my_engine"))
+        .unwrap_or_else(|| panic!("no FAIL line: {text}"));
+    assert!(fail.contains("declares order 2"), "{fail}");
+    let euler = observed_order(&text);
+    assert!((0.8..=1.2).contains(&euler), "Euler: {euler}: {text}");
+    assert!(fail.contains(&format!("shows order {euler:.2}")), "{fail}");
+
+    let toml = d.join("pushval.toml");
+    let decl = std::fs::read_to_string(&toml).unwrap();
+    assert!(decl.contains("\norder = 2\n"), "{decl}");
+    std::fs::write(&toml, decl.replace("\norder = 2\n", "\norder = 1\n")).unwrap();
+    let (_, text) = run(&[]);
+    assert!(!text.contains("declares order"), "{text}");
+    assert!(text.contains("1 declared"), "{text}");
+}
+
 /// An empty folder: the main job validates the shipped scenarios of the
 /// compiled-in engines and passes; those of pushval's own outside engines
 /// are skipped and named.
