@@ -123,6 +123,13 @@ fn private_dir(dir: &Path) -> anyhow::Result<()> {
 /// compared with the binary's text before it is trusted. Nothing goes to
 /// the system's shared temporary folder.
 pub fn materialized(folder: &str) -> anyhow::Result<PathBuf> {
+    // Callers fall back to a local folder on an error: say it here, once.
+    materialize(folder).inspect_err(|e| {
+        eprintln!("pushval: the shipped {folder} are not used: {e:#}");
+    })
+}
+
+fn materialize(folder: &str) -> anyhow::Result<PathBuf> {
     use std::hash::{Hash, Hasher};
     let rows = match folder {
         "scenarios" => SCENARIOS,

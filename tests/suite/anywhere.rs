@@ -104,10 +104,48 @@ fn a_first_order_step_declaring_order_2_fails_naming_both_orders() {
 /// An empty folder: the main job validates the shipped scenarios of the
 /// compiled-in engines and passes; those of pushval's own outside engines
 /// are skipped and named.
+///
+/// Issue 40, item 5: the shipped files it reads by path are written under
+/// `$XDG_CACHE_HOME/pushval/`, every level owner-only (0700), and nothing
+/// is left in `$TMPDIR`.
 #[test]
 fn main_job_in_an_empty_folder_runs_the_shipped_scenarios() {
+    use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().unwrap();
-    let out = pushval_in(dir.path()).output().unwrap();
+    let (tmp, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let out = pushval_in(dir.path())
+        .env("TMPDIR", tmp.path())
+        .env("XDG_CACHE_HOME", cache.path())
+        .output()
+        .unwrap();
+    assert_eq!(
+        std::fs::read_dir(tmp.path()).unwrap().count(),
+        0,
+        "pushval left files in TMPDIR"
+    );
+    // A study reads its shipped study files by path: from the cache.
+    let elsewhere = tempfile::tempdir().unwrap();
+    let study = pushval_in(dir.path())
+        .args(["study", "rapier2d_impulse_disk", "--quick", "--out"])
+        .arg(elsewhere.path())
+        .env("TMPDIR", tmp.path())
+        .env("XDG_CACHE_HOME", cache.path())
+        .output()
+        .unwrap();
+    assert_eq!(study.status.code(), Some(0), "{study:?}");
+    assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0);
+    let root = cache.path().join("pushval");
+    let mut levels = vec![root.clone()];
+    for e in std::fs::read_dir(&root).unwrap() {
+        let v = e.unwrap().path();
+        levels.push(v.join("studies"));
+        levels.push(v);
+    }
+    assert!(levels.len() >= 3, "{levels:?}");
+    for d in &levels {
+        let mode = std::fs::symlink_metadata(d).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o700, "{}", d.display());
+    }
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
@@ -121,6 +159,41 @@ fn main_job_in_an_empty_folder_runs_the_shipped_scenarios() {
     );
     // Nothing is written into the user's folder.
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// A cache folder another user could enter (mode 0777) or a symlink in its
+/// place is never used: the command says why on stderr, writes nothing
+/// there, and reads the study file from the binary instead.
+#[test]
+fn an_open_or_linked_cache_folder_is_refused() {
+    use std::os::unix::fs::PermissionsExt;
+    for kind in ["open", "symlink"] {
+        let dir = tempfile::tempdir().unwrap();
+        let (tmp, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let target = cache.path().join("elsewhere");
+        std::fs::create_dir(&target).unwrap();
+        let ours = cache.path().join("pushval");
+        match kind {
+            "open" => {
+                std::fs::create_dir(&ours).unwrap();
+                std::fs::set_permissions(&ours, std::fs::Permissions::from_mode(0o777)).unwrap();
+            }
+            _ => std::os::unix::fs::symlink(&target, &ours).unwrap(),
+        }
+        let (code, text) = run_with(
+            dir.path(),
+            tmp.path(),
+            cache.path(),
+            &["study", "rapier2d_impulse_disk", "--quick", "--out", "s"],
+        );
+        assert_eq!(code, Some(0), "{kind}: {text}");
+        assert!(
+            text.contains(&format!("{}:", ours.display())) && text.contains("not used"),
+            "{kind}: {text}"
+        );
+        assert_eq!(std::fs::read_dir(&target).unwrap().count(), 0, "{kind}");
+        assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0, "{kind}");
+    }
 }
 
 /// `pushval shipped` writes the embedded files out, byte for byte the
@@ -189,66 +262,148 @@ fn study_runs_in_an_empty_folder() {
     assert!(dir.path().join("s/map.csv").is_file());
 }
 
-/// `pushval init` in an empty folder, then the main job: the init adapter
-/// (Coulomb forces per support, in Python) passes its gate; its trajectory
-/// feeds `fit` and `track`, and `study` maps it. A second `init` refuses to
-/// overwrite, exit 2 naming the file.
+/// The `pushval` lines of README.md's user section, as a user copies them
+/// (comments dropped), split into arguments; `pushval init` left out.
+fn readme_user_lines() -> Vec<Vec<String>> {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let section = readme
+        .split("## Gate your own engine in five minutes")
+        .nth(1)
+        .expect("README.md has its user section");
+    let block = section
+        .split("```sh")
+        .nth(1)
+        .unwrap()
+        .split("```")
+        .next()
+        .unwrap();
+    block
+        .lines()
+        .map(|l| l.split('#').next().unwrap().trim())
+        .filter(|l| l.starts_with("pushval") && *l != "pushval init")
+        .map(|l| l.split_whitespace().skip(1).map(String::from).collect())
+        .collect()
+}
+
+/// `pushval init` in an empty folder, then every line of README.md's user
+/// section, verbatim (issue 40, item 2): each exits 0 and writes rows (the
+/// gate, the study's map and its Coulomb fit, run, fit, track and power's
+/// gate_power.csv with rows for the init engine); every fit verdict that is
+/// not a success has its reason; the kit is named as it is installed, never
+/// as a registry package. A second `init` refuses to overwrite, exit 2
+/// naming the file. Nothing is left in `$TMPDIR`.
 #[test]
-fn init_then_gate_study_fit_and_track_in_an_empty_folder() {
+fn init_then_every_readme_line_in_an_empty_folder() {
     let dir = tempfile::tempdir().unwrap();
+    let (tmp, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     let d = dir.path();
-    let run = |args: &[&str]| {
-        let out = pushval_in(d).args(args).output().unwrap();
-        let text = format!(
-            "{}\n{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
-        (out.status.code(), text)
-    };
+    let run = |args: &[&str]| run_with(d, tmp.path(), cache.path(), args);
     let (code, text) = run(&["init"]);
     assert_eq!(code, Some(0), "{text}");
     for f in ["pushval.toml", "adapter.py", "scenarios/my_engine.toml"] {
         assert!(d.join(f).is_file(), "{f}");
+        let body = std::fs::read_to_string(d.join(f)).unwrap();
+        assert!(!body.contains("pip install pushval"), "{f}: {body}");
     }
-    let (code, text) = run(&[]);
-    assert_eq!(code, Some(0), "{text}");
+    assert!(!text.contains("pip install pushval"), "{text}");
     assert!(
-        text.contains("my_engine") && text.contains("PASS"),
+        text.contains("pip install PATH/TO/pushval") || text.contains("as installed"),
         "{text}"
     );
+    let lines = readme_user_lines();
+    assert!(lines.len() >= 6, "{lines:?}");
+    let mut ran = Vec::new();
+    for args in &lines {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, text) = run(&args);
+        assert_eq!(code, Some(0), "pushval {}: {text}", args.join(" "));
+        ran.push(args.first().copied().unwrap_or("(gate)"));
+        if args.is_empty() {
+            assert!(
+                text.contains("my_engine") && text.contains("PASS"),
+                "{text}"
+            );
+        }
+    }
+    for cmd in ["(gate)", "study", "run", "fit", "track", "power"] {
+        assert!(ran.contains(&cmd), "the README runs no `{cmd}`: {lines:?}");
+    }
+    let rows = |f: &str| {
+        std::fs::read_to_string(d.join(f))
+            .unwrap_or_else(|e| panic!("{f}: {e}"))
+            .lines()
+            .count()
+            .saturating_sub(1)
+    };
+    for f in [
+        "run/trajectory.csv",
+        "track/track.csv",
+        "results/friction_models/my_engine/map.csv",
+        "results/friction_models/my_engine/coulomb_fit.csv",
+    ] {
+        assert!(rows(f) > 0, "{f}: no rows");
+    }
+    let power = std::fs::read_to_string(d.join("power/gate_power.csv")).unwrap();
+    assert!(
+        power
+            .lines()
+            .skip(1)
+            .any(|l| l.starts_with("my-engine-square,my_engine,")),
+        "{power}"
+    );
+    let fits = std::fs::read_to_string(d.join("results/friction_models/my_engine/coulomb_fit.csv"))
+        .unwrap();
+    let header: Vec<&str> = fits.lines().next().unwrap().split(',').collect();
+    let (iv, ir) = (
+        header.iter().position(|h| *h == "verdict").unwrap(),
+        header.iter().position(|h| *h == "reason").unwrap(),
+    );
+    for l in fits.lines().skip(1) {
+        let f: Vec<&str> = l.split(',').collect();
+        // The kit's Coulomb forces are Coulomb's law: the fit explains them.
+        assert_eq!(f[iv], "explained", "{l}");
+        if ["failed", "degenerate", "unidentifiable"].contains(&f[iv]) {
+            assert!(!f[ir].is_empty(), "{l}");
+        }
+    }
     let (code, text) = run(&["init"]);
     assert_eq!(code, Some(2), "{text}");
     assert!(text.contains("pushval.toml: already exists"), "{text}");
-    let (code, text) = run(&["run", "scenarios/my_engine.toml", "--out", "r"]);
-    assert_eq!(code, Some(0), "{text}");
-    let (code, text) = run(&[
-        "fit",
-        "scenarios/my_engine.toml",
-        "--trajectory",
-        "r/trajectory.csv",
-        "--model",
-        "my_engine",
-        "--params",
-        "mu_scale",
-        "--out",
-        "f",
-    ]);
-    assert_eq!(code, Some(0), "{text}");
-    let (code, text) = run(&[
-        "track",
-        "scenarios/my_engine.toml",
-        "--trajectory",
-        "r/trajectory.csv",
-        "--model",
-        "my_engine",
-        "--params",
-        "mu_scale",
-        "--out",
-        "k",
-    ]);
-    assert_eq!(code, Some(0), "{text}");
-    let (code, text) = run(&["study", "my_engine", "--quick", "--out", "s"]);
-    assert_eq!(code, Some(0), "{text}");
-    assert!(d.join("s/map.csv").is_file(), "{text}");
+    assert_eq!(
+        std::fs::read_dir(tmp.path()).unwrap().count(),
+        0,
+        "pushval left files in TMPDIR"
+    );
+}
+
+/// `power` in a folder whose scenarios gate nothing writes nothing and
+/// exits 1 saying why, never 0 with no rows.
+#[test]
+fn power_with_nothing_to_measure_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tmp, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let d = dir.path();
+    assert_eq!(run_with(d, tmp.path(), cache.path(), &["init"]).0, Some(0));
+    let sc = d.join("scenarios/my_engine.toml");
+    let text = std::fs::read_to_string(&sc).unwrap();
+    // No `gate` line: the default gate (rapier2d) only where `models` lists
+    // it, and it does not: my_engine is an informational row (an empty
+    // `gate` is refused at load).
+    let ungated: String = text
+        .lines()
+        .filter(|l| !l.starts_with("gate = "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_ne!(ungated, text);
+    std::fs::write(&sc, ungated).unwrap();
+    let (code, text) = run_with(
+        d,
+        tmp.path(),
+        cache.path(),
+        &["power", "--quick", "--out", "p"],
+    );
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("gates an engine"), "{text}");
+    assert!(!d.join("p/gate_power.csv").exists());
 }
