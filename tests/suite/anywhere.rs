@@ -407,3 +407,34 @@ fn power_with_nothing_to_measure_exits_1() {
     assert!(text.contains("gates an engine"), "{text}");
     assert!(!d.join("p/gate_power.csv").exists());
 }
+
+/// A study whose engine fails on every run (an adapter that exits with an
+/// error) is not a success: it exits non-zero naming the failure, and the
+/// Coulomb fit's row says at which stage it failed (issue 40, item 2).
+#[test]
+fn a_study_of_an_engine_that_always_fails_exits_non_zero_saying_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tmp, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let d = dir.path();
+    assert_eq!(run_with(d, tmp.path(), cache.path(), &["init"]).0, Some(0));
+    std::fs::write(
+        d.join("adapter.py"),
+        "import sys\nsys.exit('adapter.py: broken on purpose')\n",
+    )
+    .unwrap();
+    let (code, text) = run_with(
+        d,
+        tmp.path(),
+        cache.path(),
+        &["study", "my_engine", "--quick", "--out", "s"],
+    );
+    assert_ne!(code, Some(0), "{text}");
+    assert!(text.contains("engine run(s) failed"), "{text}");
+    assert!(text.contains("broken on purpose"), "{text}");
+    let fits = std::fs::read_to_string(d.join("s/coulomb_fit.csv")).unwrap();
+    let row = fits.lines().nth(1).unwrap();
+    assert!(
+        row.contains(",failed,the engine's run of the schedule failed"),
+        "{fits}"
+    );
+}
