@@ -539,11 +539,17 @@ pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {
         return Ok(std::process::ExitCode::from(1));
     }
     let start = Instant::now();
-    let rows = measure(
-        &scenarios,
-        &["box2d", "avian2d"],
-        if quick { 8 } else { 16 },
-    )?;
+    // The other Coulomb engines are compared on pushval's own scenarios; a
+    // project's scenarios measure the engines they gate, nothing else.
+    let (ours, theirs): (Vec<Scenario>, Vec<Scenario>) = scenarios.into_iter().partition(|s| {
+        s.path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| crate::shipped::scenario_text(n).is_some())
+    });
+    let iters = if quick { 8 } else { 16 };
+    let mut rows = measure(&ours, &["box2d", "avian2d"], iters)?;
+    rows.extend(measure(&theirs, &[], iters)?);
     if rows.is_empty() {
         eprintln!(
             "pushval power: no rows: every gate of {} refused its auto tolerances (the reasons are above); nothing written",

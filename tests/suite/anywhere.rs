@@ -438,3 +438,43 @@ fn a_study_of_an_engine_that_always_fails_exits_non_zero_saying_why() {
         "{fits}"
     );
 }
+
+/// `power` from any folder measures the gates of the project that
+/// `--engines FILE` names (its `scenarios/` beside the file): rows for the
+/// init engine, and none for engines the project does not gate.
+#[test]
+fn power_measures_the_project_named_by_engines() {
+    let (project, elsewhere) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let (tmp, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    assert_eq!(
+        run_with(project.path(), tmp.path(), cache.path(), &["init"]).0,
+        Some(0)
+    );
+    let file = project.path().join("pushval.toml");
+    let (code, text) = run_with(
+        elsewhere.path(),
+        tmp.path(),
+        cache.path(),
+        &[
+            "--engines",
+            file.to_str().unwrap(),
+            "power",
+            "--quick",
+            "--out",
+            "p",
+        ],
+    );
+    assert_eq!(code, Some(0), "{text}");
+    let csv = std::fs::read_to_string(elsewhere.path().join("p/gate_power.csv")).unwrap();
+    let engines: std::collections::BTreeSet<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap())
+        .collect();
+    assert_eq!(
+        engines.into_iter().collect::<Vec<_>>(),
+        ["my_engine"],
+        "{csv}"
+    );
+    assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0);
+}
