@@ -573,10 +573,13 @@ fn switching_hint(
 /// Runs every model the scenario asks for (the dynamic model always, as the
 /// reference) and compares each with the dynamic model. The engines named in
 /// `[run] gate` are gated by the scenario's `[tolerance]` at the time step
-/// [`choose_engine_dt`] picks, with the convergence check beside them; the
-/// other engines and the quasi-static models are informational; the dynamic
-/// row checks the integrated ω against the roots. The scenario must have
-/// passed [`crate::registry::check`].
+/// [`choose_engine_dt`] picks, with the convergence check beside them: the
+/// order observed on the trajectory over the ladder's runs
+/// ([`tolerance::check_order`]) fails a gate whose declared order is higher,
+/// and where none is observed the tolerances come from the estimate at the
+/// safer order 1; the other engines and the quasi-static models are
+/// informational; the dynamic row checks the integrated ω against the roots.
+/// The scenario must have passed [`crate::registry::check`].
 pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, ModelError> {
     let problem = sc.problem();
     let mut names: Vec<&str> = vec!["dynamic"];

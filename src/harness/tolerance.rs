@@ -2,7 +2,9 @@
 //! otherwise (`"auto"`, the default) derived from the gated engine's own
 //! accuracy: [`AUTO_FACTOR`] times its self-convergence estimate at the
 //! chosen time step (Richardson from the dt ladder), never below
-//! [`AUTO_TARGET`], plus the dynamic model's own error.
+//! [`AUTO_TARGET`], plus the dynamic model's own error; and the check of
+//! the engine's declared order against the one its trajectory shows
+//! ([`check_order`]), which decides the order that estimate is made at.
 
 use pushval_model::{DynamicModel, Integrator, Problem, Simulator, Trajectory};
 use pushval_scenario::{Limit, Scenario};
