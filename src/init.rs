@@ -76,11 +76,13 @@ pub fn cli(dir: &Path, force: bool) -> anyhow::Result<ExitCode> {
     }
     if vendored {
         println!(
-            "python3 cannot import pushval.adapter (pushval was not installed with pip), so the kit is written beside the adapter in pushval/"
+            "python3 cannot import pushval.adapter, so the kit is written beside the adapter in pushval/ (to install it instead: `python3 -m pip install PATH/TO/pushval`, pushval's source folder; no package registry has it)"
         );
+    } else {
+        println!("python3 imports pushval.adapter as installed; the kit is not copied");
     }
     println!(
-        "\nNext: `pushval` gates my_engine on scenarios/my_engine.toml; edit adapter.py's step() to call your simulator, then run it again.\n`pushval study my_engine --quick` maps its friction against Coulomb's law."
+        "\nNext: `pushval` gates my_engine on scenarios/my_engine.toml; edit adapter.py's step() to call your simulator, set `order` in pushval.toml to its step's order in dt, then run it again.\n`pushval study my_engine --quick` maps its friction against Coulomb's law."
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -204,12 +204,16 @@ enum Command {
         quick: bool,
     },
     /// Measure the gate's power: the smallest model error of each kind the
-    /// default gate (and `compare`) catches; write OUT/gate_power.{csv,svg}.
+    /// gate of every scenario in scenarios/ (and `compare`) catches, for the
+    /// engines those scenarios gate (a project's own, from the pushval.toml
+    /// found or named by --engines); write OUT/gate_power.{csv,svg}. Exit 1
+    /// when nothing could be measured.
     Power {
         /// Output folder (created if missing).
         #[arg(long, default_value = "results")]
         out: PathBuf,
-        /// Only the paper scenario at 1 m/s, coarser bisection (for tests).
+        /// One scenario (the paper's where scenarios/ has it, else the first
+        /// that gates an engine), coarser bisection.
         #[arg(long)]
         quick: bool,
         /// Draw OUT/gate_power.svg again from OUT/gate_power.csv (nothing

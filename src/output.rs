@@ -96,7 +96,7 @@ pub fn summary(report: &ScenarioReport) -> Value {
                 "diagnostics": run.map_or(Value::Null, |r| r.diagnostics.clone()),
                 "tolerance": c.tolerance.as_ref().map_or(Value::Null, |t| t.json()),
                 "loosened": c.pass.is_some() && !sc.tolerance.loosened().is_empty(),
-                "warnings": if c.pass.is_some() { gate_warnings(sc, &c.model) } else { Vec::new() },
+                "warnings": if c.pass.is_some() { gate_warnings(sc) } else { Vec::new() },
                 "convergence": c.convergence.as_ref().map_or(Value::Null, |v| json!({
                     "dts": v.dts,
                     "expected_order": v.expected_order,
@@ -155,9 +155,9 @@ pub fn summary(report: &ScenarioReport) -> Value {
 
 /// What a gated row must say about the gate itself: a loosened tolerance
 /// (a `[tolerance]` number above the default auto ceiling, with the file's
-/// reason or the lack of one), and a scenario that switches continuously
-/// while engines switch impulsively.
-pub fn gate_warnings(sc: &pushval_scenario::Scenario, model: &str) -> Vec<String> {
+/// reason or the lack of one). The continuous-switching hint is on a
+/// failing row whose engine switched impulsively only (the harness's).
+pub fn gate_warnings(sc: &pushval_scenario::Scenario) -> Vec<String> {
     let mut out = Vec::new();
     let loose = sc.tolerance.loosened();
     if !loose.is_empty() {
@@ -173,14 +173,6 @@ pub fn gate_warnings(sc: &pushval_scenario::Scenario, model: &str) -> Vec<String
                 .as_ref()
                 .map_or("no reason given".to_string(), |r| format!("reason: {r}"))
         ));
-    }
-    if sc.switching == pushval_model::Switching::Continuous
-        && !pushval_scenario::ANALYTIC_MODELS.contains(&model)
-    {
-        out.push(
-            "switching = \"continuous\": the model blends pushes over a switch, engines switch impulsively (differences at each switch are expected; use \"impulsive\" to gate an engine)"
-                .to_string(),
-        );
     }
     out
 }
@@ -269,6 +261,13 @@ pub fn table(reports: &[ScenarioReport]) -> String {
                         }
                     ));
                 }
+                if let Some(o) = &t.order {
+                    notes.push(match o.observed {
+                        Some(p) => format!("order {p:.2} observed, {} declared", o.declared),
+                        None => format!("order not observed, {} declared", o.declared),
+                    });
+                }
+                notes.extend(t.notes.iter().cloned());
                 if let Some(k) = &t.catches {
                     let f = |c: &Option<(f64, &str)>| {
                         c.map_or("-".to_string(), |(m, _)| format!("{m:.1e}"))
@@ -296,7 +295,7 @@ pub fn table(reports: &[ScenarioReport]) -> String {
                 notes.push(format!("assumptions fail: {}", flags.join(", ")));
             }
             if c.pass.is_some() {
-                notes.extend(gate_warnings(&r.scenario, &c.model));
+                notes.extend(gate_warnings(&r.scenario));
             }
             rows.push([
                 r.scenario.name.clone(),

@@ -498,10 +498,16 @@ fn key<DB: DrawingBackend>(
 /// before the first `_` or `[` (the engine: `rapier2d`, `jolt`, …), each
 /// family one colour of [`PALETTE`], its members told apart by
 /// [`Stroke::Solid`], [`Stroke::Dashed`], [`Stroke::Dotted`] and
-/// [`Stroke::Dots`] in turn (then the next palette colour).
+/// [`Stroke::Dots`] in turn (then the next palette colour). No two names
+/// share colour and stroke: past the palette's ten colours a family whose
+/// pair is taken takes its colour's next free stroke, else the next colour
+/// with one; [`GREY`] dashed stays free for reference lines (targets).
 pub fn family_styles(names: &[&str]) -> Vec<(RGBColor, Stroke)> {
     const STROKES: [Stroke; 4] = [Stroke::Solid, Stroke::Dashed, Stroke::Dotted, Stroke::Dots];
     let family = |n: &str| n.split(['_', '[']).next().unwrap_or(n).to_string();
+    let grey = PALETTE.iter().position(|c| *c == GREY);
+    // (colour index, stroke index) pairs taken, the reference line's first.
+    let mut used: Vec<(usize, usize)> = grey.map(|g| (g, 1)).into_iter().collect();
     let mut families: Vec<String> = Vec::new();
     let mut members: Vec<usize> = Vec::new();
     let mut colour_of: Vec<usize> = Vec::new();
@@ -523,10 +529,19 @@ pub fn family_styles(names: &[&str]) -> Vec<(RGBColor, Stroke)> {
                 colour_of[i] = next_colour;
                 next_colour += 1;
             }
-            (
-                PALETTE[colour_of[i] % PALETTE.len()],
-                STROKES[m % STROKES.len()],
-            )
+            let (c0, s0) = (colour_of[i] % PALETTE.len(), m % STROKES.len());
+            // The preferred pair, else the first free one after it.
+            let n_pairs = PALETTE.len() * STROKES.len();
+            let (c, s) = (0..n_pairs)
+                .map(|k| {
+                    let s = (s0 + k) % STROKES.len();
+                    let c = (c0 + (s0 + k) / STROKES.len()) % PALETTE.len();
+                    (c, s)
+                })
+                .find(|p| !used.contains(p))
+                .unwrap_or((c0, s0));
+            used.push((c, s));
+            (PALETTE[c], STROKES[s])
         })
         .collect()
 }
@@ -732,6 +747,53 @@ mod tests {
         assert_ne!(s[1].0, s[3].0);
         // Every (colour, stroke) pair is distinct.
         for i in 0..s.len() {
+            for j in 0..i {
+                assert!(s[i] != s[j], "{} and {} look the same", names[i], names[j]);
+            }
+        }
+    }
+
+    /// More families than the palette has colours (the cost chart's
+    /// engines, results/engine_work_precision.csv, in its order): the
+    /// palette wraps, yet no two series share colour and stroke (drake_lagged
+    /// drew as rapier2d did), and none is the target line's grey dashes.
+    #[test]
+    fn family_styles_never_repeat_a_pair_when_the_palette_wraps() {
+        let names = [
+            "rapier2d",
+            "rapier2d[body]",
+            "rapier2d_impulse_box",
+            "rapier2d_impulse_box[body]",
+            "rapier2d_impulse_disk",
+            "rapier2d_impulse_disk[body]",
+            "rapier2d_regularised_linear",
+            "rapier2d_regularised_linear[body]",
+            "rapier2d_regularised_tanh",
+            "rapier2d_regularised_tanh[body]",
+            "rapier3d",
+            "rapier3d_simplified",
+            "box2d",
+            "box2d_motor_joint",
+            "avian2d",
+            "avian3d",
+            "mujoco_elliptic",
+            "mujoco_pyramidal",
+            "physx_patch",
+            "physx_one_directional",
+            "physx_two_directional",
+            "jolt_box",
+            "jolt_feet",
+            "drake_lagged",
+            "drake_sap",
+            "drake_similar",
+            "drake_tamsi",
+            "pure_python",
+            "pybullet_forces",
+            "mujoco4_elliptic",
+        ];
+        let s = family_styles(&names);
+        for i in 0..s.len() {
+            assert!(s[i] != (GREY, Stroke::Dashed), "{}", names[i]);
             for j in 0..i {
                 assert!(s[i] != s[j], "{} and {} look the same", names[i], names[j]);
             }

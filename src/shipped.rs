@@ -6,7 +6,9 @@
 //! - scenarios: the project's `scenarios/` (beside the `pushval.toml` in use,
 //!   else `./scenarios`), else the shipped ones;
 //! - study files: `--studies DIR`, else `./studies`, else the shipped ones;
-//! - `pushval shipped --out DIR` writes them all out, to read or edit.
+//! - `pushval shipped --out DIR` writes them all out, to read or edit;
+//! - a command that needs them as files reads them from the user's cache
+//!   folder ([`materialized`]), never from the shared temporary folder.
 
 use std::path::{Path, PathBuf};
 
@@ -68,11 +70,66 @@ pub fn write_out(dir: &Path, force: bool) -> anyhow::Result<Vec<PathBuf>> {
     Ok(files.into_iter().map(|(p, _)| p).collect())
 }
 
+/// The user's cache folder for pushval: `$XDG_CACHE_HOME/pushval` (an
+/// absolute path only, as the XDG spec asks), else `$HOME/.cache/pushval`.
+pub fn cache_root() -> anyhow::Result<PathBuf> {
+    let xdg = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute());
+    let base = match xdg {
+        Some(p) => p,
+        None => std::env::var_os("HOME")
+            .map(PathBuf::from)
+            .filter(|p| p.is_absolute())
+            .map(|h| h.join(".cache"))
+            .context("no cache folder: neither XDG_CACHE_HOME nor HOME is an absolute path")?,
+    };
+    Ok(base.join("pushval"))
+}
+
+/// Creates `dir` owner-only (0700) if it is missing, then checks it as it
+/// is: a real folder (not a symlink), owned by this user, with no access
+/// for group or others. A folder someone else made or widened is refused,
+/// never used or repaired.
+fn private_dir(dir: &Path) -> anyhow::Result<()> {
+    use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};
+    match std::fs::DirBuilder::new().mode(0o700).create(dir) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+        Err(e) => return Err(e).with_context(|| format!("creating {}", dir.display())),
+    }
+    let m = std::fs::symlink_metadata(dir).with_context(|| format!("reading {}", dir.display()))?;
+    let uid = rustix::process::geteuid().as_raw();
+    if m.file_type().is_symlink() || !m.is_dir() {
+        anyhow::bail!("{}: not a folder (a symlink or a file); pushval keeps its shipped files only in a folder of its own", dir.display());
+    }
+    if m.uid() != uid {
+        anyhow::bail!("{}: owned by user {}, not by this user ({uid}); pushval will not read shipped files from it", dir.display(), m.uid());
+    }
+    let mode = m.permissions().mode() & 0o777;
+    if mode & 0o077 != 0 {
+        anyhow::bail!(
+            "{}: mode {mode:03o} lets others in; pushval needs it owner-only (chmod 700)",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
 /// A folder holding the shipped files of `folder` (`"scenarios"` or
 /// `"studies"`), for commands that read them by path: written once per
-/// content under the system's temporary folder
-/// (`pushval-VERSION-HASH/FOLDER`), each file atomically, and reused.
+/// content under the user's cache folder ([`cache_root`]`/VERSION-HASH/FOLDER`),
+/// every level owner-only and checked before use, each file atomically and
+/// compared with the binary's text before it is trusted. Nothing goes to
+/// the system's shared temporary folder.
 pub fn materialized(folder: &str) -> anyhow::Result<PathBuf> {
+    // Callers fall back to a local folder on an error: say it here, once.
+    materialize(folder).inspect_err(|e| {
+        eprintln!("pushval: the shipped {folder} are not used: {e:#}");
+    })
+}
+
+fn materialize(folder: &str) -> anyhow::Result<PathBuf> {
     use std::hash::{Hash, Hasher};
     let rows = match folder {
         "scenarios" => SCENARIOS,
@@ -82,17 +139,22 @@ pub fn materialized(folder: &str) -> anyhow::Result<PathBuf> {
     // A content hash in the name: a newer binary never reads older files.
     let mut h = std::collections::hash_map::DefaultHasher::new();
     rows.hash(&mut h);
-    let dir = std::env::temp_dir()
-        .join(format!(
-            "pushval-{}-{:016x}",
-            env!("CARGO_PKG_VERSION"),
-            h.finish()
-        ))
-        .join(folder);
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let root = cache_root()?;
+    if let Some(parent) = root.parent() {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("creating {}", parent.display()))?;
+    }
+    let version = root.join(format!("{}-{:016x}", env!("CARGO_PKG_VERSION"), h.finish()));
+    let dir = version.join(folder);
+    for d in [&root, &version, &dir] {
+        private_dir(d)?;
+    }
     for (name, text) in rows {
         let p = dir.join(name);
-        if std::fs::read_to_string(&p).ok().as_deref() != Some(*text) {
+        // A symlink is replaced, never followed: rename swaps the link itself.
+        let same = std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file())
+            && std::fs::read_to_string(&p).ok().as_deref() == Some(*text);
+        if !same {
             crate::atomic::write_atomic(&p, text.as_bytes())?;
         }
     }

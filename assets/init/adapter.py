@@ -18,7 +18,15 @@ The physics here (a small reference simulator):
 
     (I_P: inertia about the contact point; r: offsets from the centre of
     mass in the world frame; v_p: the pusher's velocity);
-  * a step is Heun's method (second order in dt: declare order = 2).
+  * a step is Heun's method, second order in dt: pushval.toml declares
+    `order = 2`.
+
+When you change the step, change `order` in pushval.toml with it: 1 for
+explicit or semi-implicit (symplectic) Euler and most game engines, 2 for
+Heun, midpoint or leapfrog. pushval measures the order on the trajectory at
+successive time steps and fails the gate, naming both orders, when the
+declared one is higher than what it measures (its error estimate would be
+too small).
 """
 
 import math
@@ -28,9 +36,12 @@ try:
     from pushval.adapter import Engine, Problem, Push, State, main
 except ImportError:
     sys.exit(
-        f"adapter.py: the Python package `pushval` is not installed for {sys.executable}; "
-        "install it (python3 -m pip install pushval) or name a Python that has it "
-        "in pushval.toml's command"
+        f"adapter.py: {sys.executable} cannot import the adapter kit pushval.adapter. "
+        "`pushval init` writes it beside this file (pushval/adapter.py) when python3 "
+        "lacks it: run `pushval init --force` again here, or install pushval's "
+        "source folder (the one with pyproject.toml) with "
+        "`python3 -m pip install PATH/TO/pushval`, or name a Python that has it in "
+        "pushval.toml's command (pushval is on no package registry)"
     )
 
 

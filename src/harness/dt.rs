@@ -346,8 +346,100 @@ pub fn choose_engine_dt(
     Err(last_err.expect("the ladder's floor either returns or fails"))
 }
 
+/// The order in dt observed on the trajectory itself: the largest
+/// centre-of-mass distance and the largest angle difference over the
+/// samples between runs at 4k and 2k (`d_coarse`) and at 2k and k
+/// (`d_fine`), `p = log2(d_coarse / d_fine)`, read at the finest triple of
+/// the ladder's runs whose `d_fine` is at least the ladder's target for
+/// that figure. Below the target the difference says nothing the verdict
+/// needs (the estimate is on its floor) and may be the engine's rounding.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TrajectoryOrder {
+    /// Position: the observed order and the steps (s) it was read at,
+    /// largest first; None where no triple resolves it.
+    pub position: Option<(f64, [f64; 3])>,
+    /// The same for the angle.
+    pub theta: Option<(f64, [f64; 3])>,
+}
+
+impl TrajectoryOrder {
+    /// The lower of the two figures' orders (the one whose error the
+    /// declared order would understate more); None when neither is resolved.
+    pub fn observed(&self) -> Option<f64> {
+        match (self.position, self.theta) {
+            (Some(a), Some(b)) => Some(a.0.min(b.0)),
+            (a, b) => a.or(b).map(|x| x.0),
+        }
+    }
+
+    /// Each resolved figure's order and the steps it was read at.
+    pub fn describe(&self) -> String {
+        let one = |name: &str, f: Option<(f64, [f64; 3])>| {
+            f.map(|(p, d)| {
+                format!(
+                    "{name} {p:.2} at dt {:.3e}, {:.3e}, {:.3e} s",
+                    d[0], d[1], d[2]
+                )
+            })
+        };
+        [one("position", self.position), one("theta", self.theta)]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// Largest centre-of-mass distance and angle difference between two runs
+/// at their common samples; None when their samples differ in number.
+fn max_differences(a: &Trajectory, b: &Trajectory) -> Option<[f64; 2]> {
+    if a.samples.len() != b.samples.len() {
+        return None;
+    }
+    let mut d = [0.0f64; 2];
+    for (s, r) in a.samples.iter().zip(&b.samples) {
+        d[0] = d[0].max(((s.x - r.x).powi(2) + (s.y - r.y).powi(2)).sqrt());
+        d[1] = d[1].max((s.theta - r.theta).abs());
+    }
+    d.iter().all(|x| x.is_finite()).then_some(d)
+}
+
+/// [`TrajectoryOrder`] from runs at any steps (`(dt, trajectory)`, in any
+/// order; the triples are those whose steps halve exactly), with floors
+/// `[m, rad]` on the finer difference.
+pub fn trajectory_order(runs: &[(f64, &Trajectory)], floor: [f64; 2]) -> TrajectoryOrder {
+    let mut runs: Vec<(f64, &Trajectory)> = runs.to_vec();
+    runs.sort_by(|a, b| b.0.total_cmp(&a.0));
+    runs.dedup_by(|a, b| a.0 == b.0);
+    let half = |a: f64, b: f64| (a - 2.0 * b).abs() <= 1e-9 * a;
+    let mut out = TrajectoryOrder::default();
+    // Coarse to fine: a finer resolved triple overwrites a coarser one.
+    for w in runs.windows(3) {
+        let [(h4, t4), (h2, t2), (h1, t1)] = [w[0], w[1], w[2]];
+        if !(half(h4, h2) && half(h2, h1)) {
+            continue;
+        }
+        let (Some(c), Some(f)) = (max_differences(t4, t2), max_differences(t2, t1)) else {
+            continue;
+        };
+        for k in 0..2 {
+            if f[k] >= floor[k] && c[k] > 0.0 {
+                let p = (c[k] / f[k]).log2();
+                let slot = if k == 0 {
+                    &mut out.position
+                } else {
+                    &mut out.theta
+                };
+                *slot = Some((p, [h4, h2, h1]));
+            }
+        }
+    }
+    out
+}
+
 /// Runs the engine at 2h and 4h beside the run at h and measures how its
-/// steady ω converges.
+/// steady ω converges, and how its trajectory does ([`trajectory_order`]
+/// over every run of the ladder and these).
 #[allow(clippy::too_many_arguments)]
 pub fn engine_convergence(
     sc: &Scenario,
@@ -370,9 +462,14 @@ pub fn engine_convergence(
     let mid = at(2.0 * h)?;
     let coarse = at(4.0 * h)?;
     let order = engine.order();
+    let mut ladder: Vec<(f64, &Trajectory)> = done.iter().map(|r| (r.dt, &r.trajectory)).collect();
+    ladder.extend([(h, fine), (2.0 * h, &mid), (4.0 * h, &coarse)]);
+    let t = ladder_targets(sc, DT_FRACTION);
+    let trajectory = trajectory_order(&ladder, [t.position_max, t.theta_max]);
     let mut out = Convergence {
         expected_order: order,
         dts: [4.0 * h, 2.0 * h, h],
+        trajectory,
         orders: Vec::new(),
         richardson1_rel_max: 0.0,
         richardson2_rel_max: 0.0,

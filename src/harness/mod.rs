@@ -16,8 +16,8 @@ mod dt;
 pub mod tolerance;
 
 pub use dt::{
-    choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, DtChoice, DtEstimate, DtSource,
-    DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
+    choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, trajectory_order, DtChoice,
+    DtEstimate, DtSource, TrajectoryOrder, DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
 };
 pub use tolerance::{Figures, Resolved};
 
@@ -141,7 +141,10 @@ pub struct Convergence {
     pub expected_order: f64,
     /// The three time steps (s), largest first.
     pub dts: [f64; 3],
-    /// Observed order per settled segment.
+    /// The order observed on the trajectory (positions and angle at the
+    /// samples, every run of the ladder): [`dt::trajectory_order`].
+    pub trajectory: TrajectoryOrder,
+    /// Observed order of the steady ω per settled segment.
     pub orders: Vec<(usize, f64)>,
     /// Largest relative error of the extrapolation at the expected order,
     /// against the dynamic model's tail-mean ω (within 1e-6 of ω*).
@@ -530,13 +533,53 @@ pub fn catchable(
     }
 }
 
+/// The hint a failing gated row of a `switching = "continuous"` scenario
+/// carries when the engine switched impulsively: its trajectory is nearer
+/// the model's impulsive switching than the continuous one the scenario
+/// asks for. None when the scenario switches impulsively, has no switch, or
+/// the engine follows the continuous rule (the adapter kit does).
+fn switching_hint(
+    sc: &Scenario,
+    problem: &Problem,
+    continuous: &Trajectory,
+    engine: &Trajectory,
+) -> Option<String> {
+    use pushval_model::Switching;
+    if problem.switching != Switching::Continuous
+        || !(problem.pushes.len() > 1 || sc.initial.from_rest)
+    {
+        return None;
+    }
+    let mut p = problem.clone();
+    p.switching = Switching::Impulsive;
+    let impulsive = DynamicModel::default().simulate(&p).ok()?;
+    let distance = |a: &Trajectory| {
+        let d = a
+            .samples
+            .iter()
+            .zip(&engine.samples)
+            .map(|(s, r)| (s.theta - r.theta).abs())
+            .fold(0.0, f64::max);
+        (a.samples.len() == engine.samples.len()).then_some(d)
+    };
+    let (di, dc) = (distance(&impulsive)?, distance(continuous)?);
+    (di < dc).then(|| {
+        format!(
+            "the engine switched impulsively (its angle is within {di:.2e} rad of the model's impulsive switching, {dc:.2e} rad of the continuous one): switching = \"continuous\" blends pushes over a switch; use \"impulsive\" to gate this engine"
+        )
+    })
+}
+
 /// Runs every model the scenario asks for (the dynamic model always, as the
 /// reference) and compares each with the dynamic model. The engines named in
 /// `[run] gate` are gated by the scenario's `[tolerance]` at the time step
-/// [`choose_engine_dt`] picks, with the convergence check beside them; the
-/// other engines and the quasi-static models are informational; the dynamic
-/// row checks the integrated ω against the roots. The scenario must have
-/// passed [`crate::registry::check`].
+/// [`choose_engine_dt`] picks, with the convergence check beside them: the
+/// order observed on the trajectory over the ladder's runs
+/// ([`tolerance::check_order`]) fails a gate whose declared order is higher,
+/// and where none is observed the tolerances come from the estimate at the
+/// safer order 1; the other engines and the quasi-static models are
+/// informational; the dynamic row checks the integrated ω against the roots.
+/// The scenario must have passed [`crate::registry::check`].
 pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, ModelError> {
     let problem = sc.problem();
     let mut names: Vec<&str> = vec!["dynamic"];
@@ -628,27 +671,10 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
     let reference = runs[0].trajectory.clone();
     let segments = analyse_segments(sc, &problem, &reference);
     let model_error = tolerance::model_error(&problem, &reference, opts.model_tol);
-    let resolved = |name: &str| {
-        gated_runs
-            .iter()
-            .find(|g| g.0.name() == name)
-            .map(|(_, choice, _)| {
-                let mut r = tolerance::resolve(sc, choice.rungs.last(), model_error);
-                r.dt = Some((choice.dt, choice.source, choice.met));
-                r
-            })
-    };
-    let mut comparisons: Vec<Comparison> = runs
-        .iter()
-        .map(|r| {
-            let tol = resolved(&r.name);
-            let mut c = compare(sc, &segments, &reference, r, tol.as_ref().map(|t| &t.value));
-            c.tolerance = tol;
-            c
-        })
-        .collect();
+    // Per gated engine: its convergence over the ladder, and the tolerances
+    // resolved from its estimate at the order the trajectory confirms.
+    let mut gates: Vec<(String, Convergence, Resolved)> = Vec::new();
     for (engine, choice, done) in &gated_runs {
-        let h = choice.dt;
         let run = runs
             .iter()
             .find(|r| r.name == engine.name())
@@ -660,24 +686,49 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             &segments,
             &run.trajectory,
             &reference,
-            h,
+            choice.dt,
             done,
         )?;
-        for c in comparisons.iter_mut().filter(|c| c.model == engine.name()) {
-            if let Some(res) = c.tolerance.as_mut() {
-                if let Some(p) = tolerance::order_problem(res, &conv) {
-                    res.problems.push(p);
-                }
-                res.catches = Some(catchable(sc, &segments, &reference, &res.value));
+        let order = tolerance::check_order(choice.order, &conv.trajectory);
+        let estimate = choice
+            .rungs
+            .last()
+            .map(|e| tolerance::reorder(e, choice.order, order.estimate_order));
+        let mut res = tolerance::resolve(sc, estimate.as_ref(), model_error);
+        res.dt = Some((choice.dt, choice.source, choice.met));
+        res.problems.extend(order.problem.clone());
+        if let Some(p) = tolerance::order_problem(&res, &conv) {
+            res.problems.push(p);
+        }
+        res.notes.extend(order.note.clone());
+        res.notes
+            .extend(tolerance::ladder_note(&res, choice.met, &choice.targets));
+        res.order = Some(order);
+        res.catches = Some(catchable(sc, &segments, &reference, &res.value));
+        gates.push((engine.name().to_string(), conv, res));
+    }
+    let mut comparisons: Vec<Comparison> = runs
+        .iter()
+        .map(|r| {
+            let gate = gates.iter().find(|g| g.0 == r.name);
+            let tol = gate.map(|g| &g.2.value);
+            let mut c = compare(sc, &segments, &reference, r, tol);
+            if let Some((_, conv, res)) = gate {
                 // A gate that cannot stand on its tolerances fails, saying why.
                 if !res.problems.is_empty() {
                     c.failed.extend(res.problems.iter().cloned());
                     c.pass = Some(false);
                 }
+                c.convergence = Some(conv.clone());
+                c.tolerance = Some(res.clone());
+                if c.pass == Some(false) {
+                    c.failed
+                        .extend(switching_hint(sc, &problem, &reference, &r.trajectory));
+                }
             }
-            c.convergence = Some(conv.clone());
-        }
-    }
+            c
+        })
+        .collect();
     for (name, e) in failures {
         // An engine that blows up fails the gate and says where; an
         // informational model's failure is reported without failing it.

@@ -2,7 +2,9 @@
 //! otherwise (`"auto"`, the default) derived from the gated engine's own
 //! accuracy: [`AUTO_FACTOR`] times its self-convergence estimate at the
 //! chosen time step (Richardson from the dt ladder), never below
-//! [`AUTO_TARGET`], plus the dynamic model's own error.
+//! [`AUTO_TARGET`], plus the dynamic model's own error; and the check of
+//! the engine's declared order against the one its trajectory shows
+//! ([`check_order`]), which decides the order that estimate is made at.
 
 use pushval_model::{DynamicModel, Integrator, Problem, Simulator, Trajectory};
 use pushval_scenario::{Limit, Scenario};
@@ -81,6 +83,13 @@ pub struct Resolved {
     /// The gated engine's time step (s), where it came from and whether the
     /// ladder's estimate met its targets there; None outside `validate`.
     pub dt: Option<(f64, super::DtSource, bool)>,
+    /// The order the engine declares, the order its trajectory shows over
+    /// the ladder (None: not observed) and the order the self-convergence
+    /// estimate used ([`check_order`]); None outside `validate`.
+    pub order: Option<OrderCheck>,
+    /// What the row must say without failing: the order not observed, the
+    /// ladder that missed its target and what that means for the verdict.
+    pub notes: Vec<String>,
 }
 
 impl Resolved {
@@ -112,6 +121,11 @@ impl Resolved {
             "dt": self.dt.map_or(serde_json::Value::Null, |d| num(d.0)),
             "dt_source": self.dt.map_or(serde_json::Value::Null, |d| d.1.as_str().into()),
             "ladder_met": self.dt.map(|d| d.2),
+            "declared_order": self.order.as_ref().map(|o| o.declared),
+            "observed_order": self.order.as_ref().and_then(|o| o.observed).map(num),
+            "observed_order_on": self.order.as_ref().map(|o| o.on.clone()),
+            "estimate_order": self.order.as_ref().map(|o| o.estimate_order),
+            "notes": self.notes,
         })
     }
 }
@@ -218,7 +232,109 @@ pub fn resolve(sc: &Scenario, estimate: Option<&DtEstimate>, model_error: Figure
         problems,
         catches: None,
         dt: None,
+        order: None,
+        notes: Vec::new(),
     }
+}
+
+/// The order the self-convergence estimate falls back on where the
+/// trajectory shows none: Richardson divides `|X(2h) − X(h)|` by `2^p − 1`,
+/// 1 at first order, the largest estimate any convergent scheme gets.
+pub const SAFE_ORDER: f64 = 1.0;
+
+/// The declared order against the one the ladder's runs show on the
+/// trajectory ([`super::TrajectoryOrder`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrderCheck {
+    /// What the engine declares (`order` in its table, or its registry row).
+    pub declared: f64,
+    /// The lower of position's and angle's observed orders; None when no
+    /// triple of runs resolves either (every difference below the targets).
+    pub observed: Option<f64>,
+    /// Which figures and steps gave it (empty when not observed).
+    pub on: String,
+    /// The order the estimate behind the step and the auto tolerances uses:
+    /// the declared one, or [`SAFE_ORDER`] when nothing is observed and the
+    /// declared order is higher.
+    pub estimate_order: f64,
+    /// Set when the observed order is below the declared one by more than
+    /// [`ORDER_BAND`]: the sentence that fails the row, naming both.
+    pub problem: Option<String>,
+    /// Set when no order is observed: the sentence the row carries.
+    pub note: Option<String>,
+}
+
+/// Checks the declared order against the trajectory's. Only an observed
+/// order below the declared one fails: the estimate then understates the
+/// engine's error by `(2^declared − 1) / (2^observed − 1)`; one above it
+/// only overstates the error, and the gate stays sound.
+pub fn check_order(declared: f64, observed: &super::TrajectoryOrder) -> OrderCheck {
+    let on = observed.describe();
+    match observed.observed() {
+        Some(p) if p < declared - ORDER_BAND => {
+            let understated = (2f64.powf(declared) - 1.0) / (2f64.powf(p.max(0.01)) - 1.0);
+            OrderCheck {
+                declared,
+                observed: Some(p),
+                problem: Some(format!(
+                    "the engine declares order {declared} in dt but its trajectory shows order {p:.2} ({on}), lower by more than {ORDER_BAND}: the self-convergence estimate behind its step and tolerances understates its error about {understated:.1}x; declare order = {} in its table (pushval.toml) or fix its step",
+                    p.round().max(1.0)
+                )),
+                on,
+                estimate_order: declared,
+                note: None,
+            }
+        }
+        Some(p) => OrderCheck {
+            declared,
+            observed: Some(p),
+            on,
+            estimate_order: declared,
+            problem: None,
+            note: None,
+        },
+        None => {
+            let estimate_order = declared.min(SAFE_ORDER);
+            OrderCheck {
+                declared,
+                observed: None,
+                on,
+                estimate_order,
+                problem: None,
+                note: Some(format!(
+                    "order not observed: the runs at successive steps differ by less than the ladder's targets, so the trajectory cannot confirm the declared order {declared}; the error estimate uses order {estimate_order}"
+                )),
+            }
+        }
+    }
+}
+
+/// The estimate `e` (made at order `from`) as order `to` would make it.
+pub fn reorder(e: &DtEstimate, from: f64, to: f64) -> DtEstimate {
+    let k = (2f64.powf(from) - 1.0) / (2f64.powf(to) - 1.0);
+    DtEstimate {
+        position_max: k * e.position_max,
+        theta_max: k * e.theta_max,
+        omega_steady_rel_max: e.omega_steady_rel_max.map(|w| k * w),
+        ..*e
+    }
+}
+
+/// What a ladder that missed its target means for the verdict: the
+/// engine's own error at the step it ran is above what the gate meant to
+/// allow, so the gate sees less than it should. None when it met it.
+pub fn ladder_note(res: &Resolved, met: bool, targets: &Figures) -> Option<String> {
+    if met {
+        return None;
+    }
+    let e = res.engine_estimate.as_ref()?;
+    let dt = res
+        .dt
+        .map_or(String::new(), |d| format!(" at dt {:.3e} s", d.0));
+    Some(format!(
+        "ladder missed its target: the engine's own error{dt} is estimated at {:.2e} m, {:.2e} rad (targets {:.2e} m, {:.2e} rad), so the comparison carries that error: a PASS bounds the model's error only to within it, and a FAIL by less than it may be the engine's own; a finer [engine] dt or a higher-order step removes the doubt",
+        e.position_max, e.theta_max, targets.position_max, targets.theta_max
+    ))
 }
 
 /// How far an engine's observed order in dt may stray from the order it

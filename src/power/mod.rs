@@ -1,6 +1,7 @@
 //! `pushval power`: the smallest model error the CI gate catches.
 //!
-//! For each shipped scenario that gates an engine, and each engine variant
+//! For each scenario that gates an engine (the project's `scenarios/`, else
+//! the shipped ones; `--engines FILE` names the project), and each engine variant
 //! (the scenario's gate as shipped, rapier2d in its body-velocity mode, and
 //! every other Coulomb engine in the registry that this build has), the gate
 //! is run once: the engine at the time step and with the tolerances
@@ -516,19 +517,46 @@ pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .collect();
     files.sort();
-    if quick {
-        files.retain(|f| f.ends_with("paper-square-v1.0.toml"));
-    }
-    let scenarios = files
+    let mut scenarios = files
         .iter()
         .map(crate::registry::load)
         .collect::<Result<Vec<_>, _>>()?;
+    scenarios.retain(|s| !s.gate.is_empty());
+    if quick {
+        // The paper scenario where the folder has it (the shipped ones),
+        // else the project's first gating scenario (an init project's one).
+        let paper = scenarios
+            .iter()
+            .position(|s| s.path.ends_with("paper-square-v1.0.toml"))
+            .unwrap_or(0);
+        scenarios = scenarios.into_iter().skip(paper).take(1).collect();
+    }
+    if scenarios.is_empty() {
+        eprintln!(
+            "pushval power: no scenario in {} gates an engine: nothing to measure, nothing written",
+            dir.display()
+        );
+        return Ok(std::process::ExitCode::from(1));
+    }
     let start = Instant::now();
-    let rows = measure(
-        &scenarios,
-        &["box2d", "avian2d"],
-        if quick { 8 } else { 16 },
-    )?;
+    // The other Coulomb engines are compared on pushval's own scenarios; a
+    // project's scenarios measure the engines they gate, nothing else.
+    let (ours, theirs): (Vec<Scenario>, Vec<Scenario>) = scenarios.into_iter().partition(|s| {
+        s.path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| crate::shipped::scenario_text(n).is_some())
+    });
+    let iters = if quick { 8 } else { 16 };
+    let mut rows = measure(&ours, &["box2d", "avian2d"], iters)?;
+    rows.extend(measure(&theirs, &[], iters)?);
+    if rows.is_empty() {
+        eprintln!(
+            "pushval power: no rows: every gate of {} refused its auto tolerances (the reasons are above); nothing written",
+            dir.display()
+        );
+        return Ok(std::process::ExitCode::from(1));
+    }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     crate::atomic::write_atomic(&out.join("gate_power.csv"), csv(&rows).as_bytes())?;
     crate::atomic::write_atomic(&out.join("gate_power.svg"), figure(&rows)?.as_bytes())?;

@@ -1,8 +1,11 @@
 //! `map.svg`: a model's (Fr, φ) map drawn from its `map.csv` text alone
 //! (so `pushval study index` redraws it without running the engine). Two
-//! panels: the engine's error against Coulomb and against its own law, one
-//! coloured cell per row, by decade of the error; cells where the law locks
-//! are outlined black, semi-stable ones purple.
+//! panels: the engine's error against Coulomb and against its own law with
+//! the problem's loads, and a third, against its law on the run's own loads
+//! (`omega_law_run`), wherever the engine measured its loads: an engine
+//! whose feet unload as it turns follows its law there and not with the
+//! problem's statics. One coloured cell per row, by decade of the error;
+//! cells where the law locks are outlined black, semi-stable ones purple.
 
 use plotters::style::RGBColor;
 
@@ -51,7 +54,8 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
     let phis = grid(rows.iter().map(|r| num(r, "phi")).collect());
     let (fe, pe) = (cell_edges(&frs, true), cell_edges(&phis, false));
     let at = |v: f64, g: &[f64], e: &[(f64, f64)]| g.iter().position(|&x| x == v).map(|i| e[i]);
-    let (mut coulomb, mut law, mut outlines) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut coulomb, mut law, mut law_run, mut outlines) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for r in &rows {
         let (Some(x), Some(y)) = (
             at(num(r, "froude"), &frs, &fe),
@@ -74,6 +78,11 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
         coulomb.push(cell(class(err(we, wc, wc, speed))));
         if wl.is_finite() {
             law.push(cell(class(err(we, wl, wc, speed))));
+        }
+        // Absent column or empty cell: no loads measured there.
+        let wr = num(r, "omega_law_run");
+        if wr.is_finite() {
+            law_run.push(cell(class(err(we, wr, wc, speed))));
         }
         let color = match r.get("class").map(String::as_str) {
             Some("locked") => Some(DARK),
@@ -103,12 +112,27 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
     let (x, y) = axes();
     let title = if law.is_empty() {
         format!("{model}: no law declared")
-    } else {
+    } else if law_run.is_empty() {
         format!("{model}: error against its law")
+    } else {
+        format!("{model}: against its law, problem's loads")
     };
     let mut right = heat_map(title, x, y, &law, &scale);
     left.outlines.clone_from(&outlines);
-    right.outlines = outlines;
+    right.outlines.clone_from(&outlines);
+    let mut panels = vec![left, right];
+    if !law_run.is_empty() {
+        let (x, y) = axes();
+        let mut run = heat_map(
+            format!("{model}: against its law, run's own loads"),
+            x,
+            y,
+            &law_run,
+            &scale,
+        );
+        run.outlines = outlines;
+        panels.push(run);
+    }
     let labels = [
         "< 1e-4",
         "1e-4 – 1e-3",
@@ -116,12 +140,23 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
         "1e-2 – 1e-1",
         "≥ 1e-1",
     ];
-    let notes = [
-        "relative steady-ω error".to_string(),
-        "|ω_engine − ω_ref| / |ω_ref|,".to_string(),
-        "ref: Coulomb (left), the".to_string(),
-        "engine's law (right)".to_string(),
-    ];
+    let notes = if panels.len() == 3 {
+        vec![
+            "relative steady-ω error".to_string(),
+            "|ω_engine − ω_ref| / |ω_ref|,".to_string(),
+            "ref: Coulomb (left), the".to_string(),
+            "engine's law on the problem's".to_string(),
+            "loads (middle), on the run's".to_string(),
+            "own loads (right)".to_string(),
+        ]
+    } else {
+        vec![
+            "relative steady-ω error".to_string(),
+            "|ω_engine − ω_ref| / |ω_ref|,".to_string(),
+            "ref: Coulomb (left), the".to_string(),
+            "engine's law (right)".to_string(),
+        ]
+    };
     let mut key = scale.key("error", &labels, &notes);
     key.entries.push(("undefined".to_string(), GREY));
     key.outlined = vec![
@@ -129,9 +164,9 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
         ("law semi-stable".to_string(), PURPLE),
     ];
     Ok(Figure {
-        size: (1500, 640),
-        cols: 2,
-        panels: vec![left, right],
+        size: (if panels.len() == 3 { 2150 } else { 1500 }, 640),
+        cols: panels.len(),
+        panels,
         key: Some(key),
     })
 }

@@ -3,7 +3,8 @@
 //! machinery ([`crate::fit`], Levenberg–Marquardt), and whether the fit
 //! explains the engine.
 //!
-//! Two schedules of the paper plate, read from the shipped scenarios:
+//! Two schedules of the paper plate, read from the shipped scenarios (the
+//! binary's, whatever folder the study runs in):
 //! `friction-engines.toml` (one push of 6 s at 0.5 m/s, φ = π/4 + 0.3) and
 //! `paper-square-v1.0.toml` (the paper's five 2 s segments at 1 m/s; not on
 //! the quick grid). `mu_scale` is always fitted; `center_of_friction` and
@@ -76,32 +77,104 @@ fn identified(sc: &pushval_scenario::Scenario, s: &Settings) -> anyhow::Result<V
     }
 }
 
+/// Where a fit task failed: its row holds NaN and, in its last value, the
+/// stage's code negated ([`failed_row`], [`failure_reason`]), so that the
+/// reason survives the numeric shard files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// The shipped schedule did not load.
+    Schedule = 1,
+    /// The engine's run of the schedule failed.
+    EngineRun = 2,
+    /// The engine's samples are not the schedule's.
+    Grid = 3,
+    /// The identifiability check or the Levenberg–Marquardt fit failed.
+    Fit = 4,
+}
+
+impl Stage {
+    const ALL: [Stage; 4] = [Stage::Schedule, Stage::EngineRun, Stage::Grid, Stage::Fit];
+
+    /// What failed, as the `reason` column says it.
+    pub fn reason(self) -> &'static str {
+        match self {
+            Stage::Schedule => "the shipped schedule did not load",
+            Stage::EngineRun => "the engine's run of the schedule failed",
+            Stage::Grid => "the engine's samples are not on the schedule's sample times",
+            Stage::Fit => "the fit itself failed (identifiability check or Levenberg-Marquardt)",
+        }
+    }
+}
+
+/// The row of a fit that failed at `stage`.
+pub fn failed_row(stage: Stage) -> Vec<f64> {
+    let mut row = vec![f64::NAN; WIDTH];
+    row[WIDTH - 1] = -(stage as i32 as f64);
+    row
+}
+
+/// Why a row is `failed` (None when it is not): its stage's reason, and
+/// where the error itself went.
+pub fn failure_reason(row: &[f64]) -> Option<String> {
+    if !row[0].is_nan() {
+        return None;
+    }
+    let code = -row[WIDTH - 1];
+    let stage = Stage::ALL.into_iter().find(|s| *s as i32 as f64 == code);
+    Some(match stage {
+        Some(s) => format!(
+            "{} (the error is on the study's standard error)",
+            s.reason()
+        ),
+        None => "the fit did not run (no stage recorded)".into(),
+    })
+}
+
 /// Fits schedule `k` to `engine` run at `study_dt / STEP_DIVISOR`: the row
-/// of [`COLUMNS`] (NaN where not fitted).
-pub fn fit_engine(engine: &dyn Engine, k: usize, study_dt: f64) -> anyhow::Result<Vec<f64>> {
+/// of [`COLUMNS`] (NaN where not fitted), or the stage that failed and why.
+pub fn fit_engine(
+    engine: &dyn Engine,
+    k: usize,
+    study_dt: f64,
+) -> Result<Vec<f64>, (Stage, anyhow::Error)> {
     let settings = Settings::default();
-    let sc = crate::registry::load(crate::registry::default_scenario_dir().join(SCHEDULES[k]))?;
+    let at = |stage: Stage| move |e: anyhow::Error| (stage, e);
+    // The shipped schedules, from the binary: a project's own scenarios/
+    // (an init project's) holds neither.
+    let sc = crate::shipped::scenario(SCHEDULES[k]).map_err(at(Stage::Schedule))?;
     let problem = sc.problem();
     let dt = study_dt / STEP_DIVISOR;
     let run = |h: f64| {
         engine
             .run(&problem, h)
             .map(|r| r.trajectory.samples)
-            .map_err(|e| anyhow::anyhow!("{} at dt = {h}: {e}", engine.name()))
+            .map_err(|e| {
+                (
+                    Stage::EngineRun,
+                    anyhow::anyhow!("{} at dt = {h}: {e}", engine.name()),
+                )
+            })
     };
     let (data, coarse) = (run(dt)?, run(2.0 * dt)?);
-    crate::fit::check_grid(&sc, &data).map_err(anyhow::Error::msg)?;
+    crate::fit::check_grid(&sc, &data).map_err(|e| (Stage::Grid, anyhow::Error::msg(e)))?;
     let k_rich = 1.0 / (2f64.powf(engine.order()) - 1.0);
     let engine_error = rms_difference(&coarse, &data).map(|d| k_rich * d);
-    let set = identified(&sc, &settings)?;
-    let model = Parametrised::new(&sc, &set).map_err(anyhow::Error::msg)?;
+    let fail = at(Stage::Fit);
+    let set = identified(&sc, &settings).map_err(fail)?;
+    let model = Parametrised::new(&sc, &set)
+        .map_err(anyhow::Error::msg)
+        .map_err(fail)?;
     let start = model.file_values();
     let problem0 = model
         .problem(&start)
-        .map_err(|e| anyhow::anyhow!("{}", e.0))?;
-    let reference = DynamicModel::default().simulate(&problem0)?;
+        .map_err(|e| (Stage::Fit, anyhow::anyhow!("{}", e.0)))?;
+    let reference = DynamicModel::default()
+        .simulate(&problem0)
+        .map_err(|e| (Stage::Fit, e.into()))?;
     let start_rms = rms_difference(&reference.samples, &data);
-    let f = fit(&model, &data, &start, &settings).map_err(anyhow::Error::msg)?;
+    let f = fit(&model, &data, &start, &settings)
+        .map_err(anyhow::Error::msg)
+        .map_err(fail)?;
     let get = |p: Param| {
         f.get(p)
             .unwrap_or((vec![f64::NAN; p.dim()], vec![f64::NAN; p.dim()]))

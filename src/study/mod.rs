@@ -180,6 +180,9 @@ pub fn class_name(code: f64) -> &'static str {
 /// A model's study: its setups, steps and task list.
 pub struct Plan {
     pub model: String,
+    /// Engine runs that failed in this process: how many, and the first
+    /// error (said on stderr at the end, never swallowed).
+    failures: std::sync::Mutex<(usize, Option<String>)>,
     pub spec: Spec,
     pub setups: Vec<Setup>,
     pub quick: bool,
@@ -321,6 +324,7 @@ impl Plan {
         }
         Ok(Self {
             model: model.to_string(),
+            failures: std::sync::Mutex::new((0, None)),
             ladder: spec.ladder(dt, quick),
             tail,
             sweeps,
@@ -415,8 +419,19 @@ impl Plan {
     /// [`fit::WIDTH`] (NaN where the engine or the fit fails).
     pub fn eval(&self, t: &Task) -> Vec<f64> {
         if let Task::Fit { k } = *t {
-            return fit::fit_engine(self.setups[0].engine.as_ref(), k, self.dt)
-                .unwrap_or_else(|_| vec![f64::NAN; fit::WIDTH]);
+            return fit::fit_engine(self.setups[0].engine.as_ref(), k, self.dt).unwrap_or_else(
+                |(stage, e)| {
+                    // The row keeps the stage (its reason column); the
+                    // error itself is said here.
+                    eprintln!(
+                        "study {}: coulomb fit of {}: {}: {e:#}",
+                        self.model,
+                        fit::SCHEDULES[k],
+                        stage.reason()
+                    );
+                    fit::failed_row(stage)
+                },
+            );
         }
         if let Task::Sweep { w, i, v } = *t {
             let sw = &self.sweeps[w];
@@ -430,12 +445,26 @@ impl Plan {
                     phi,
                 });
             }
-            return run_row(engine, &p, dt, sw.tail);
+            return run_row(engine, &p, dt, sw.tail, &self.failures);
         }
         let (speed, phi, dt, s) = self.push(t);
         let setup = &self.setups[s];
         let p = paper_plate(speed, phi, self.t_run, setup.supports_half);
-        run_row(setup.engine.as_ref(), &p, dt, self.tail)
+        run_row(setup.engine.as_ref(), &p, dt, self.tail, &self.failures)
+    }
+
+    /// The note on the engine runs that failed (their rows are blank), if
+    /// any: how many and the first error.
+    pub fn failure_note(&self) -> Option<String> {
+        let f = self.failures.lock().expect("not poisoned");
+        (f.0 > 0).then(|| {
+            format!(
+                "study {}: {} engine run(s) failed, their cells left blank; the first: {}",
+                self.model,
+                f.0,
+                f.1.as_deref().unwrap_or("-")
+            )
+        })
     }
 
     fn width(&self, t: &Task) -> usize {
@@ -448,8 +477,21 @@ impl Plan {
 
 /// A run's row ([`RUN_WIDTH`] values): the engine's tail-mean ω and loads,
 /// Coulomb's ω*, the law's ω, class and loads.
-fn run_row(engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
-    let run = engine.run(p, dt).ok();
+fn run_row(
+    engine: &dyn Engine,
+    p: &Problem,
+    dt: f64,
+    tail: f64,
+    failures: &std::sync::Mutex<(usize, Option<String>)>,
+) -> Vec<f64> {
+    let run = engine
+        .run(p, dt)
+        .inspect_err(|e| {
+            let mut f = failures.lock().expect("not poisoned");
+            f.0 += 1;
+            f.1.get_or_insert_with(|| format!("v_c {} m/s, dt {dt} s: {e}", p.pushes[0].speed));
+        })
+        .ok();
     // The last segment: the push, or the rest after a stop, where ω is the
     // mean |ω| over the tail (a signed mean hides a chattering stop).
     let seg = p.pushes.len() - 1;
@@ -697,6 +739,24 @@ pub fn run_model(model: &str, dir: &Path, opts: &Options) -> anyhow::Result<Summ
     };
     let mut w = Writer::new(dir)?;
     readme::write(&plan, &tasks, &rows, &mut w)?;
+    let notes: Vec<String> = plan.failure_note().into_iter().collect();
+    for n in &notes {
+        eprintln!("{n}");
+    }
+    // Every run failed: nothing was measured, whatever was written.
+    let runs = rows
+        .iter()
+        .zip(&tasks)
+        .filter(|(_, t)| !matches!(t, Task::Fit { .. }));
+    let measured = runs
+        .clone()
+        .any(|(r, _)| r.first().is_some_and(|w| !w.is_nan()));
+    if runs.count() > 0 && !measured {
+        bail!(
+            "study {model}: no engine run gave a steady omega; every cell is blank ({})",
+            notes.join("; ")
+        );
+    }
     Ok(Summary {
         files: w.into_written(),
         tasks: computed,

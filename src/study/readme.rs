@@ -285,12 +285,17 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             } else {
                 fit::verdict(r)
             };
+            let reason = match verdict {
+                "failed" => fit::failure_reason(r).unwrap_or_default(),
+                "degenerate" => fit::degenerate_reason(r),
+                _ => String::new(),
+            };
             let _ = writeln!(
                 fits,
                 "{},{},{fitted},{verdict},{}",
                 fit::SCHEDULES[k],
                 vals.join(","),
-                fit::degenerate_reason(r)
+                reason.replace(',', ";")
             );
         }
     }
@@ -589,7 +594,11 @@ fn readme(
             s.push_str(&line);
         }
         if name.is_empty() {
-            s.push_str("\nFigure: [`map.svg`](map.svg), drawn from `map.csv`: the error against Coulomb and against the law by decade; the law's locked cells outlined.\n");
+            s.push_str(if st[7] > 0 {
+                "\nFigure: [`map.svg`](map.svg), drawn from `map.csv`: the error against Coulomb, against the law with the problem's loads and against the law on the run's own loads, by decade; the law's locked cells outlined.\n"
+            } else {
+                "\nFigure: [`map.svg`](map.svg), drawn from `map.csv`: the error against Coulomb and against the law by decade; the law's locked cells outlined.\n"
+            });
         }
     };
     map_section("", "map.csv", map);
@@ -659,10 +668,10 @@ fn readme(
                 sig(num(&r, "mu_scale")),
                 sig(num(&r, "position_rms")),
                 sig(num(&r, "theta_rms")),
-                if r["verdict"] == "degenerate" {
-                    format!("degenerate: {}", r["reason"])
-                } else {
+                if r["reason"].is_empty() {
                     r["verdict"].to_string()
+                } else {
+                    format!("{}: {}", r["verdict"], r["reason"])
                 }
             );
         }

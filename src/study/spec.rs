@@ -111,11 +111,15 @@ impl Spec {
     /// file and the key.
     pub fn load(dir: &Path, model: &str) -> anyhow::Result<Self> {
         let path = dir.join(format!("{model}.toml"));
-        if !path.exists() {
+        let text = if path.exists() {
+            std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?
+        } else if let (false, Some(text)) = (dir.exists(), crate::shipped::study_text(model)) {
+            // No folder at all (the shipped files could not be written out):
+            // the binary's own file.
+            text.to_string()
+        } else {
             return Ok(Self::default());
-        }
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("reading {}", path.display()))?;
+        };
         let de = toml::Deserializer::parse(&text)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         let spec: Spec = serde_path_to_error::deserialize(de).map_err(|e| {

@@ -533,6 +533,53 @@ pub fn summary(
     (v, not_converged, degenerate)
 }
 
+/// The parameters `track` can estimate that the scenario's pushes do not
+/// identify to its convergence thresholds ([`REL_TOL`] of the value, or
+/// [`COF_TOL`] for the centre of friction), each with why: unidentifiable
+/// by `pushval fit`'s rules, or a Fisher std above the threshold (the
+/// Fisher information of the dynamic model at the file's values, at the
+/// noise levels given, [`crate::fit::fisher_at`]). One push through a fixed
+/// contact, for instance, leaves the centre of friction and I_cm trading
+/// off against each other.
+pub fn unidentifiable(
+    sc: &Scenario,
+    sigma_position: f64,
+    sigma_theta: f64,
+) -> Result<Vec<(Param, String)>, String> {
+    let all = [Param::MuScale, Param::CenterOfFriction, Param::InertiaCm];
+    let model = crate::fit::Parametrised::new(sc, &all)?;
+    let settings = crate::fit::Settings {
+        sigma_position,
+        sigma_theta,
+        ..Default::default()
+    };
+    let values = model.file_values();
+    let f = crate::fit::fisher_at(&model, &values, &settings)?;
+    let std = f.std();
+    let mut out: Vec<(Param, String)> = Vec::new();
+    for (j, (p, _)) in model.slots().into_iter().enumerate() {
+        if out.iter().any(|(q, _)| *q == p) {
+            continue;
+        }
+        let limit = match p {
+            Param::CenterOfFriction => COF_TOL,
+            _ => REL_TOL * values[j].abs(),
+        };
+        if f.unidentifiable[j] {
+            out.push((p, "unidentifiable (Fisher information)".into()));
+        } else if !(std[j] <= limit) {
+            out.push((
+                p,
+                format!(
+                    "Fisher std {:.1e} above the {limit:.1e} it must reach",
+                    std[j]
+                ),
+            ));
+        }
+    }
+    Ok(out)
+}
+
 /// `pushval track`: exit 0 converged, 1 not converged or the model does
 /// not explain the data, Err (exit 2) on bad input with nothing written.
 pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
@@ -589,7 +636,26 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
     if !out.omega_read {
         eprintln!("note: {src}: no `omega` column: the filter estimates omega from theta");
     }
-    let (json, not_converged, degenerate) = summary(&sc, &params, &req.settings, &out);
+    let (mut json, not_converged, degenerate) = summary(&sc, &params, &req.settings, &out);
+    // What the pushes cannot identify, asked for or not: said, never hidden.
+    let blind = unidentifiable(&sc, req.settings.sigma_position, req.settings.sigma_theta)
+        .unwrap_or_default();
+    json["unidentifiable"] = json!(blind
+        .iter()
+        .map(|(p, why)| json!({"parameter": p.name(), "why": why, "estimated": params.contains(p)}))
+        .collect::<Vec<_>>());
+    for (p, why) in &blind {
+        eprintln!(
+            "note: {}: its pushes do not identify {} ({why}){}",
+            sc.name,
+            p.name(),
+            if params.contains(p) {
+                ": its estimate cannot converge on this trajectory"
+            } else {
+                ": not estimated here (kept at the file's value)"
+            }
+        );
+    }
     std::fs::create_dir_all(&req.out).with_context(|| format!("creating {}", req.out.display()))?;
     let csv_path = req.out.join("track.csv");
     crate::atomic::write_atomic(&csv_path, &csv)?;
