@@ -4,23 +4,28 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use pushval_engine::{
-    trajectory_from_steps, ContactRecord, Engine, EngineCrate, EngineInfo, EngineOptions,
-    EngineRun, FrictionLaw, LoadRecorder, OptionKeys, StepRecord,
+    rigid_cm_velocity, run_via_session, trajectory_from_steps, with_pushes, ContactRecord, Engine,
+    EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession, EngineState, FrictionLaw,
+    LoadRecorder, OptionKeys, StepRecord,
 };
-use pushval_model::{ModelError, Problem};
+use pushval_model::{ModelError, Problem, Push};
 
+use crate::check::{self, Bound};
 use crate::config::Spec;
 use crate::csv;
 use crate::document::{problem_document, problem_document_v2};
-use crate::limits::Limits;
+use crate::limits::{Limits, HEADER_BYTES};
 use crate::process::{last_lines, run_process, ProcessError};
-use crate::session;
+use crate::session::{Close, Lease};
 
 /// How many lines of a failed process's standard error a message quotes.
 const STDERR_LINES: usize = 8;
 
 /// An outside engine with a scenario's `[engine]` options: one process per
-/// run (see the crate docs).
+/// run, or a session (see the crate docs). With protocol 3 it steps: its
+/// [`Engine::session`] keeps the adapter's world between pushes, and `run`
+/// is `start`, one `advance` per push, `finish`; with protocol 1 or 2,
+/// [`dyn Engine::start`] replays the schedule applied so far.
 #[derive(Clone)]
 pub struct OutsideEngine {
     spec: Arc<Spec>,
@@ -125,6 +130,9 @@ impl Engine for OutsideEngine {
         self.law.as_deref()
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        if self.steps() {
+            return run_via_session(self, problem, dt);
+        }
         let start = Instant::now();
         problem.check()?;
         let limits = Limits::for_problem(problem, dt);
@@ -133,24 +141,23 @@ impl Engine for OutsideEngine {
         } else {
             problem_document(&self.spec.name, problem, &self.options, dt)
         };
-        let mut input = serde_json::to_vec(&doc).expect("a JSON value serialises");
         let timeout = Duration::from_secs_f64(self.spec.timeout_s);
-        let broken = |e: ProcessError| {
-            ModelError::Adapter(format!(
-                "{}: {}; {}",
-                self.who(),
-                e.what,
-                last_lines(&e.stderr, STDERR_LINES)
-            ))
-        };
-        let input_bytes = input.len();
-        let (stdout, stderr, process_time, served_by) = if self.spec.session {
-            // One document per line (compact JSON holds no line break).
-            input.push(b'\n');
-            let a = session::answer(&self.spec, input, limits, timeout).map_err(broken)?;
-            let about = serde_json::json!({"pid": a.pid, "answered_before": a.answered_before});
-            (a.stdout, a.stderr, a.elapsed, Some(about))
+        let (stdout, stderr, process_time, input_bytes, served_by) = if self.spec.session {
+            let serde_json::Value::Object(doc) = doc else {
+                unreachable!("the document is an object")
+            };
+            let mut lease = Lease::take(&self.spec).map_err(|e| self.broken(e))?;
+            let a = lease
+                .request(doc, "problem", Close::End, limits, timeout)
+                .map_err(|e| self.broken(e))?;
+            let about = serde_json::json!({
+                "pid": a.pid,
+                "answered_before": a.answered_before,
+                "request": a.request,
+            });
+            (a.stdout, a.stderr, a.elapsed, None, Some(about))
         } else {
+            let input = serde_json::to_vec(&doc).expect("a JSON value serialises");
             let out = run_process(
                 &self.spec.program(),
                 &self.spec.command[1..],
@@ -159,9 +166,9 @@ impl Engine for OutsideEngine {
                 timeout,
                 limits,
             )
-            .map_err(broken)?;
+            .map_err(|e| self.broken(e))?;
             if !out.status.success() {
-                return Err(broken(ProcessError {
+                return Err(self.broken(ProcessError {
                     what: match out.status.code() {
                         Some(c) => format!("exited with status {c}"),
                         None => format!("was ended by a signal ({})", out.status),
@@ -169,41 +176,324 @@ impl Engine for OutsideEngine {
                     stderr: out.stderr,
                 }));
             }
-            (out.stdout, out.stderr, out.elapsed, None)
+            (out.stdout, out.stderr, out.elapsed, Some(input.len()), None)
         };
-        let fail = |what: String| {
-            ModelError::Adapter(format!(
-                "{}: {what}; {}",
-                self.who(),
-                last_lines(&stderr, STDERR_LINES)
-            ))
-        };
+        let fail = |what: String| self.fail(what, &stderr);
         let parse_start = Instant::now();
         let text = std::str::from_utf8(&stdout)
             .map_err(|e| fail(format!("wrote standard output that is not UTF-8 ({e})")))?;
         let rows = csv::read(text, problem.body.len())
             .map_err(|e| fail(format!("wrote a malformed row on its standard output: {e}")))?;
-        let history = history_from_rows(problem, &rows)
+        check::rows(&Bound::of(problem), None, &rows, |r| {
+            format!("line {}", r.line)
+        })
+        .map_err(|e| fail(format!("wrote a row that is not a motion of the push: {e}")))?;
+        let mut run = self
+            .assemble(problem, dt, &rows)
             .map_err(|e| fail(format!("wrote rows that do not cover the run: {e}")))?;
-        let trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
-        let contact = contact_from_rows(problem, &rows);
         let parse_time = parse_start.elapsed();
+        run.wall_time = start.elapsed();
+        run.diagnostics = serde_json::json!({
+            "rows": rows.len(),
+            "process_wall_time_s": process_time.as_secs_f64(),
+            "parse_resample_time_s": parse_time.as_secs_f64(),
+            "input_bytes": input_bytes,
+            "output_bytes": stdout.len(),
+            "protocol": self.spec.protocol,
+            "session": served_by,
+            "replays": false,
+        });
+        Ok(run)
+    }
+
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        if !self.steps() {
+            return None;
+        }
+        Some(Stepping::start(self, problem, dt).map(|s| Box::new(s) as Box<dyn EngineSession + 'a>))
+    }
+}
+
+impl OutsideEngine {
+    /// Whether the engine steps (protocol 3 in a session): its own
+    /// [`EngineSession`]; else [`dyn Engine::start`] replays.
+    fn steps(&self) -> bool {
+        self.spec.session && self.spec.protocol >= 3
+    }
+
+    /// A process failure as the run's error.
+    fn broken(&self, e: ProcessError) -> ModelError {
+        ModelError::Adapter(format!(
+            "{}: {}; {}",
+            self.who(),
+            e.what,
+            last_lines(&e.stderr, STDERR_LINES)
+        ))
+    }
+
+    /// Bad output as the run's error.
+    fn fail(&self, what: String, stderr: &[u8]) -> ModelError {
+        ModelError::Adapter(format!(
+            "{}: {what}; {}",
+            self.who(),
+            last_lines(stderr, STDERR_LINES)
+        ))
+    }
+
+    /// The run of checked `rows` (diagnostics and wall time left to the
+    /// caller).
+    fn assemble(
+        &self,
+        problem: &Problem,
+        dt: f64,
+        rows: &[csv::Record],
+    ) -> Result<EngineRun, String> {
+        let history = history_from_rows(problem, rows)?;
+        let trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
         Ok(EngineRun {
             trajectory,
             dt,
             steps: history.len() - 1,
-            wall_time: start.elapsed(),
-            diagnostics: serde_json::json!({
-                "rows": rows.len(),
-                "process_wall_time_s": process_time.as_secs_f64(),
-                "parse_resample_time_s": parse_time.as_secs_f64(),
-                "input_bytes": input_bytes,
-                "output_bytes": stdout.len(),
-                "protocol": self.spec.protocol,
-                "session": served_by,
-            }),
-            contact,
+            wall_time: Duration::ZERO,
+            diagnostics: serde_json::Value::Null,
+            contact: contact_from_rows(problem, rows),
         })
+    }
+}
+
+/// A protocol 3 session: the adapter keeps its world between pushes.
+struct Stepping<'a> {
+    engine: &'a OutsideEngine,
+    /// The problem at `start` (its schedule replaced by the pushes applied).
+    problem: Problem,
+    dt: f64,
+    lease: Lease,
+    applied: Vec<Push>,
+    /// The header line, once the first advance has given it.
+    header: Option<String>,
+    rows: Vec<csv::Record>,
+    state: EngineState,
+    started: Instant,
+    process_time: Duration,
+    parse_time: Duration,
+    output_bytes: usize,
+    /// The request number of each answer, for messages.
+    requests: Vec<u64>,
+    answered_before: u64,
+}
+
+impl<'a> Stepping<'a> {
+    fn start(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<Self, ModelError> {
+        let started = Instant::now();
+        let spec = &engine.spec;
+        let limits = Limits::for_problem(problem, dt);
+        let mut doc = problem_document_v2(&spec.name, problem, &engine.options, dt, limits);
+        let o = doc.as_object_mut().expect("the document is an object");
+        // The schedule is given push by push; the cap is per answer.
+        o.remove("pushes");
+        o.remove("limits");
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "start".into());
+        request.insert("rows".into(), spec.rows.as_str().into());
+        request.insert("problem".into(), doc);
+        let mut lease = Lease::take(spec).map_err(|e| engine.broken(e))?;
+        let timeout = Duration::from_secs_f64(spec.timeout_s);
+        let small = Limits {
+            max_rows: 0,
+            max_bytes: HEADER_BYTES,
+        };
+        let a = lease
+            .request(request, "start", Close::Ok, small, timeout)
+            .map_err(|e| engine.broken(e))?;
+        Ok(Self {
+            engine,
+            problem: with_pushes(problem, Vec::new()),
+            dt,
+            lease,
+            applied: Vec::new(),
+            header: None,
+            rows: Vec::new(),
+            state: EngineState::initial(problem),
+            started,
+            process_time: a.elapsed,
+            parse_time: Duration::ZERO,
+            output_bytes: 0,
+            requests: vec![a.request],
+            answered_before: a.answered_before,
+        })
+    }
+
+    /// The rows of one advance's answer (`text`: the header first in the
+    /// first answer), checked against the rows before.
+    fn read(&mut self, text: &str, request: u64, push: &Push) -> Result<(), String> {
+        let problem = with_pushes(&self.problem, self.applied.clone());
+        let first = self.header.is_none();
+        let (rows, offset) = if first {
+            let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+            self.header = Some(header.trim().to_string());
+            (csv::read(text, problem.body.len()), 0)
+        } else {
+            let full = format!("{}\n{text}", self.header.as_deref().unwrap_or(""));
+            (csv::read(&full, problem.body.len()), 1)
+        };
+        let where_ =
+            |line: usize| format!("line {} of its answer to request {request}", line - offset);
+        let mut rows = rows.map_err(|e| {
+            let at = if e.line > offset {
+                where_(e.line)
+            } else {
+                format!("request {request}")
+            };
+            format!("wrote a malformed row ({at}): {}", e.problem)
+        })?;
+        let (t0, t1) = *problem.segment_times().last().expect("a push applied");
+        let tol = 1e-9 * t1.max(1.0);
+        if rows.is_empty() {
+            return Err(format!(
+                "answered request {request} (advance {} s to {t1} s) with no row",
+                t0
+            ));
+        }
+        if first && rows[0].numbers[0].abs() > tol {
+            return Err(format!(
+                "{}: the first row is at t = {} s, not at 0 (the first advance's answer starts with the header and the row at t = 0)",
+                where_(rows[0].line),
+                rows[0].numbers[0]
+            ));
+        }
+        let last = rows.last().expect("not empty");
+        if (last.numbers[0] - t1).abs() > tol {
+            return Err(format!(
+                "{}: the answer to request {request} (advance {t0} s to {t1} s) ends at t = {} s, not at the push's end",
+                where_(last.line),
+                last.numbers[0]
+            ));
+        }
+        check::rows(&Bound::of(&problem), self.rows.last(), &rows, |r| {
+            where_(r.line)
+        })
+        .map_err(|e| format!("wrote a row that is not a motion of the push: {e}"))?;
+        for r in &mut rows {
+            // Lines counted over the whole session's answers, for the
+            // resampler's messages.
+            r.line -= offset;
+        }
+        let s = rows.last().expect("not empty").numbers;
+        self.state = EngineState {
+            t: s[0],
+            x: s[1],
+            y: s[2],
+            theta: s[3],
+            omega: s[4],
+            v_cm: rigid_cm_velocity(&problem, Some(push), s[3], s[4]),
+        };
+        self.rows.extend(rows);
+        Ok(())
+    }
+}
+
+impl EngineSession for Stepping<'_> {
+    fn state(&self) -> EngineState {
+        self.state
+    }
+
+    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        let engine = self.engine;
+        self.applied.push(*push);
+        let one = with_pushes(&self.problem, vec![*push]);
+        let limits = Limits::for_problem(&one, self.dt);
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "advance".into());
+        request.insert("speed".into(), push.speed.into());
+        request.insert("phi".into(), push.phi.into());
+        request.insert("duration".into(), push.duration.into());
+        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
+        let a = self
+            .lease
+            .request(request, "advance", Close::End, limits, timeout)
+            .map_err(|e| engine.broken(e))?;
+        self.process_time += a.elapsed;
+        self.output_bytes += a.stdout.len();
+        self.requests.push(a.request);
+        let parse = Instant::now();
+        let text = std::str::from_utf8(&a.stdout).map_err(|e| {
+            engine.fail(
+                format!(
+                    "wrote an answer to request {} that is not UTF-8 ({e})",
+                    a.request
+                ),
+                &a.stderr,
+            )
+        })?;
+        self.read(text, a.request, push)
+            .map_err(|e| engine.fail(e, &a.stderr))?;
+        self.parse_time += parse.elapsed();
+        Ok(())
+    }
+
+    fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {
+        let engine = self.engine;
+        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
+        let small = Limits {
+            max_rows: 0,
+            max_bytes: HEADER_BYTES,
+        };
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "finish".into());
+        let a = self
+            .lease
+            .request(request, "finish", Close::End, small, timeout)
+            .map_err(|e| engine.broken(e))?;
+        if !a.stdout.iter().all(u8::is_ascii_whitespace) {
+            return Err(engine.fail(
+                format!(
+                    "wrote {} bytes before `#end {}` in its answer to request {} (finish), which holds nothing but that line",
+                    a.stdout.len(),
+                    a.request,
+                    a.request
+                ),
+                &a.stderr,
+            ));
+        }
+        self.process_time += a.elapsed;
+        self.requests.push(a.request);
+        let problem = with_pushes(&self.problem, self.applied.clone());
+        problem.check()?;
+        let parse = Instant::now();
+        let mut run = engine
+            .assemble(&problem, self.dt, &self.rows)
+            .map_err(|e| {
+                engine.fail(
+                    format!("wrote rows that do not cover the run: {e}"),
+                    &a.stderr,
+                )
+            })?;
+        self.parse_time += parse.elapsed();
+        run.wall_time = self.started.elapsed();
+        run.diagnostics = serde_json::json!({
+            "rows": self.rows.len(),
+            "process_wall_time_s": self.process_time.as_secs_f64(),
+            "parse_resample_time_s": self.parse_time.as_secs_f64(),
+            "input_bytes": serde_json::Value::Null,
+            "output_bytes": self.output_bytes,
+            "protocol": engine.spec.protocol,
+            "rows_asked": engine.spec.rows.as_str(),
+            "session": {
+                "pid": self.lease.pid(),
+                "answered_before": self.answered_before,
+                "requests": self.requests,
+            },
+            "replays": false,
+        });
+        Ok(run)
+    }
+
+    fn steps_taken(&self) -> usize {
+        self.rows.len().saturating_sub(1)
     }
 }
 

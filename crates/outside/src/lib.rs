@@ -33,6 +33,7 @@
 //! a scenario file can name an outside engine but never define one.
 #![warn(missing_docs)]
 
+pub mod check;
 mod config;
 pub mod csv;
 mod document;
@@ -44,7 +45,8 @@ mod stream;
 mod tree;
 
 pub use config::{
-    Config, ConfigError, Spec, DEFAULT_DT, DEFAULT_ORDER, DEFAULT_PROTOCOL, DEFAULT_TIMEOUT_S,
+    Config, ConfigError, Rows, Spec, DEFAULT_DT, DEFAULT_ORDER, DEFAULT_PROTOCOL,
+    DEFAULT_SESSION_PROTOCOL, DEFAULT_TIMEOUT_S,
 };
 pub use document::{problem_document, problem_document_v2, FORMAT, FORMAT_V2};
 pub use engine::{history_from_rows, OutsideEngine};

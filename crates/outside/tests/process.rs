@@ -193,12 +193,22 @@ fn each_engine_receives_its_protocol_version() {
 fn protocol_and_session_keys_are_checked() {
     let file = Path::new("/proj/pushval.toml");
     for (extra, key, what) in [
-        ("protocol = 3\n", "engine.a.protocol", "must be 1"),
+        ("protocol = 4\n", "engine.a.protocol", "must be 1"),
+        (
+            "protocol = 3\n",
+            "engine.a.protocol",
+            "runs in a session: set session = true",
+        ),
         ("session = \"yes\"\n", "engine.a.session", "true or false"),
         (
             "session = true\nprotocol = 1\n",
             "engine.a.protocol",
-            "needs protocol 2",
+            "needs protocol 2 or 3",
+        ),
+        (
+            "session = true\nrows = \"all\"\n",
+            "engine.a.rows",
+            "\"samples\" or \"steps\"",
         ),
     ] {
         let e = Config::from_toml(&format!("[engine.a]\ncommand = [\"x\"]\n{extra}"), file)

@@ -40,7 +40,7 @@ fn fixture() -> String {
 fn spec(dir: &Path, name: &str, extra: &str) -> Arc<Spec> {
     let log = dir.join("pids").display().to_string();
     let text = format!(
-        "[engine.{name}]\ncommand = [\"python3\", {:?}, \"--pid-log\", {log:?}]\nsession = true\ntimeout_s = 20\n{extra}",
+        "[engine.{name}]\ncommand = [\"python3\", {:?}, \"--pid-log\", {log:?}]\nsession = true\nprotocol = 2\ntimeout_s = 20\n{extra}",
         fixture()
     );
     let cfg = Config::from_toml(&text, &dir.join("pushval.toml")).unwrap();
@@ -48,7 +48,7 @@ fn spec(dir: &Path, name: &str, extra: &str) -> Arc<Spec> {
     assert_eq!(
         (s.protocol, s.session),
         (2, true),
-        "session implies protocol 2"
+        "a whole-document session"
     );
     Arc::new(s)
 }
@@ -159,7 +159,8 @@ fn an_error_answer_fails_one_run_and_the_session_goes_on() {
     ok.run(&p, 1e-3).unwrap();
     let e = bad.run(&p, 1e-3).unwrap_err().to_string();
     assert!(
-        e.contains("outside engine \"refusing\"") && e.contains("`#error deliberate failure`"),
+        e.contains("outside engine \"refusing\"")
+            && e.contains("answered request 2 (problem) with `#error 2 deliberate failure`"),
         "{e}"
     );
     assert!(e.contains("problem 2 (error)"), "its standard error: {e}");
