@@ -124,6 +124,30 @@ fn a_timeout_ends_every_descendant_setsid_or_not() {
     }
 }
 
+/// The escape the process group, the mark and the parent links all miss
+/// (issue 40): a child that calls setsid() and execs with an empty
+/// environment, whose parent (a shell in the background) has exited, so
+/// it is re-parented to this process (a child subreaper). At the adapter's
+/// timeout it is ended too.
+#[test]
+fn a_timeout_ends_an_orphan_with_an_empty_environment() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("orphan");
+    let escape = "import os; os.setsid(); os.execve('/bin/sleep', ['sleep', '300'], {})";
+    let script = format!(
+        "(python3 -c \"{escape}\" </dev/null >/dev/null 2>&1 & echo $! > '{}'); sleep 1000",
+        f.display()
+    );
+    let (spec, p, options) = engine(dir.path(), &["sh", "-c", &script], "timeout_s = 2\n");
+    let e = OutsideEngine::new(spec, &options)
+        .run(&p, 1e-3)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("timeout of 2 s: killed"), "{e}");
+    let pid: u32 = std::fs::read_to_string(&f).unwrap().trim().parse().unwrap();
+    assert!(gone(pid), "the orphan {pid} survived the timeout");
+}
+
 /// An adapter that answers and exits 0 but leaves a daemon behind (double
 /// fork and setsid: re-parented away from the adapter): the daemon ends
 /// with the run.
