@@ -32,7 +32,11 @@
 //!
 //! * `engine_run_session_*`: pure_python.py as a session (`session = true`:
 //!   one process answering every run, started by a warm-up run outside the
-//!   timing), beside the one-process-per-run rows above.
+//!   timing), beside the one-process-per-run rows above: the default
+//!   (protocol 3, stepping, rows at the sample times: 1001 rows for the
+//!   10 001 steps), `engine_run_session_steps_*` (protocol 3, every step)
+//!   and `engine_run_session_p2_*` (protocol 2, whole documents, every
+//!   step).
 //!
 //! The protocol's overhead per run is `engine_run − adapter_stepping`; the
 //! rows `overhead_*` give it and `overhead_share_*` its share of the run.
@@ -86,10 +90,11 @@ fn spec(python: &str) -> Arc<Spec> {
 }
 
 /// pure_python.py as a session (`session = true`: one process answering
-/// every run, the kit's session mode).
-fn session_spec(python: &str) -> Arc<Spec> {
+/// every run, the kit's session mode), with `extra` keys (`protocol`,
+/// `rows`).
+fn session_spec(python: &str, extra: &str) -> Arc<Spec> {
     let text = format!(
-        "[engine.pure_python]\ncommand = [{python:?}, \"adapters/python/pure_python.py\"]\norder = 1\nsession = true\n"
+        "[engine.pure_python]\ncommand = [{python:?}, \"adapters/python/pure_python.py\"]\norder = 1\nsession = true\n{extra}"
     );
     let cfg = Config::from_toml(&text, &root().join("pushval.toml")).expect("a valid engines file");
     Arc::new(cfg.engines.into_iter().next().expect("one engine"))
@@ -103,17 +108,30 @@ fn resolved_python() -> String {
     String::from_utf8(o.stdout).unwrap().trim().to_string()
 }
 
-fn which(cmd: &str) -> String {
-    std::env::var_os("PATH")
-        .and_then(|paths| {
-            std::env::split_paths(&paths)
-                .map(|p| p.join(cmd))
-                .find(|p| p.is_file())
-        })
-        .map_or_else(
-            || format!("{cmd} (not on PATH)"),
-            |p| p.display().to_string(),
-        )
+/// What `python3` on PATH is, without the machine's paths: a pyenv shim
+/// (a bash script) or the interpreter itself.
+fn shim_or_not() -> &'static str {
+    let found = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|p| p.join("python3"))
+            .find(|p| p.is_file())
+    });
+    match found {
+        Some(p) if p.components().any(|c| c.as_os_str() == "shims") => {
+            "on this machine a pyenv shim, a bash script that runs `pyenv exec`"
+        }
+        Some(_) => "the interpreter itself",
+        None => "not on PATH",
+    }
+}
+
+/// How a row's label names the interpreter, without the machine's paths.
+fn interpreter(label: &str) -> &'static str {
+    if label == "resolved" {
+        "the resolved interpreter"
+    } else {
+        "python3 from PATH"
+    }
 }
 
 fn process(program: &str, args: &[&str], input: &[u8]) -> pushval_outside::ProcessOutput {
@@ -195,23 +213,20 @@ fn main() {
         &mut rows,
         "spawn_python3_on_path",
         time(runs, || process("python3", &echo, &input)),
-        format!(
-            "`python3` as pushval.toml names it, found at {}",
-            which("python3")
-        ),
+        format!("`python3` as pushval.toml names it ({})", shim_or_not()),
     );
     put(
         &mut rows,
         "spawn_resolved_interpreter",
         time(runs, || process(&py, &echo, &input)),
-        format!("{py} (what `python3` on PATH runs)"),
+        "the interpreter `python3` on PATH runs, named by its path".into(),
     );
     let echo_s = ["-S", "-c", "import sys; sys.stdin.buffer.read()"];
     put(
         &mut rows,
         "spawn_resolved_no_site",
         time(runs, || process(&py, &echo_s, &input)),
-        format!("{py} -S (no site import, no .pth files)"),
+        "the resolved interpreter with -S (no site import, no .pth files)".into(),
     );
     let venv = root().join(".venv-adapters/bin/python");
     if venv.exists() {
@@ -256,7 +271,7 @@ fn main() {
         &mut rows,
         "adapter_process_resolved",
         median(whole),
-        format!("{py} {adapter}: start to exit, document in, CSV out"),
+        format!("the resolved interpreter running {adapter}: start to exit, document in, CSV out"),
     );
     put(
         &mut rows,
@@ -280,27 +295,44 @@ fn main() {
         &mut rows,
         "engine_run_resolved",
         run_r,
-        format!("OutsideEngine::run (command {py})"),
+        "OutsideEngine::run (command: the resolved interpreter)".into(),
     );
     let mut session_rows = Vec::new();
-    for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
-        let session = OutsideEngine::new(session_spec(python), &options);
-        let warm = session.run(&problem, DT).unwrap();
-        assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
-        let r = time(runs, || session.run(&problem, DT).unwrap());
-        let last = session.run(&problem, DT).unwrap();
-        assert_eq!(
-            last.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
-            "one process served every run"
-        );
-        put(
-            &mut rows,
-            &format!("engine_run_session_{label}"),
-            r,
-            format!("OutsideEngine::run, pure_python.py as a session ({python}): one process for {} runs, started before the timing", runs + 2),
-        );
-        session_rows.push((format!("session_{label}"), r));
-        shutdown_sessions();
+    // The default session (protocol 3, rows at the sample times), then the
+    // same with every step, then protocol 2 (whole documents, every step).
+    let kinds = [
+        ("session", "", "protocol 3, rows at the sample times (the default)"),
+        ("session_steps", "rows = \"steps\"\n", "protocol 3, rows = \"steps\""),
+        ("session_p2", "protocol = 2\n", "protocol 2: whole documents, a row per step"),
+    ];
+    for (kind, extra, what) in kinds {
+        for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
+            if kind != "session" && label != "resolved" {
+                continue;
+            }
+            let session = OutsideEngine::new(session_spec(python, extra), &options);
+            let warm = session.run(&problem, DT).unwrap();
+            assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
+            let r = time(runs, || session.run(&problem, DT).unwrap());
+            let last = session.run(&problem, DT).unwrap();
+            assert_eq!(
+                last.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
+                "one process served every run"
+            );
+            put(
+                &mut rows,
+                &format!("engine_run_{kind}_{label}"),
+                r,
+                format!(
+                    "OutsideEngine::run, pure_python.py as a session, {what} ({}): one process for {} runs, started before the timing, {} rows a run",
+                    interpreter(label),
+                    runs + 2,
+                    last.diagnostics["rows"]
+                ),
+            );
+            session_rows.push((format!("{kind}_{label}"), r));
+            shutdown_sessions();
+        }
     }
     // The adapter's own input and output (imports, json.load, writing the
     // rows), by difference.

@@ -726,6 +726,8 @@ class Stepper:
             self.mode = "steps"
         row = (0.0, *_state(state, 0.0), *extras)
         self.last = row
+        if self.mode == "samples":
+            row += (0,)  # the steps column: none before t = 0
         return [row]
 
     def apply(
@@ -816,6 +818,7 @@ class Stepper:
         rows = []
         t_prev = t0 if prev[0] < t0 else prev[0]
         columns = self.columns
+        j_prev = 0
         for t in times:
             # The pose between the step ends around t (exact on a step end).
             u = (t - t0) / h
@@ -833,8 +836,9 @@ class Stepper:
             row = (t, *_state((x, y, th, w), t))
             if columns:
                 row += _extras(more[i - 1], columns, t)
-            rows.append(row)
-            t_prev = t
+            # The engine steps the row's interval took (pushval's count).
+            rows.append(row + (j - j_prev,))
+            t_prev, j_prev = t, j
         return rows
 
     def close(self) -> None:
@@ -845,8 +849,10 @@ class Stepper:
 
     @property
     def header(self) -> str:
-        """The CSV header of the rows."""
-        return ",".join((HEADER, *self.columns))
+        """The CSV header of the rows: `HEADER`, the engine's extra columns,
+        and with rows at the sample times ``steps`` (the engine steps each
+        row's interval took)."""
+        return ",".join((HEADER, *self.columns, *(("steps",) if self.mode == "samples" else ())))
 
 
 def simulate(

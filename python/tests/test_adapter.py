@@ -319,6 +319,12 @@ class ServeTest(unittest.TestCase):
         # The recorder's x is the time: interpolated, x is the row's time.
         for r in rows:
             self.assertAlmostEqual(r[1], r[0], places=12)
+        # The steps each interval took: 9 steps of 0.25/9 s hold 0.1 and 0.2
+        # after 4 and 8 steps (ceil(0.1 / 0.02778) = 4), then 1 to 0.25;
+        # 4 steps of 0.025 s reach 0.3 after 2 and 0.35 after 2 more.
+        self.assertEqual(got[1][0], "t,x,y,theta,omega,steps")
+        self.assertEqual([len(r) for r in rows], [6] * 6)
+        self.assertEqual([r[5] for r in rows], [0, 4, 4, 1, 2, 2])
 
     def test_limits_fall_back_to_sample_rows_then_fail(self):
         d = doc(format="pushval-problem/2", limits={"max_rows": 6})

@@ -2,10 +2,12 @@
 //! format ([`pushval_model::format`], which `compare`, `fit` and `track`
 //! read too): header with `t,x,y,theta` required, `omega` optional (derived
 //! from θ when absent), `model` optional (one model only), further columns
-//! ignored but two: `rise` (m, the centre of mass above its resting height)
-//! and `load_1`, …, `load_n` (N, each support's normal force), which an
-//! engine that measures them may add and pushval reads ([`Record::rise`],
-//! [`Record::loads`]). Errors name the line and the column.
+//! ignored but three: `rise` (m, the centre of mass above its resting
+//! height) and `load_1`, …, `load_n` (N, each support's normal force), which
+//! an engine that measures them may add and pushval reads ([`Record::rise`],
+//! [`Record::loads`]), and `steps` (the engine steps the row's interval
+//! took, where rows are not one per step: the kit writes it on rows at the
+//! sample times; [`Record::steps`]). Errors name the line and the column.
 
 use std::io::BufRead;
 
@@ -29,6 +31,10 @@ pub struct Record {
     /// The row's `load_1..load_n` (N), where the output has every one of
     /// the problem's supports.
     pub loads: Option<Vec<f64>>,
+    /// The engine steps between the row before and this one, where the
+    /// output has the column `steps` (rows at the sample times); without
+    /// it, a row is one step.
+    pub steps: Option<f64>,
 }
 
 /// Reads a whole output text (at most [`MAX_ROWS`] rows) of a problem with
@@ -46,6 +52,7 @@ pub fn read_from<R: BufRead>(
 ) -> Result<Vec<Record>, CsvError> {
     let names: Vec<String> = std::iter::once("rise".to_string())
         .chain((1..=supports).map(|i| format!("load_{i}")))
+        .chain(std::iter::once("steps".to_string()))
         .collect();
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
     let mut reader = Reader::new(input, "", max_rows).extra(&refs);
@@ -54,8 +61,13 @@ pub fn read_from<R: BufRead>(
     let mut samples = Vec::new();
     while let Some(row) = reader.next_row()? {
         samples.push(row.sample(f64::NAN));
-        let loads: Option<Vec<f64>> = row.extra[1..].iter().copied().collect();
-        rows.push((row.line, row.extra[0], loads.filter(|l| !l.is_empty())));
+        let loads: Option<Vec<f64>> = row.extra[1..=supports].iter().copied().collect();
+        rows.push((
+            row.line,
+            row.extra[0],
+            loads.filter(|l| !l.is_empty()),
+            row.extra[supports + 1],
+        ));
     }
     if !has_omega {
         derive_omega(&mut samples);
@@ -63,11 +75,12 @@ pub fn read_from<R: BufRead>(
     Ok(rows
         .into_iter()
         .zip(samples)
-        .map(|((line, rise, loads), s)| Record {
+        .map(|((line, rise, loads, steps), s)| Record {
             line,
             numbers: [s.t, s.x, s.y, s.theta, s.omega],
             rise,
             loads,
+            steps,
         })
         .collect())
 }

@@ -253,11 +253,14 @@ impl OutsideEngine {
         rows: &[csv::Record],
     ) -> Result<EngineRun, String> {
         let history = history_from_rows(problem, rows)?;
-        let trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
+        let mut trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
+        let steps = engine_steps(rows);
+        trajectory.stats.steps = steps;
+        trajectory.stats.rhs_evals = steps;
         Ok(EngineRun {
             trajectory,
             dt,
-            steps: history.len() - 1,
+            steps,
             wall_time: Duration::ZERO,
             diagnostics: serde_json::Value::Null,
             contact: contact_from_rows(problem, rows),
@@ -493,8 +496,17 @@ impl EngineSession for Stepping<'_> {
     }
 
     fn steps_taken(&self) -> usize {
-        self.rows.len().saturating_sub(1)
+        engine_steps(&self.rows)
     }
+}
+
+/// The engine steps `rows` took: their `steps` column where they have one
+/// (rows at the sample times), else one a row after the first.
+fn engine_steps(rows: &[csv::Record]) -> usize {
+    rows.iter()
+        .skip(1)
+        .map(|r| r.steps.map_or(1, |n| n.round().max(0.0) as usize))
+        .sum()
 }
 
 /// The contact record of an engine's rows where they carry `load_i`

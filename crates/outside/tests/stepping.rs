@@ -95,6 +95,9 @@ fn rows_at_the_sample_times_keep_the_poses() {
     assert_eq!(samples.diagnostics["rows_asked"], "samples");
     let rows = samples.diagnostics["rows"].as_u64().unwrap();
     assert_eq!(rows as usize, p.sample_times().len(), "one row per sample");
+    // The engine's steps, from the rows' `steps` column: 10 s at 1e-3 s.
+    assert_eq!((samples.steps, steps.steps), (10_000, 10_000));
+    assert_eq!(samples.trajectory.stats.rhs_evals, 10_000);
     for (a, b) in samples
         .trajectory
         .samples
