@@ -40,6 +40,10 @@
 //!
 //! The protocol's overhead per run is `engine_run − adapter_stepping`; the
 //! rows `overhead_*` give it and `overhead_share_*` its share of the run.
+//! For a one-shot run the stepping is `adapter_stepping` (a one-shot
+//! `--timing` run); for a session it is paired: each run's wall time
+//! against the adapter's own stepping in that same run
+//! (`adapter_stepping_session_*`).
 //! (`spawn_venv`: the virtual environment of `scripts/setup-adapters.sh`,
 //! when it exists.)
 
@@ -91,13 +95,28 @@ fn spec(python: &str) -> Arc<Spec> {
 
 /// pure_python.py as a session (`session = true`: one process answering
 /// every run, the kit's session mode), with `extra` keys (`protocol`,
-/// `rows`).
-fn session_spec(python: &str, extra: &str) -> Arc<Spec> {
+/// `rows`), run with `--timing` through `sh` so that the adapter's own
+/// stepping time of each run lands in `log` (one `step_time_s=` line a
+/// run).
+fn session_spec(python: &str, extra: &str, log: &Path) -> Arc<Spec> {
+    let script = format!(
+        "exec '{python}' adapters/python/pure_python.py --timing 2>>'{}'",
+        log.display()
+    );
     let text = format!(
-        "[engine.pure_python]\ncommand = [{python:?}, \"adapters/python/pure_python.py\"]\norder = 1\nsession = true\n{extra}"
+        "[engine.pure_python]\ncommand = [\"sh\", \"-c\", {script:?}]\norder = 1\nsession = true\n{extra}"
     );
     let cfg = Config::from_toml(&text, &root().join("pushval.toml")).expect("a valid engines file");
     Arc::new(cfg.engines.into_iter().next().expect("one engine"))
+}
+
+/// The stepping times (s) an adapter run with `--timing` logged, in order.
+fn step_times(log: &Path) -> Vec<f64> {
+    std::fs::read_to_string(log)
+        .unwrap_or_default()
+        .split_whitespace()
+        .filter_map(|w| w.strip_prefix("step_time_s=").and_then(|n| n.parse().ok()))
+        .collect()
 }
 
 fn resolved_python() -> String {
@@ -297,41 +316,75 @@ fn main() {
         run_r,
         "OutsideEngine::run (command: the resolved interpreter)".into(),
     );
-    let mut session_rows = Vec::new();
-    // The default session (protocol 3, rows at the sample times), then the
-    // same with every step, then protocol 2 (whole documents, every step).
+    // Sessions, measured in pairs: each run's wall time against the
+    // adapter's own stepping in that same run (warm, in the same process),
+    // so the protocol's share does not mix a cold one-shot stepping time
+    // with a warm session's run. The default session (protocol 3, rows at
+    // the sample times), the same with every step, then protocol 2 (whole
+    // documents, every step).
     let kinds = [
         ("session", "", "protocol 3, rows at the sample times (the default)"),
-        ("session_steps", "rows = \"steps\"\n", "protocol 3, rows = \"steps\""),
+        ("session_steps", "rows = \"steps\"\n", "protocol 3, rows = 'steps'"),
         ("session_p2", "protocol = 2\n", "protocol 2: whole documents, a row per step"),
     ];
+    let logs = tempfile::tempdir().expect("a temporary folder");
     for (kind, extra, what) in kinds {
         for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
             if kind != "session" && label != "resolved" {
                 continue;
             }
-            let session = OutsideEngine::new(session_spec(python, extra), &options);
+            let log = logs.path().join(format!("{kind}_{label}"));
+            let session = OutsideEngine::new(session_spec(python, extra, &log), &options);
             let warm = session.run(&problem, DT).unwrap();
             assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
-            let r = time(runs, || session.run(&problem, DT).unwrap());
+            let mut walls = Vec::with_capacity(runs);
+            for _ in 0..runs {
+                let s = Instant::now();
+                std::hint::black_box(session.run(&problem, DT).unwrap());
+                walls.push(s.elapsed().as_secs_f64());
+            }
             let last = session.run(&problem, DT).unwrap();
             assert_eq!(
                 last.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
                 "one process served every run"
             );
+            shutdown_sessions();
+            let steps = step_times(&log);
+            assert_eq!(steps.len(), runs + 2, "a stepping time per run: {steps:?}");
+            let steps = &steps[1..=runs];
+            let over: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| w - s).collect();
+            let share: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| (w - s) / w).collect();
+            let about = format!(
+                "pure_python.py as a session, {what}, {} ({} rows a run; {runs} runs on one process started before the timing)",
+                interpreter(label),
+                last.diagnostics["rows"]
+            );
             put(
                 &mut rows,
                 &format!("engine_run_{kind}_{label}"),
-                r,
-                format!(
-                    "OutsideEngine::run, pure_python.py as a session, {what} ({}): one process for {} runs, started before the timing, {} rows a run",
-                    interpreter(label),
-                    runs + 2,
-                    last.diagnostics["rows"]
-                ),
+                median(walls.clone()),
+                format!("OutsideEngine::run: {about}"),
             );
-            session_rows.push((format!("{kind}_{label}"), r));
-            shutdown_sessions();
+            put(
+                &mut rows,
+                &format!("adapter_stepping_{kind}_{label}"),
+                median(steps.to_vec()),
+                "the adapter's own stepping in those runs (--timing: reset and the step loop)".into(),
+            );
+            put(
+                &mut rows,
+                &format!("overhead_{kind}_{label}"),
+                median(over),
+                "engine_run − adapter_stepping, run by run: the protocol's cost per run".into(),
+            );
+            let (med, min) = median(share);
+            rows.push((
+                format!("overhead_share_{kind}_{label}"),
+                med,
+                min,
+                "fraction",
+                "overhead / engine_run, run by run (median, min)".into(),
+            ));
         }
     }
     // The adapter's own input and output (imports, json.load, writing the
@@ -352,11 +405,10 @@ fn main() {
         (proc_r.0 - spawn_r.0 - stepping.0, proc_r.1 - spawn_r.1 - stepping.1),
         "adapter_process_resolved − spawn_resolved_interpreter − adapter_stepping: the adapter's imports, json.load and CSV writing".into(),
     );
-    let mut overheads = vec![
+    let overheads = vec![
         ("python3_on_path".to_string(), run),
         ("resolved".to_string(), run_r),
     ];
-    overheads.extend(session_rows);
     for (label, r) in overheads {
         let over = r.0 - stepping.0;
         put(

@@ -31,18 +31,34 @@ row at t = 0 (the state `Engine.reset` returns) and one row per engine step:
 
 Two ways to serve, chosen by one rule pushval relies on:
 
-* **one-shot** (no ``--session`` argument): standard input holds one
-  document, then end of file. The kit writes the CSV and exits 0; a document
-  it cannot read exits 2, a failed run exits 1, both with the reason on
-  standard error and nothing on standard output.
+* **one-shot** (no ``--session`` argument, no ``PUSHVAL_SESSION=1``):
+  standard input holds one document, then end of file. The kit writes the
+  CSV and exits 0; a document it cannot read exits 2, a failed run exits 1,
+  both with the reason on standard error and nothing on standard output.
 * **session** (pushval starts the process with ``PUSHVAL_SESSION=1`` in its
-  environment when the engine's ``pushval.toml`` table says
-  ``session = true``; ``--session`` does the same by hand): standard
-  input holds one document per line. Each is answered with the header, the
-  rows and a line ``#end``, flushed. A document that cannot be read or a run
-  that fails is answered by one line ``#error MESSAGE`` instead (nothing
-  else), and the session goes on. End of file on standard input ends the
-  session (exit 0).
+  environment, and no argument, when the engine's ``pushval.toml`` table
+  says ``session = true``; ``--session`` does the same by hand): standard
+  input holds one JSON document per line, each with ``"request": N``, and
+  every answer closes with that number. A whole problem (protocol 2) is
+  answered with the header, the rows and ``#end N``. Protocol 3 steps:
+  ``{"op": "start", "problem": {...}, "rows": "samples"|"steps"}`` (the
+  version 2 problem without its ``pushes``) is answered ``#ok N``;
+  ``{"op": "advance", "speed": .., "phi": .., "duration": ..}`` by that
+  push's rows (the first advance starts with the header and the row at
+  t = 0) and ``#end N``; ``{"op": "finish"}`` by ``#end N``. A document
+  that cannot be read or a request that fails is answered by one line
+  ``#error N MESSAGE`` instead (nothing else), and the session goes on. End
+  of file on standard input ends the session (exit 0).
+
+Protocol 3 is served from the same `Engine.reset`, `Engine.switch` and
+`Engine.step` (`Stepper`): `reset` receives the problem with the first push
+as its schedule, each advance cuts its push into steps as a whole run does,
+so stepping push by push writes the rows a whole run writes. With
+``"rows": "samples"`` (pushval's default) and an engine without extra
+columns, an advance writes only the rows at the sample times and at its
+push's end, with a last column ``steps`` (the engine steps each row's
+interval took); ω on such a row is the one held over its interval, read at
+the interval's middle.
 
 The engine object lives for the whole process: `Engine.reset` is called once
 per problem (so a session reuses what ``__init__`` loaded), `Engine.close`
@@ -97,6 +113,7 @@ Standard library only; Python 3.9 or newer.
 from __future__ import annotations
 
 import argparse
+import array
 import bisect
 import dataclasses
 import itertools
@@ -121,6 +138,7 @@ __all__ = [
     "Push",
     "Run",
     "State",
+    "Stepper",
     "Support",
     "answer",
     "main",
@@ -833,7 +851,12 @@ class Stepper:
             # ω held over (t_prev, t], read at its middle.
             i = min(n, max(1, math.ceil(((t_prev + t) / 2 - t0) / h)))
             w = states[i - 1][3]
-            row = (t, *_state((x, y, th, w), t))
+            try:
+                row = (t, float(x), float(y), float(th), float(w))
+            except (TypeError, ValueError):
+                row = ()
+            if not row or not all(map(math.isfinite, row)):
+                row = (t, *_state((x, y, th, w), t))  # raises, naming the time
             if columns:
                 row += _extras(more[i - 1], columns, t)
             # The engine steps the row's interval took (pushval's count).
@@ -908,6 +931,17 @@ def _csv(rows: Iterable[tuple[float, ...]]) -> str:
     return "".join(",".join(map(repr, r)) + "\n" for r in rows)
 
 
+def _compact(rows: Sequence[tuple[float, ...]]) -> str:
+    """``rows`` as one compact line (protocol 3, where pushval's ``start``
+    says ``"compact": true``): ``!`` then the numbers, row after row, as
+    hexadecimal little-endian IEEE 754 binary64 (16 digits each); exact, and
+    far cheaper to write than decimal text."""
+    numbers = array.array("d", itertools.chain.from_iterable(rows))
+    if sys.byteorder != "little":
+        numbers.byteswap()
+    return "!" + numbers.tobytes().hex() + "\n"
+
+
 def answer(
     problem: Problem,
     run: Run,
@@ -969,6 +1003,7 @@ class _Server:
 
     def __init__(self, engine: Engine, out: IO[str], err: IO[str], timing: bool):
         self.engine = engine
+        self.compact = False
         self.out = out
         self.err = err
         self.timing = timing
@@ -1089,6 +1124,7 @@ class _Server:
                 raise ProblemError(f"`rows` is {rows!r}; known: steps, samples")
             problem = parse_problem(r.raw("problem"), schedule=False)
             self.stepper = Stepper(self.engine, problem, rows)
+            self.compact = r.has("compact") and r.boolean("compact")
             return f"#ok{tag}\n"
         if op not in ("advance", "finish"):
             raise ProblemError(f"`op` is {op!r}; known: start, advance, finish")
@@ -1108,7 +1144,8 @@ class _Server:
         if not stepper.header_sent:
             stepper.header_sent = True
             head = stepper.header + "\n"
-        return head + _csv(rows) + f"#end{tag}\n"
+        body = _compact(rows) if self.compact else _csv(rows)
+        return head + body + f"#end{tag}\n"
 
 def serve(
     engine: Engine,
@@ -1151,7 +1188,7 @@ def main(engine: Callable[[argparse.Namespace], Engine], argv: Sequence[str] | N
         "--session",
         action="store_true",
         help="serve one problem document per line until standard input closes "
-        "(answers framed by #end / #error)",
+        "(answers closed by #end N, #ok N or #error N MESSAGE; pushval sets PUSHVAL_SESSION=1 instead)",
     )
     parser.add_argument(
         "--timing",

@@ -326,6 +326,10 @@ class ServeTest(unittest.TestCase):
         self.assertEqual([len(r) for r in rows], [6] * 6)
         self.assertEqual([r[5] for r in rows], [0, 4, 4, 1, 2, 2])
 
+    def test_compact_rows_are_little_endian_binary64_in_hex(self):
+        # 1.5 is 0x3FF8000000000000: little-endian digits 000000000000f83f.
+        self.assertEqual(adapter._compact([(0.0, 1.5)]), "!" + "0" * 16 + "000000000000f83f\n")
+
     def test_limits_fall_back_to_sample_rows_then_fail(self):
         d = doc(format="pushval-problem/2", limits={"max_rows": 6})
         status, out, err = self.serve(Recorder(), json.dumps(d), session=False)

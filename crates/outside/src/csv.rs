@@ -84,3 +84,113 @@ pub fn read_from<R: BufRead>(
         })
         .collect())
 }
+
+/// The first character of a compact line (protocol 3): the rows that
+/// follow it as hexadecimal little-endian IEEE 754 binary64 numbers.
+pub const COMPACT: char = '!';
+
+/// Where the columns pushval reads sit in a header.
+#[derive(Debug, Clone)]
+pub struct Columns {
+    count: usize,
+    at: [usize; 5],
+    rise: Option<usize>,
+    loads: Option<Vec<usize>>,
+    steps: Option<usize>,
+}
+
+impl Columns {
+    /// The columns of `header` (comma-separated names) for a problem with
+    /// `supports` supports: `t,x,y,theta,omega` required (compact rows
+    /// carry ω), `rise`, every `load_i` and `steps` read where present.
+    pub fn of(header: &str, supports: usize) -> Result<Self, String> {
+        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        for (i, n) in names.iter().enumerate() {
+            if names[..i].contains(n) {
+                return Err(format!("the header names the column `{n}` twice"));
+            }
+        }
+        let find = |n: &str| names.iter().position(|c| *c == n);
+        let mut at = [0; 5];
+        for (slot, n) in at.iter_mut().zip(["t", "x", "y", "theta", "omega"]) {
+            *slot = find(n).ok_or_else(|| {
+                format!("the header lacks the column `{n}` (compact rows need t,x,y,theta,omega)")
+            })?;
+        }
+        let loads: Option<Vec<usize>> =
+            (1..=supports).map(|i| find(&format!("load_{i}"))).collect();
+        Ok(Self {
+            count: names.len(),
+            at,
+            rise: find("rise"),
+            loads: loads.filter(|l| !l.is_empty()),
+            steps: find("steps"),
+        })
+    }
+}
+
+/// Reads one compact line (after its [`COMPACT`] mark: hexadecimal digits,
+/// 16 per number, whole rows of `columns.count` numbers), numbering its
+/// rows' `line` as `line`. Every number must be finite.
+pub fn read_compact(hex: &str, columns: &Columns, line: usize) -> Result<Vec<Record>, String> {
+    let hex = hex.trim().as_bytes();
+    let width = 16 * columns.count;
+    if hex.len() % width != 0 {
+        return Err(format!(
+            "line {line}: a compact line of {} hexadecimal digits is not whole rows of {} numbers (16 digits each)",
+            hex.len(),
+            columns.count
+        ));
+    }
+    let digit = |b: u8| match b {
+        b'0'..=b'9' => Some(b - b'0'),
+        b'a'..=b'f' => Some(b - b'a' + 10),
+        b'A'..=b'F' => Some(b - b'A' + 10),
+        _ => None,
+    };
+    let mut values = Vec::with_capacity(hex.len() / 16);
+    for (k, chunk) in hex.chunks_exact(16).enumerate() {
+        let mut bytes = [0u8; 8];
+        for (i, b) in bytes.iter_mut().enumerate() {
+            let (hi, lo) = (digit(chunk[2 * i]), digit(chunk[2 * i + 1]));
+            *b = match (hi, lo) {
+                (Some(h), Some(l)) => h << 4 | l,
+                _ => {
+                    return Err(format!(
+                        "line {line}: number {} of the compact line is not hexadecimal",
+                        k + 1
+                    ))
+                }
+            };
+        }
+        values.push(f64::from_le_bytes(bytes));
+    }
+    let names = ["t", "x", "y", "theta", "omega"];
+    values
+        .chunks_exact(columns.count)
+        .enumerate()
+        .map(|(r, row)| {
+            if let Some(c) = row.iter().position(|v| !v.is_finite()) {
+                let name = columns.at.iter().position(|&a| a == c).map_or_else(
+                    || format!("column {}", c + 1),
+                    |i| format!("column `{}`", names[i]),
+                );
+                return Err(format!(
+                    "line {line}, row {} of the compact line: {name}: {} is not finite",
+                    r + 1,
+                    row[c]
+                ));
+            }
+            Ok(Record {
+                line,
+                numbers: columns.at.map(|i| row[i]),
+                rise: columns.rise.map(|i| row[i]),
+                loads: columns
+                    .loads
+                    .as_ref()
+                    .map(|l| l.iter().map(|&i| row[i]).collect()),
+                steps: columns.steps.map(|i| row[i]),
+            })
+        })
+        .collect()
+}

@@ -201,7 +201,6 @@ impl Engine for OutsideEngine {
             "output_bytes": stdout.len(),
             "protocol": self.spec.protocol,
             "session": served_by,
-            "replays": false,
         });
         Ok(run)
     }
@@ -287,6 +286,9 @@ struct Stepping<'a> {
     /// The request number of each answer, for messages.
     requests: Vec<u64>,
     answered_before: u64,
+    /// Set once a request failed: the adapter's world is no longer the
+    /// pushes applied, so the session takes no further request.
+    failed: bool,
 }
 
 impl<'a> Stepping<'a> {
@@ -302,6 +304,8 @@ impl<'a> Stepping<'a> {
         let mut request = serde_json::Map::new();
         request.insert("op".into(), "start".into());
         request.insert("rows".into(), spec.rows.as_str().into());
+        // pushval reads compact lines in answers (the kit writes them).
+        request.insert("compact".into(), true.into());
         request.insert("problem".into(), doc);
         let mut lease = Lease::take(spec).map_err(|e| engine.broken(e))?;
         let timeout = Duration::from_secs_f64(spec.timeout_s);
@@ -327,6 +331,7 @@ impl<'a> Stepping<'a> {
             output_bytes: 0,
             requests: vec![a.request],
             answered_before: a.answered_before,
+            failed: false,
         })
     }
 
@@ -335,6 +340,12 @@ impl<'a> Stepping<'a> {
     fn read(&mut self, text: &str, request: u64, push: &Push) -> Result<(), String> {
         let problem = with_pushes(&self.problem, self.applied.clone());
         let first = self.header.is_none();
+        if text
+            .lines()
+            .any(|l| l.trim_start().starts_with(csv::COMPACT))
+        {
+            return self.read_compact(text, request, push, problem);
+        }
         let (rows, offset) = if first {
             let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
             self.header = Some(header.trim().to_string());
@@ -353,6 +364,60 @@ impl<'a> Stepping<'a> {
             };
             format!("wrote a malformed row ({at}): {}", e.problem)
         })?;
+        for r in &mut rows {
+            // Lines counted in the answer.
+            r.line -= offset;
+        }
+        self.take(rows, first, request, push, problem)
+    }
+
+    /// An answer of compact lines (the header first, in the first answer).
+    fn read_compact(
+        &mut self,
+        text: &str,
+        request: u64,
+        push: &Push,
+        problem: Problem,
+    ) -> Result<(), String> {
+        let first = self.header.is_none();
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        if first {
+            let (_, header) = lines.next().unwrap_or((0, ""));
+            self.header = Some(header.trim().to_string());
+        }
+        let header = self.header.as_deref().unwrap_or("");
+        let columns = csv::Columns::of(header, problem.body.len()).map_err(|e| {
+            format!("wrote a header its compact rows cannot use (request {request}): {e}")
+        })?;
+        let mut rows = Vec::new();
+        for (i, l) in lines {
+            let Some(hex) = l.trim().strip_prefix(csv::COMPACT) else {
+                return Err(format!(
+                    "wrote a malformed row (line {} of its answer to request {request}): a text row among compact lines",
+                    i + 1
+                ));
+            };
+            rows.extend(csv::read_compact(hex, &columns, i + 1).map_err(|e| {
+                format!("wrote a malformed compact row (answer to request {request}): {e}")
+            })?);
+        }
+        self.take(rows, first, request, push, problem)
+    }
+
+    /// Checks an advance's rows against the push and the rows before, and
+    /// keeps them.
+    fn take(
+        &mut self,
+        rows: Vec<csv::Record>,
+        first: bool,
+        request: u64,
+        push: &Push,
+        problem: Problem,
+    ) -> Result<(), String> {
+        let where_ = |line: usize| format!("line {line} of its answer to request {request}");
         let (t0, t1) = *problem.segment_times().last().expect("a push applied");
         let tol = 1e-9 * t1.max(1.0);
         if rows.is_empty() {
@@ -380,11 +445,6 @@ impl<'a> Stepping<'a> {
             where_(r.line)
         })
         .map_err(|e| format!("wrote a row that is not a motion of the push: {e}"))?;
-        for r in &mut rows {
-            // Lines counted over the whole session's answers, for the
-            // resampler's messages.
-            r.line -= offset;
-        }
         let s = rows.last().expect("not empty").numbers;
         self.state = EngineState {
             t: s[0],
@@ -399,12 +459,27 @@ impl<'a> Stepping<'a> {
     }
 }
 
+impl Stepping<'_> {
+    /// An error once a request of this session has failed.
+    fn usable(&self) -> Result<(), ModelError> {
+        if self.failed {
+            return Err(ModelError::Adapter(format!(
+                "{}: an earlier request of this stepping session failed (its world is no longer the pushes applied): start a new session",
+                self.engine.who()
+            )));
+        }
+        Ok(())
+    }
+}
+
 impl EngineSession for Stepping<'_> {
     fn state(&self) -> EngineState {
         self.state
     }
 
     fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        self.usable()?;
+        self.failed = true;
         let engine = self.engine;
         self.applied.push(*push);
         let one = with_pushes(&self.problem, vec![*push]);
@@ -435,10 +510,12 @@ impl EngineSession for Stepping<'_> {
         self.read(text, a.request, push)
             .map_err(|e| engine.fail(e, &a.stderr))?;
         self.parse_time += parse.elapsed();
+        self.failed = false;
         Ok(())
     }
 
     fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {
+        self.usable()?;
         let engine = self.engine;
         let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
         let small = Limits {
