@@ -4,9 +4,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use pushval_engine::{
-    rigid_cm_velocity, run_via_session, trajectory_from_steps, with_pushes, ContactRecord, Engine,
-    EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession, EngineState, FrictionLaw,
-    LoadRecorder, OptionKeys, StepRecord,
+    rigid_cm_velocity, trajectory_from_steps, with_pushes, ContactRecord, Engine, EngineCrate,
+    EngineInfo, EngineOptions, EngineRun, EngineSession, EngineState, FrictionLaw, LoadRecorder,
+    OptionKeys, StepRecord,
 };
 use pushval_model::{ModelError, Problem, Push};
 
@@ -16,7 +16,7 @@ use crate::csv;
 use crate::document::{problem_document, problem_document_v2};
 use crate::limits::{Limits, HEADER_BYTES};
 use crate::process::{last_lines, run_process, ProcessError};
-use crate::session::{Close, Lease};
+use crate::session::{Answer, Close, Lease};
 
 /// How many lines of a failed process's standard error a message quotes.
 const STDERR_LINES: usize = 8;
@@ -131,7 +131,7 @@ impl Engine for OutsideEngine {
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         if self.steps() {
-            return run_via_session(self, problem, dt);
+            return Stepping::run(self, problem, dt);
         }
         let start = Instant::now();
         problem.check()?;
@@ -292,8 +292,18 @@ struct Stepping<'a> {
 }
 
 impl<'a> Stepping<'a> {
-    fn start(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<Self, ModelError> {
-        let started = Instant::now();
+    /// The cap of an answer that holds only its closing line.
+    const SMALL: Limits = Limits {
+        max_rows: 0,
+        max_bytes: HEADER_BYTES,
+    };
+
+    /// The `start` request of `problem` at `dt`.
+    fn start_doc(
+        engine: &OutsideEngine,
+        problem: &Problem,
+        dt: f64,
+    ) -> serde_json::Map<String, serde_json::Value> {
         let spec = &engine.spec;
         let limits = Limits::for_problem(problem, dt);
         let mut doc = problem_document_v2(&spec.name, problem, &engine.options, dt, limits);
@@ -307,16 +317,59 @@ impl<'a> Stepping<'a> {
         // pushval reads compact lines in answers (the kit writes them).
         request.insert("compact".into(), true.into());
         request.insert("problem".into(), doc);
-        let mut lease = Lease::take(spec).map_err(|e| engine.broken(e))?;
-        let timeout = Duration::from_secs_f64(spec.timeout_s);
-        let small = Limits {
-            max_rows: 0,
-            max_bytes: HEADER_BYTES,
-        };
+        request
+    }
+
+    /// The `advance` request of `push`, and the cap of its answer.
+    fn advance_doc(
+        problem: &Problem,
+        dt: f64,
+        push: &Push,
+    ) -> (serde_json::Map<String, serde_json::Value>, Limits) {
+        let one = with_pushes(problem, vec![*push]);
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "advance".into());
+        request.insert("speed".into(), push.speed.into());
+        request.insert("phi".into(), push.phi.into());
+        request.insert("duration".into(), push.duration.into());
+        (request, Limits::for_problem(&one, dt))
+    }
+
+    fn finish_doc() -> serde_json::Map<String, serde_json::Value> {
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "finish".into());
+        request
+    }
+
+    fn timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.engine.spec.timeout_s)
+    }
+
+    fn start(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<Self, ModelError> {
+        let started = Instant::now();
+        let mut lease = Lease::take(&engine.spec).map_err(|e| engine.broken(e))?;
+        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
         let a = lease
-            .request(request, "start", Close::Ok, small, timeout)
+            .request(
+                Self::start_doc(engine, problem, dt),
+                "start",
+                Close::Ok,
+                Self::SMALL,
+                timeout,
+            )
             .map_err(|e| engine.broken(e))?;
-        Ok(Self {
+        Ok(Self::new(engine, problem, dt, lease, &a, started))
+    }
+
+    fn new(
+        engine: &'a OutsideEngine,
+        problem: &Problem,
+        dt: f64,
+        lease: Lease,
+        started_by: &Answer,
+        started: Instant,
+    ) -> Self {
+        Self {
             engine,
             problem: with_pushes(problem, Vec::new()),
             dt,
@@ -326,13 +379,53 @@ impl<'a> Stepping<'a> {
             rows: Vec::new(),
             state: EngineState::initial(problem),
             started,
-            process_time: a.elapsed,
+            process_time: started_by.elapsed,
             parse_time: Duration::ZERO,
             output_bytes: 0,
-            requests: vec![a.request],
-            answered_before: a.answered_before,
+            requests: vec![started_by.request],
+            answered_before: started_by.answered_before,
             failed: false,
-        })
+        }
+    }
+
+    /// A whole run: start, an advance per push and finish, the documents
+    /// written at once and the answers read in order (no wait between
+    /// requests), each answer read as [`EngineSession::advance`] and
+    /// [`EngineSession::finish`] read it.
+    fn run(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        problem.check()?;
+        let started = Instant::now();
+        let mut lease = Lease::take(&engine.spec).map_err(|e| engine.broken(e))?;
+        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
+        let mut docs = vec![(
+            Self::start_doc(engine, problem, dt),
+            "start",
+            Close::Ok,
+            Self::SMALL,
+        )];
+        for push in &problem.pushes {
+            let (doc, limits) = Self::advance_doc(problem, dt, push);
+            docs.push((doc, "advance", Close::End, limits));
+        }
+        docs.push((Self::finish_doc(), "finish", Close::End, Self::SMALL));
+        let mut answers = lease.pipeline(docs, timeout).into_iter();
+        let mut next = |what: &str| {
+            answers.next().unwrap_or_else(|| {
+                Err(ProcessError {
+                    what: format!("no answer to the {what} request (the session ended earlier)"),
+                    stderr: Vec::new(),
+                })
+            })
+        };
+        let a = next("start").map_err(|e| engine.broken(e))?;
+        let mut s = Self::new(engine, problem, dt, lease, &a, started);
+        for push in &problem.pushes {
+            let a = next("advance").map_err(|e| engine.broken(e))?;
+            s.applied.push(*push);
+            s.absorb(a, push)?;
+        }
+        let a = next("finish").map_err(|e| engine.broken(e))?;
+        s.close(a)
     }
 
     /// The rows of one advance's answer (`text`: the header first in the
@@ -460,40 +553,10 @@ impl<'a> Stepping<'a> {
 }
 
 impl Stepping<'_> {
-    /// An error once a request of this session has failed.
-    fn usable(&self) -> Result<(), ModelError> {
-        if self.failed {
-            return Err(ModelError::Adapter(format!(
-                "{}: an earlier request of this stepping session failed (its world is no longer the pushes applied): start a new session",
-                self.engine.who()
-            )));
-        }
-        Ok(())
-    }
-}
-
-impl EngineSession for Stepping<'_> {
-    fn state(&self) -> EngineState {
-        self.state
-    }
-
-    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
-        self.usable()?;
-        self.failed = true;
+    /// Reads an advance's answer for `push` (already in `applied`).
+    fn absorb(&mut self, a: Answer, push: &Push) -> Result<(), ModelError> {
         let engine = self.engine;
-        self.applied.push(*push);
-        let one = with_pushes(&self.problem, vec![*push]);
-        let limits = Limits::for_problem(&one, self.dt);
-        let mut request = serde_json::Map::new();
-        request.insert("op".into(), "advance".into());
-        request.insert("speed".into(), push.speed.into());
-        request.insert("phi".into(), push.phi.into());
-        request.insert("duration".into(), push.duration.into());
-        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
-        let a = self
-            .lease
-            .request(request, "advance", Close::End, limits, timeout)
-            .map_err(|e| engine.broken(e))?;
+        self.failed = true;
         self.process_time += a.elapsed;
         self.output_bytes += a.stdout.len();
         self.requests.push(a.request);
@@ -514,20 +577,9 @@ impl EngineSession for Stepping<'_> {
         Ok(())
     }
 
-    fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {
-        self.usable()?;
+    /// Reads the finish's answer and returns the run.
+    fn close(mut self, a: Answer) -> Result<EngineRun, ModelError> {
         let engine = self.engine;
-        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
-        let small = Limits {
-            max_rows: 0,
-            max_bytes: HEADER_BYTES,
-        };
-        let mut request = serde_json::Map::new();
-        request.insert("op".into(), "finish".into());
-        let a = self
-            .lease
-            .request(request, "finish", Close::End, small, timeout)
-            .map_err(|e| engine.broken(e))?;
         if !a.stdout.iter().all(u8::is_ascii_whitespace) {
             return Err(engine.fail(
                 format!(
@@ -570,6 +622,54 @@ impl EngineSession for Stepping<'_> {
             "replays": false,
         });
         Ok(run)
+    }
+
+    /// An error once a request of this session has failed.
+    fn usable(&self) -> Result<(), ModelError> {
+        if self.failed {
+            return Err(ModelError::Adapter(format!(
+                "{}: an earlier request of this stepping session failed (its world is no longer the pushes applied): start a new session",
+                self.engine.who()
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl EngineSession for Stepping<'_> {
+    fn state(&self) -> EngineState {
+        self.state
+    }
+
+    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        self.usable()?;
+        self.failed = true;
+        let engine = self.engine;
+        let (doc, limits) = Self::advance_doc(&self.problem, self.dt, push);
+        let timeout = self.timeout();
+        let a = self
+            .lease
+            .request(doc, "advance", Close::End, limits, timeout)
+            .map_err(|e| engine.broken(e))?;
+        self.applied.push(*push);
+        self.absorb(a, push)
+    }
+
+    fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {
+        self.usable()?;
+        let engine = self.engine;
+        let timeout = self.timeout();
+        let a = self
+            .lease
+            .request(
+                Self::finish_doc(),
+                "finish",
+                Close::End,
+                Self::SMALL,
+                timeout,
+            )
+            .map_err(|e| engine.broken(e))?;
+        self.close(a)
     }
 
     fn steps_taken(&self) -> usize {

@@ -195,33 +195,32 @@ impl Session {
         !self.ended && !tree::has_exited(&mut self.child)
     }
 
-    /// Writes `doc` (a JSON object) with the next request number and reads
-    /// the answer up to its closing line, which must carry that number.
-    fn answer(
+    /// Writes `doc` (a JSON object) with the next request number; returns
+    /// the number and when it was written. With no answer outstanding,
+    /// whatever arrived since the last answer was closed is an error: it
+    /// answers no request.
+    fn send(
         &mut self,
         mut doc: serde_json::Map<String, serde_json::Value>,
         what: &str,
-        close: Close,
-        limits: Limits,
-        timeout: Duration,
-    ) -> Result<(u64, Vec<u8>), Fail> {
-        // Whatever arrived since the last answer was closed answers no
-        // request: a second answer, or output outside any answer.
-        while let Some(Piece::Bytes(b)) = self.out.next(Instant::now()) {
-            self.carry.extend_from_slice(&b);
+    ) -> Result<(u64, Instant), Fail> {
+        if self.answered == self.request {
+            while let Some(Piece::Bytes(b)) = self.out.next(Instant::now()) {
+                self.carry.extend_from_slice(&b);
+            }
+            if !self.carry.iter().all(u8::is_ascii_whitespace) {
+                let first = String::from_utf8_lossy(&self.carry);
+                let first = first.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+                return Err(Fail::Broken(format!(
+                    "wrote {} bytes after its answer to request {} was closed and before request {} was sent (a second answer, or output outside any answer), the first line `{}`",
+                    self.carry.len(),
+                    self.request,
+                    self.request + 1,
+                    clip(first)
+                )));
+            }
+            self.carry.clear();
         }
-        if !self.carry.iter().all(u8::is_ascii_whitespace) {
-            let first = String::from_utf8_lossy(&self.carry);
-            let first = first.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
-            return Err(Fail::Broken(format!(
-                "wrote {} bytes after its answer to request {} was closed and before request {} was sent (a second answer, or output outside any answer), the first line `{}`",
-                self.carry.len(),
-                self.request,
-                self.request + 1,
-                clip(first)
-            )));
-        }
-        self.carry.clear();
         let number = self.request + 1;
         self.request = number;
         doc.insert("request".into(), serde_json::Value::from(number));
@@ -229,15 +228,46 @@ impl Session {
         // One document per line (compact JSON holds no line break).
         line.push(b'\n');
         let written = Instant::now();
-        let deadline = written + timeout;
         let sent = self.input.as_ref().is_some_and(|tx| tx.send(line).is_ok());
         if !sent {
             return Err(Fail::Broken(format!(
                 "its standard input is closed (the session has ended) at request {number} ({what})"
             )));
         }
+        Ok((number, written))
+    }
+
+    /// Writes `doc` and reads its answer.
+    fn answer(
+        &mut self,
+        doc: serde_json::Map<String, serde_json::Value>,
+        what: &str,
+        close: Close,
+        limits: Limits,
+        timeout: Duration,
+    ) -> Result<(u64, Vec<u8>), Fail> {
+        let (number, written) = self.send(doc, what)?;
+        self.receive(number, written, what, close, limits, timeout)
+    }
+
+    /// Reads the answer to request `number` (written at `written`) up to
+    /// its closing line, which must carry that number, within `timeout` of
+    /// `written`.
+    fn receive(
+        &mut self,
+        number: u64,
+        written: Instant,
+        what: &str,
+        close: Close,
+        limits: Limits,
+        timeout: Duration,
+    ) -> Result<(u64, Vec<u8>), Fail> {
+        let deadline = written + timeout;
         let mut meter = Meter::new(limits);
-        let mut answer = Vec::new();
+        // Pipelined answers may arrive back to back: the bytes after the
+        // last closing line start this answer.
+        let mut answer = std::mem::take(&mut self.carry);
+        meter.add(&answer).map_err(Fail::Broken)?;
         let mut scanned = 0;
         let mut hinted = self.answered > 0;
         loop {
@@ -532,33 +562,104 @@ impl Lease {
                 ),
                 stderr: s.err.get(ERROR_TAIL_WAIT),
             }),
-            Err(fail @ (Fail::Broken(_) | Fail::TimedOut(_))) => {
-                let (text, timed_out) = match fail {
-                    Fail::TimedOut(t) => (t, true),
-                    Fail::Broken(t) | Fail::Refused(t) => (t, false),
-                };
-                let status = s.end();
-                let stderr = s.err.get(Duration::from_millis(200));
-                if let Some(s) = self.session.take() {
-                    release(s);
+            Err(fail) => Err(self.broken(fail, what)),
+        }
+    }
+}
+
+impl Lease {
+    /// Sends every document of `requests` at once, then reads their
+    /// answers in order (as [`Lease::request`] would one by one, without
+    /// waiting for each answer before the next document): one result per
+    /// request. An `#error` answer fails its request and the others are
+    /// still read; a broken session fails the rest. Each answer has
+    /// `timeout` from the moment its document was written.
+    pub(crate) fn pipeline(
+        &mut self,
+        requests: Vec<(
+            serde_json::Map<String, serde_json::Value>,
+            &str,
+            Close,
+            Limits,
+        )>,
+        timeout: Duration,
+    ) -> Vec<Result<Answer, ProcessError>> {
+        let mut sent = Vec::with_capacity(requests.len());
+        let mut results: Vec<Result<Answer, ProcessError>> = Vec::with_capacity(requests.len());
+        let Some(s) = self.session.as_mut() else {
+            return Vec::new();
+        };
+        let pid = s.child.id();
+        for (doc, what, close, limits) in requests {
+            match s.send(doc, what) {
+                Ok((number, written)) => sent.push((number, written, what, close, limits)),
+                Err(fail) => {
+                    results.push(Err(self.broken(fail, what)));
+                    return results;
                 }
-                if timed_out {
-                    tree::end_orphans();
-                }
-                let how = match status.map(|st| (st.code(), st)) {
-                    Some((Some(c), _)) => format!("; its process {pid} exited with status {c}"),
-                    Some((None, st)) => {
-                        format!("; its process {pid} was ended by a signal ({st})")
-                    }
-                    None => String::new(),
-                };
-                Err(ProcessError {
-                    what: format!(
-                        "{text}{how}; the session is ended and the next run starts a new one"
-                    ),
-                    stderr,
-                })
             }
+        }
+        for (number, written, what, close, limits) in sent {
+            let Some(s) = self.session.as_mut() else {
+                results.push(Err(ProcessError {
+                    what: format!(
+                        "request {number} ({what}): the session ended at an earlier request"
+                    ),
+                    stderr: Vec::new(),
+                }));
+                continue;
+            };
+            let answered_before = s.answered;
+            let start = Instant::now();
+            match s.receive(number, written, what, close, limits, timeout) {
+                Ok((request, stdout)) => results.push(Ok(Answer {
+                    stdout,
+                    elapsed: start.elapsed(),
+                    pid,
+                    request,
+                    answered_before,
+                    stderr: s.err.get(Duration::ZERO),
+                })),
+                Err(Fail::Refused(message)) => results.push(Err(ProcessError {
+                    what: format!(
+                        "answered request {number} ({what}) with `#error {number} {message}` (session process {pid})"
+                    ),
+                    stderr: s.err.get(ERROR_TAIL_WAIT),
+                })),
+                Err(fail) => results.push(Err(self.broken(fail, what))),
+            }
+        }
+        results
+    }
+
+    /// Ends a broken session (and, after a timeout, the orphans), and says
+    /// how.
+    fn broken(&mut self, fail: Fail, what: &str) -> ProcessError {
+        let (text, timed_out) = match fail {
+            Fail::TimedOut(t) => (t, true),
+            Fail::Broken(t) | Fail::Refused(t) => (t, false),
+        };
+        let Some(mut s) = self.session.take() else {
+            return ProcessError {
+                what: format!("{text} ({what})"),
+                stderr: Vec::new(),
+            };
+        };
+        let pid = s.child.id();
+        let status = s.end();
+        let stderr = s.err.get(Duration::from_millis(200));
+        release(s);
+        if timed_out {
+            tree::end_orphans();
+        }
+        let how = match status.map(|st| (st.code(), st)) {
+            Some((Some(c), _)) => format!("; its process {pid} exited with status {c}"),
+            Some((None, st)) => format!("; its process {pid} was ended by a signal ({st})"),
+            None => String::new(),
+        };
+        ProcessError {
+            what: format!("{text}{how}; the session is ended and the next run starts a new one"),
+            stderr,
         }
     }
 }
