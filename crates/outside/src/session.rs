@@ -265,9 +265,10 @@ impl Session {
         let deadline = written + timeout;
         let mut meter = Meter::new(limits);
         // Pipelined answers may arrive back to back: the bytes after the
-        // last closing line start this answer.
+        // last closing line start this answer. Each line is counted
+        // against the cap as it is scanned, so a later answer already read
+        // counts against its own.
         let mut answer = std::mem::take(&mut self.carry);
-        meter.add(&answer).map_err(Fail::Broken)?;
         let mut scanned = 0;
         let mut hinted = self.answered > 0;
         loop {
@@ -291,7 +292,15 @@ impl Session {
                     }
                     return Ok((number, answer));
                 }
+                meter.add(&answer[scanned..=end]).map_err(Fail::Broken)?;
                 scanned = end + 1;
+            }
+            // A line that never ends passes the cap too.
+            if (answer.len() - scanned) as u64 > limits.max_bytes {
+                return Err(Fail::Broken(format!(
+                    "wrote a line of more than {} bytes, this answer's output cap (max_bytes): killed",
+                    limits.max_bytes
+                )));
             }
             let wait_until = if hinted {
                 deadline
@@ -299,10 +308,7 @@ impl Session {
                 deadline.min(written + FIRST_ANSWER_HINT)
             };
             match self.out.next(wait_until) {
-                Some(Piece::Bytes(b)) => {
-                    meter.add(&b).map_err(Fail::Broken)?;
-                    answer.extend_from_slice(&b);
-                }
+                Some(Piece::Bytes(b)) => answer.extend_from_slice(&b),
                 Some(Piece::End) => {
                     return Err(Fail::Broken(format!(
                         "closed its standard output before the closing line of its answer to request {number} ({what}): the session ended mid-answer"

@@ -224,3 +224,27 @@ fn the_document_carries_one_dt() {
     assert_eq!(doc["dt"], 2e-3);
     assert!(doc["options"].get("dt").is_none(), "{}", doc["options"]);
 }
+
+/// Answers that arrive together (all seven of a run in one write, as a
+/// loaded machine delivers them): each is read against its own request and
+/// its own cap, and the run is the one-shot run's.
+#[test]
+fn answers_read_together_are_each_their_own() {
+    let _g = serial();
+    let (p, options) = problem();
+    let one_shot = OutsideEngine::new(spec("pure_python.py", ""), &options)
+        .run(&p, DT)
+        .unwrap();
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/batching.py")
+        .display()
+        .to_string();
+    let text = format!(
+        "[engine.batched]\ncommand = [\"python3\", {fixture:?}, \"7\", \"--\", \"python3\", \"adapters/python/pure_python.py\"]\nsession = true\nrows = \"steps\"\ntimeout_s = 60\n"
+    );
+    let cfg = Config::from_toml(&text, &root().join("pushval.toml")).unwrap();
+    let s = Arc::new(cfg.engines.into_iter().next().unwrap());
+    let run = OutsideEngine::new(s, &options).run(&p, DT).unwrap();
+    assert_eq!(run.trajectory.samples, one_shot.trajectory.samples);
+    shutdown_sessions();
+}
