@@ -58,7 +58,9 @@ so stepping push by push writes the rows a whole run writes. With
 columns, an advance writes only the rows at the sample times and at its
 push's end, with a last column ``steps`` (the engine steps each row's
 interval took); ω on such a row is the one held over its interval, read at
-the interval's middle.
+the interval's middle. Where the ``start`` says ``"compact": true`` the
+rows after the header go as one compact line per answer (``!`` and the
+numbers as little-endian binary64 in hexadecimal, `_compact`).
 
 The engine object lives for the whole process: `Engine.reset` is called once
 per problem (so a session reuses what ``__init__`` loaded), `Engine.close`
@@ -837,31 +839,37 @@ class Stepper:
         t_prev = t0 if prev[0] < t0 else prev[0]
         columns = self.columns
         j_prev = 0
+        ceil = math.ceil
         for t in times:
-            # The pose between the step ends around t (exact on a step end).
             u = (t - t0) / h
-            j = min(n, max(1, math.ceil(u - 1e-9)))
-            b = states[j - 1]
-            if j == n and t == t_end:
+            j = round(u)
+            if 1 <= j <= n and abs(u - j) < 1e-9:
+                # On a step end (the usual case: sample_dt a whole number
+                # of steps): that step's pose, exactly.
+                b = states[j - 1]
                 x, y, th = b[0], b[1], b[2]
             else:
+                # Between the step ends around t.
+                j = min(n, max(1, ceil(u - 1e-9)))
+                b = states[j - 1]
                 a = states[j - 2] if j >= 2 else (x0, y0, th0)
                 s = u - (j - 1)
                 x, y, th = a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])
             # ω held over (t_prev, t], read at its middle.
-            i = min(n, max(1, math.ceil(((t_prev + t) / 2 - t0) / h)))
-            w = states[i - 1][3]
-            try:
-                row = (t, float(x), float(y), float(th), float(w))
-            except (TypeError, ValueError):
-                row = ()
-            if not row or not all(map(math.isfinite, row)):
-                row = (t, *_state((x, y, th, w), t))  # raises, naming the time
+            i = min(n, max(1, ceil(((t_prev + t) / 2 - t0) / h)))
+            row = (t, x, y, th, states[i - 1][3])
             if columns:
                 row += _extras(more[i - 1], columns, t)
             # The engine steps the row's interval took (pushval's count).
             rows.append(row + (j - j_prev,))
             t_prev, j_prev = t, j
+        # Four finite floats each (checked at once; the first bad row named).
+        try:
+            fine = all(map(math.isfinite, itertools.chain.from_iterable(r[1:5] for r in rows)))
+        except TypeError:
+            fine = False
+        if not fine or any(type(v) is not float for r in rows for v in r[1:5]):
+            rows = [(r[0], *_state(r[1:5], r[0]), *r[5:]) for r in rows]
         return rows
 
     def close(self) -> None:
