@@ -455,6 +455,24 @@ fn main() {
         eprintln!("outside_overhead: no target/release/pushval; main_job_wall not measured (cargo build --release first)");
     }
 
+    // How busy the machine was: the protocol's share grows with the wait
+    // for a core at each handoff between pushval and the adapter.
+    if let Some(load) = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next()?.parse::<f64>().ok())
+    {
+        rows.push((
+            "load_average_1min".into(),
+            load,
+            load,
+            "processes",
+            format!(
+                "the machine's 1-minute load average at the end of the measurements ({} cores)",
+                std::thread::available_parallelism().map_or(1, |n| n.get())
+            ),
+        ));
+    }
+
     let mut csv_text = String::from("quantity,median,min,unit,note\n");
     for (name, med, min, unit, note) in &rows {
         csv_text.push_str(&format!(
