@@ -323,9 +323,21 @@ fn main() {
     // the sample times), the same with every step, then protocol 2 (whole
     // documents, every step).
     let kinds = [
-        ("session", "", "protocol 3, rows at the sample times (the default)"),
-        ("session_steps", "rows = \"steps\"\n", "protocol 3, rows = 'steps'"),
-        ("session_p2", "protocol = 2\n", "protocol 2: whole documents, a row per step"),
+        (
+            "session",
+            "",
+            "protocol 3, rows at the sample times (the default)",
+        ),
+        (
+            "session_steps",
+            "rows = \"steps\"\n",
+            "protocol 3, rows = 'steps'",
+        ),
+        (
+            "session_p2",
+            "protocol = 2\n",
+            "protocol 2: whole documents, a row per step",
+        ),
     ];
     let logs = tempfile::tempdir().expect("a temporary folder");
     for (kind, extra, what) in kinds {
@@ -369,7 +381,8 @@ fn main() {
                 &mut rows,
                 &format!("adapter_stepping_{kind}_{label}"),
                 median(steps.to_vec()),
-                "the adapter's own stepping in those runs (--timing: reset and the step loop)".into(),
+                "the adapter's own stepping in those runs (--timing: reset and the step loop)"
+                    .into(),
             );
             put(
                 &mut rows,
