@@ -32,10 +32,18 @@
 //!
 //! * `engine_run_session_*`: pure_python.py as a session (`session = true`:
 //!   one process answering every run, started by a warm-up run outside the
-//!   timing), beside the one-process-per-run rows above.
+//!   timing), beside the one-process-per-run rows above: the default
+//!   (protocol 3, stepping, rows at the sample times: 1001 rows for the
+//!   10 001 steps), `engine_run_session_steps_*` (protocol 3, every step)
+//!   and `engine_run_session_p2_*` (protocol 2, whole documents, every
+//!   step).
 //!
 //! The protocol's overhead per run is `engine_run − adapter_stepping`; the
 //! rows `overhead_*` give it and `overhead_share_*` its share of the run.
+//! For a one-shot run the stepping is `adapter_stepping` (a one-shot
+//! `--timing` run); for a session it is paired: each run's wall time
+//! against the adapter's own stepping in that same run
+//! (`adapter_stepping_session_*`).
 //! (`spawn_venv`: the virtual environment of `scripts/setup-adapters.sh`,
 //! when it exists.)
 
@@ -86,13 +94,29 @@ fn spec(python: &str) -> Arc<Spec> {
 }
 
 /// pure_python.py as a session (`session = true`: one process answering
-/// every run, the kit's session mode).
-fn session_spec(python: &str) -> Arc<Spec> {
+/// every run, the kit's session mode), with `extra` keys (`protocol`,
+/// `rows`), run with `--timing` through `sh` so that the adapter's own
+/// stepping time of each run lands in `log` (one `step_time_s=` line a
+/// run).
+fn session_spec(python: &str, extra: &str, log: &Path) -> Arc<Spec> {
+    let script = format!(
+        "exec '{python}' adapters/python/pure_python.py --timing 2>>'{}'",
+        log.display()
+    );
     let text = format!(
-        "[engine.pure_python]\ncommand = [{python:?}, \"adapters/python/pure_python.py\"]\norder = 1\nsession = true\n"
+        "[engine.pure_python]\ncommand = [\"sh\", \"-c\", {script:?}]\norder = 1\nsession = true\n{extra}"
     );
     let cfg = Config::from_toml(&text, &root().join("pushval.toml")).expect("a valid engines file");
     Arc::new(cfg.engines.into_iter().next().expect("one engine"))
+}
+
+/// The stepping times (s) an adapter run with `--timing` logged, in order.
+fn step_times(log: &Path) -> Vec<f64> {
+    std::fs::read_to_string(log)
+        .unwrap_or_default()
+        .split_whitespace()
+        .filter_map(|w| w.strip_prefix("step_time_s=").and_then(|n| n.parse().ok()))
+        .collect()
 }
 
 fn resolved_python() -> String {
@@ -103,17 +127,30 @@ fn resolved_python() -> String {
     String::from_utf8(o.stdout).unwrap().trim().to_string()
 }
 
-fn which(cmd: &str) -> String {
-    std::env::var_os("PATH")
-        .and_then(|paths| {
-            std::env::split_paths(&paths)
-                .map(|p| p.join(cmd))
-                .find(|p| p.is_file())
-        })
-        .map_or_else(
-            || format!("{cmd} (not on PATH)"),
-            |p| p.display().to_string(),
-        )
+/// What `python3` on PATH is, without the machine's paths: a pyenv shim
+/// (a bash script) or the interpreter itself.
+fn shim_or_not() -> &'static str {
+    let found = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|p| p.join("python3"))
+            .find(|p| p.is_file())
+    });
+    match found {
+        Some(p) if p.components().any(|c| c.as_os_str() == "shims") => {
+            "on this machine a pyenv shim, a bash script that runs `pyenv exec`"
+        }
+        Some(_) => "the interpreter itself",
+        None => "not on PATH",
+    }
+}
+
+/// How a row's label names the interpreter, without the machine's paths.
+fn interpreter(label: &str) -> &'static str {
+    if label == "resolved" {
+        "the resolved interpreter"
+    } else {
+        "python3 from PATH"
+    }
 }
 
 fn process(program: &str, args: &[&str], input: &[u8]) -> pushval_outside::ProcessOutput {
@@ -195,23 +232,20 @@ fn main() {
         &mut rows,
         "spawn_python3_on_path",
         time(runs, || process("python3", &echo, &input)),
-        format!(
-            "`python3` as pushval.toml names it, found at {}",
-            which("python3")
-        ),
+        format!("`python3` as pushval.toml names it ({})", shim_or_not()),
     );
     put(
         &mut rows,
         "spawn_resolved_interpreter",
         time(runs, || process(&py, &echo, &input)),
-        format!("{py} (what `python3` on PATH runs)"),
+        "the interpreter `python3` on PATH runs, named by its path".into(),
     );
     let echo_s = ["-S", "-c", "import sys; sys.stdin.buffer.read()"];
     put(
         &mut rows,
         "spawn_resolved_no_site",
         time(runs, || process(&py, &echo_s, &input)),
-        format!("{py} -S (no site import, no .pth files)"),
+        "the resolved interpreter with -S (no site import, no .pth files)".into(),
     );
     let venv = root().join(".venv-adapters/bin/python");
     if venv.exists() {
@@ -256,7 +290,7 @@ fn main() {
         &mut rows,
         "adapter_process_resolved",
         median(whole),
-        format!("{py} {adapter}: start to exit, document in, CSV out"),
+        format!("the resolved interpreter running {adapter}: start to exit, document in, CSV out"),
     );
     put(
         &mut rows,
@@ -280,27 +314,91 @@ fn main() {
         &mut rows,
         "engine_run_resolved",
         run_r,
-        format!("OutsideEngine::run (command {py})"),
+        "OutsideEngine::run (command: the resolved interpreter)".into(),
     );
-    let mut session_rows = Vec::new();
-    for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
-        let session = OutsideEngine::new(session_spec(python), &options);
-        let warm = session.run(&problem, DT).unwrap();
-        assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
-        let r = time(runs, || session.run(&problem, DT).unwrap());
-        let last = session.run(&problem, DT).unwrap();
-        assert_eq!(
-            last.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
-            "one process served every run"
-        );
-        put(
-            &mut rows,
-            &format!("engine_run_session_{label}"),
-            r,
-            format!("OutsideEngine::run, pure_python.py as a session ({python}): one process for {} runs, started before the timing", runs + 2),
-        );
-        session_rows.push((format!("session_{label}"), r));
-        shutdown_sessions();
+    // Sessions, measured in pairs: each run's wall time against the
+    // adapter's own stepping in that same run (warm, in the same process),
+    // so the protocol's share does not mix a cold one-shot stepping time
+    // with a warm session's run. The default session (protocol 3, rows at
+    // the sample times), the same with every step, then protocol 2 (whole
+    // documents, every step).
+    let kinds = [
+        (
+            "session",
+            "",
+            "protocol 3, rows at the sample times (the default)",
+        ),
+        (
+            "session_steps",
+            "rows = \"steps\"\n",
+            "protocol 3, rows = 'steps'",
+        ),
+        (
+            "session_p2",
+            "protocol = 2\n",
+            "protocol 2: whole documents, a row per step",
+        ),
+    ];
+    let logs = tempfile::tempdir().expect("a temporary folder");
+    for (kind, extra, what) in kinds {
+        for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
+            if kind != "session" && label != "resolved" {
+                continue;
+            }
+            let log = logs.path().join(format!("{kind}_{label}"));
+            let session = OutsideEngine::new(session_spec(python, extra, &log), &options);
+            let warm = session.run(&problem, DT).unwrap();
+            assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
+            let mut walls = Vec::with_capacity(runs);
+            for _ in 0..runs {
+                let s = Instant::now();
+                std::hint::black_box(session.run(&problem, DT).unwrap());
+                walls.push(s.elapsed().as_secs_f64());
+            }
+            let last = session.run(&problem, DT).unwrap();
+            assert_eq!(
+                last.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
+                "one process served every run"
+            );
+            shutdown_sessions();
+            let steps = step_times(&log);
+            assert_eq!(steps.len(), runs + 2, "a stepping time per run: {steps:?}");
+            let steps = &steps[1..=runs];
+            let over: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| w - s).collect();
+            let share: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| (w - s) / w).collect();
+            let about = format!(
+                "pure_python.py as a session, {what}, {} ({} rows a run; {runs} runs on one process started before the timing)",
+                interpreter(label),
+                last.diagnostics["rows"]
+            );
+            put(
+                &mut rows,
+                &format!("engine_run_{kind}_{label}"),
+                median(walls.clone()),
+                format!("OutsideEngine::run: {about}"),
+            );
+            put(
+                &mut rows,
+                &format!("adapter_stepping_{kind}_{label}"),
+                median(steps.to_vec()),
+                "the adapter's own stepping in those runs (--timing: reset and the step loop)"
+                    .into(),
+            );
+            put(
+                &mut rows,
+                &format!("overhead_{kind}_{label}"),
+                median(over),
+                "engine_run − adapter_stepping, run by run: the protocol's cost per run".into(),
+            );
+            let (med, min) = median(share);
+            rows.push((
+                format!("overhead_share_{kind}_{label}"),
+                med,
+                min,
+                "fraction",
+                "overhead / engine_run, run by run (median, min)".into(),
+            ));
+        }
     }
     // The adapter's own input and output (imports, json.load, writing the
     // rows), by difference.
@@ -320,11 +418,10 @@ fn main() {
         (proc_r.0 - spawn_r.0 - stepping.0, proc_r.1 - spawn_r.1 - stepping.1),
         "adapter_process_resolved − spawn_resolved_interpreter − adapter_stepping: the adapter's imports, json.load and CSV writing".into(),
     );
-    let mut overheads = vec![
+    let overheads = vec![
         ("python3_on_path".to_string(), run),
         ("resolved".to_string(), run_r),
     ];
-    overheads.extend(session_rows);
     for (label, r) in overheads {
         let over = r.0 - stepping.0;
         put(
@@ -369,6 +466,24 @@ fn main() {
         );
     } else {
         eprintln!("outside_overhead: no target/release/pushval; main_job_wall not measured (cargo build --release first)");
+    }
+
+    // How busy the machine was: the protocol's share grows with the wait
+    // for a core at each handoff between pushval and the adapter.
+    if let Some(load) = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next()?.parse::<f64>().ok())
+    {
+        rows.push((
+            "load_average_1min".into(),
+            load,
+            load,
+            "processes",
+            format!(
+                "the machine's 1-minute load average at the end of the measurements ({} cores)",
+                std::thread::available_parallelism().map_or(1, |n| n.get())
+            ),
+        ));
     }
 
     let mut csv_text = String::from("quantity,median,min,unit,note\n");

@@ -31,18 +31,36 @@ row at t = 0 (the state `Engine.reset` returns) and one row per engine step:
 
 Two ways to serve, chosen by one rule pushval relies on:
 
-* **one-shot** (no ``--session`` argument): standard input holds one
-  document, then end of file. The kit writes the CSV and exits 0; a document
-  it cannot read exits 2, a failed run exits 1, both with the reason on
-  standard error and nothing on standard output.
+* **one-shot** (no ``--session`` argument, no ``PUSHVAL_SESSION=1``):
+  standard input holds one document, then end of file. The kit writes the
+  CSV and exits 0; a document it cannot read exits 2, a failed run exits 1,
+  both with the reason on standard error and nothing on standard output.
 * **session** (pushval starts the process with ``PUSHVAL_SESSION=1`` in its
-  environment when the engine's ``pushval.toml`` table says
-  ``session = true``; ``--session`` does the same by hand): standard
-  input holds one document per line. Each is answered with the header, the
-  rows and a line ``#end``, flushed. A document that cannot be read or a run
-  that fails is answered by one line ``#error MESSAGE`` instead (nothing
-  else), and the session goes on. End of file on standard input ends the
-  session (exit 0).
+  environment, and no argument, when the engine's ``pushval.toml`` table
+  says ``session = true``; ``--session`` does the same by hand): standard
+  input holds one JSON document per line, each with ``"request": N``, and
+  every answer closes with that number. A whole problem (protocol 2) is
+  answered with the header, the rows and ``#end N``. Protocol 3 steps:
+  ``{"op": "start", "problem": {...}, "rows": "samples"|"steps"}`` (the
+  version 2 problem without its ``pushes``) is answered ``#ok N``;
+  ``{"op": "advance", "speed": .., "phi": .., "duration": ..}`` by that
+  push's rows (the first advance starts with the header and the row at
+  t = 0) and ``#end N``; ``{"op": "finish"}`` by ``#end N``. A document
+  that cannot be read or a request that fails is answered by one line
+  ``#error N MESSAGE`` instead (nothing else), and the session goes on. End
+  of file on standard input ends the session (exit 0).
+
+Protocol 3 is served from the same `Engine.reset`, `Engine.switch` and
+`Engine.step` (`Stepper`): `reset` receives the problem with the first push
+as its schedule, each advance cuts its push into steps as a whole run does,
+so stepping push by push writes the rows a whole run writes. With
+``"rows": "samples"`` (pushval's default) and an engine without extra
+columns, an advance writes only the rows at the sample times and at its
+push's end, with a last column ``steps`` (the engine steps each row's
+interval took); ω on such a row is the one held over its interval, read at
+the interval's middle. Where the ``start`` says ``"compact": true`` the
+rows after the header go as one compact line per answer (``!`` and the
+numbers as little-endian binary64 in hexadecimal, `_compact`).
 
 The engine object lives for the whole process: `Engine.reset` is called once
 per problem (so a session reuses what ``__init__`` loaded), `Engine.close`
@@ -97,8 +115,10 @@ Standard library only; Python 3.9 or newer.
 from __future__ import annotations
 
 import argparse
+import array
 import bisect
 import dataclasses
+import itertools
 import json
 import math
 import os
@@ -120,6 +140,7 @@ __all__ = [
     "Push",
     "Run",
     "State",
+    "Stepper",
     "Support",
     "answer",
     "main",
@@ -456,12 +477,14 @@ def _point(v: Any, path: str) -> tuple[float, float]:
     return _number(v[0], f"{path}[0]"), _number(v[1], f"{path}[1]")
 
 
-def parse_problem(document: str | bytes | dict[str, Any]) -> Problem:
+def parse_problem(document: str | bytes | dict[str, Any], schedule: bool = True) -> Problem:
     """Reads a pushval-problem document (JSON text or the decoded object).
 
     Raises `ProblemError` naming the key for a document that is not JSON,
     has another format, or lacks or mistypes a field. Keys the kit does not
-    know are ignored (a later version may add some).
+    know are ignored (a later version may add some). ``schedule=False``
+    reads a protocol 3 ``start``'s problem: ``pushes`` may be absent or
+    empty (the pushes come one ``advance`` at a time).
     """
     if isinstance(document, (str, bytes)):
         try:
@@ -486,6 +509,7 @@ def parse_problem(document: str | bytes | dict[str, Any]) -> Problem:
             )
         )
     ini = doc.obj("initial")
+    given = schedule or (doc.has("pushes") and doc.raw("pushes") != [])
     pushes = tuple(
         Push(
             index=i,
@@ -494,7 +518,7 @@ def parse_problem(document: str | bytes | dict[str, Any]) -> Problem:
             speed=p.number("speed", 0.0),
             phi=p.number("phi"),
         )
-        for i, p in enumerate(doc.objects("pushes"))
+        for i, p in enumerate(doc.objects("pushes") if given else ())
     )
     polygon = doc.obj("object").raw("polygon")
     if not isinstance(polygon, list) or len(polygon) < 2:
@@ -667,6 +691,201 @@ def _extras(value: Any, columns: Sequence[str], t: float) -> tuple[float, ...]:
     return vals
 
 
+class Stepper:
+    """One problem stepped push by push on an engine (protocol 3, and what
+    `simulate` runs): `Engine.reset` before the first push, `Engine.switch`
+    between pushes, each push cut into equal steps (`Push.steps`), rows
+    kept per step or at the sample times.
+
+    ``problem`` is the problem `Engine.reset` receives with the first push
+    as its schedule (a protocol 3 ``start``'s own schedule, if it has one,
+    is applied by the first `advance` before its push). ``rows``:
+    ``"steps"`` (one row per step) or ``"samples"`` (rows at the problem's
+    sample times and at each push's end only; ω on a row is the one held
+    over the interval since the row before, read at its middle, as pushval
+    reads a step's ω). An engine with `extra_columns` writes every step
+    unless its `Engine.rows` is ``"samples"``.
+    """
+
+    def __init__(self, engine: Engine, problem: Problem, rows: str = "steps"):
+        if rows not in ("steps", "samples"):
+            raise ValueError(f"unknown row mode {rows!r} (steps, samples)")
+        if problem.switching not in engine.switching_rules:
+            raise AdapterError(
+                f"the problem asks for {problem.switching} switching; this engine follows "
+                f"{' and '.join(engine.switching_rules)} only"
+            )
+        self.engine = engine
+        self.problem = problem
+        #: What `Engine.reset` receives; None: ``problem`` with the first
+        #: push as its schedule.
+        self.reset_problem: Problem | None = None
+        self.asked = rows
+        self.mode = rows
+        self.pending = list(problem.pushes)
+        self.applied: list[Push] = []
+        self.columns: tuple[str, ...] = ()
+        self.end = 0.0
+        self.last: tuple[float, ...] | None = None
+        self.steps = 0
+        self.step_time_s = 0.0
+        self.header_sent = False
+        self.closed = False
+
+    def _reset(self, first: Push) -> list[tuple[float, ...]]:
+        engine = self.engine
+        problem = self.reset_problem or dataclasses.replace(self.problem, pushes=(first,))
+        started = time.perf_counter()
+        state = engine.reset(problem)
+        self.step_time_s += time.perf_counter() - started
+        self.columns = tuple(engine.extra_columns(problem))
+        extras = _extras(engine.extras(), self.columns, 0.0) if self.columns else ()
+        if engine.rows == "samples" or (self.asked == "samples" and not self.columns):
+            self.mode = "samples"
+        else:
+            self.mode = "steps"
+        row = (0.0, *_state(state, 0.0), *extras)
+        self.last = row
+        if self.mode == "samples":
+            row += (0,)  # the steps column: none before t = 0
+        return [row]
+
+    def apply(
+        self,
+        push: Push,
+        progress: Callable[[float, float], None] | None = None,
+        total: float | None = None,
+    ) -> list[tuple[float, ...]]:
+        """Applies ``push`` as given (its `Push.t_start` is where its rows
+        start) and returns its rows: the row at t = 0 first on the first
+        push, then the rows in (t_start, t_end], the last at t_end.
+        ``progress(t, total)`` is called every 1024 steps."""
+        if self.closed:
+            raise AdapterError("the problem is finished: start another")
+        out: list[tuple[float, ...]] = []
+        if not self.applied:
+            out += self._reset(push)
+        else:
+            self.engine.switch(self.applied[-1], push)
+        out += self._segment(push, progress, total)
+        self.applied.append(push)
+        # Summed in order, as pushval sums it.
+        self.end += push.duration
+        return out
+
+    def advance(self, speed: float, phi: float, duration: float) -> list[tuple[float, ...]]:
+        """Protocol 3's ``advance``: the push (speed m/s, phi rad in the
+        object frame, duration s) starting where the pushes applied end;
+        the first call applies the start's own schedule first. Returns the
+        rows (see `apply`)."""
+        todo = [(p.speed, p.phi, p.duration) for p in self.pending] + [(speed, phi, duration)]
+        self.pending = []
+        out: list[tuple[float, ...]] = []
+        for sp, ph, du in todo:
+            push = Push(index=len(self.applied), t_start=self.end, duration=du, speed=sp, phi=ph)
+            out += self.apply(push)
+        return out
+
+    def _segment(self, push: Push, progress, total) -> list[tuple[float, ...]]:
+        engine = self.engine
+        step = engine.step
+        n = push.steps(self.problem.dt, engine.step_rule)
+        h = push.duration / n
+        t0 = push.t_start
+        columns = self.columns
+        extras = engine.extras
+        started = time.perf_counter()
+        states: list[Any] = []
+        more: list[Any] = []
+        for j0 in range(0, n, 1024):
+            m = min(n, j0 + 1024) - j0
+            if columns:
+                for _ in range(m):
+                    states.append(step(push, h))
+                    more.append(extras())
+            else:
+                states += [step(push, h) for _ in range(m)]
+            if progress is not None and j0 + m < n:
+                progress(t0 + (j0 + m) * h, total if total is not None else t0 + push.duration)
+        self.step_time_s += time.perf_counter() - started
+        self.steps += n
+        t_end = t0 + push.duration
+        if self.mode == "steps":
+            times = [t0 + j * h for j in range(1, n)] + [t_end]
+            rows = [
+                (t, *_state(s, t), *(_extras(e, columns, t) if columns else ()))
+                for t, s, e in zip(times, states, more if columns else itertools.repeat(()))
+            ]
+        else:
+            rows = self._samples(push, states, more, n, h, t_end)
+        self.last = rows[-1]
+        return rows
+
+    def _samples(self, push: Push, states, more, n: int, h: float, t_end: float):
+        """The rows at the sample times in (t_start, t_end) and at t_end."""
+        t0 = push.t_start
+        sdt = self.problem.sample_dt
+        tol = 1e-9 * sdt
+        k = math.floor(t0 / sdt * (1.0 + 1e-12) + 1e-9) + 1
+        times = []
+        while k * sdt < t_end - tol:
+            times.append(k * sdt)
+            k += 1
+        times.append(t_end)
+        prev = self.last
+        assert prev is not None
+        x0, y0, th0 = prev[1], prev[2], prev[3]
+        rows = []
+        t_prev = t0 if prev[0] < t0 else prev[0]
+        columns = self.columns
+        j_prev = 0
+        ceil = math.ceil
+        for t in times:
+            u = (t - t0) / h
+            j = round(u)
+            if 1 <= j <= n and abs(u - j) < 1e-9:
+                # On a step end (the usual case: sample_dt a whole number
+                # of steps): that step's pose, exactly.
+                b = states[j - 1]
+                x, y, th = b[0], b[1], b[2]
+            else:
+                # Between the step ends around t.
+                j = min(n, max(1, ceil(u - 1e-9)))
+                b = states[j - 1]
+                a = states[j - 2] if j >= 2 else (x0, y0, th0)
+                s = u - (j - 1)
+                x, y, th = a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])
+            # ω held over (t_prev, t], read at its middle.
+            i = min(n, max(1, ceil(((t_prev + t) / 2 - t0) / h)))
+            row = (t, x, y, th, states[i - 1][3])
+            if columns:
+                row += _extras(more[i - 1], columns, t)
+            # The engine steps the row's interval took (pushval's count).
+            rows.append(row + (j - j_prev,))
+            t_prev, j_prev = t, j
+        # Four finite floats each (checked at once; the first bad row named).
+        try:
+            fine = all(map(math.isfinite, itertools.chain.from_iterable(r[1:5] for r in rows)))
+        except TypeError:
+            fine = False
+        if not fine or any(type(v) is not float for r in rows for v in r[1:5]):
+            rows = [(r[0], *_state(r[1:5], r[0]), *r[5:]) for r in rows]
+        return rows
+
+    def close(self) -> None:
+        """Ends the problem (`Engine.close`), once."""
+        if not self.closed:
+            self.closed = True
+            self.engine.close()
+
+    @property
+    def header(self) -> str:
+        """The CSV header of the rows: `HEADER`, the engine's extra columns,
+        and with rows at the sample times ``steps`` (the engine steps each
+        row's interval took)."""
+        return ",".join((HEADER, *self.columns, *(("steps",) if self.mode == "samples" else ())))
+
+
 def simulate(
     engine: Engine,
     problem: Problem,
@@ -674,43 +893,22 @@ def simulate(
 ) -> Run:
     """Runs ``problem`` on ``engine``: `Engine.reset`, then every segment's
     steps (with `Engine.switch` between segments), `Engine.close` at the
-    end. ``progress(t, end)`` is called now and then (every 1024 steps).
+    end; one row per step. ``progress(t, end)`` is called now and then
+    (every 1024 steps).
 
     Raises `AdapterError` for a switching rule the engine does not follow or
     a state that is not four finite numbers.
     """
-    if problem.switching not in engine.switching_rules:
-        raise AdapterError(
-            f"the problem asks for {problem.switching} switching; this engine follows "
-            f"{' and '.join(engine.switching_rules)} only"
-        )
+    stepper = Stepper(engine, dataclasses.replace(problem, pushes=()), "steps")
+    stepper.reset_problem = problem
     end = problem.duration
-    started = time.perf_counter()
     try:
-        raw: list[tuple[float, Any, Any]] = [(0.0, engine.reset(problem), ())]
-        columns = tuple(engine.extra_columns(problem))
-        extras = engine.extras if columns else tuple
-        if columns:
-            raw[0] = (0.0, raw[0][1], extras())
-        before: Push | None = None
-        step = engine.step
+        rows: list[tuple[float, ...]] = []
         for push in problem.pushes:
-            if before is not None:
-                engine.switch(before, push)
-            before = push
-            n = push.steps(problem.dt, engine.step_rule)
-            h = push.duration / n
-            t0 = push.t_start
-            for j in range(1, n):
-                raw.append((t0 + j * h, step(push, h), extras()))
-                if progress is not None and not j & 1023:
-                    progress(t0 + j * h, end)
-            raw.append((t0 + push.duration, step(push, h), extras()))
-        elapsed = time.perf_counter() - started
+            rows += stepper.apply(push, progress, end)
     finally:
-        engine.close()
-    rows = [(t, *_state(s, t), *_extras(e, columns, t)) for t, s, e in raw]
-    return Run(rows=rows, steps=len(rows) - 1, step_time_s=elapsed, columns=columns)
+        stepper.close()
+    return Run(rows=rows, steps=stepper.steps, step_time_s=stepper.step_time_s, columns=stepper.columns)
 
 
 # --------------------------------------------------------------------------
@@ -739,6 +937,17 @@ def _sampled(problem: Problem, rows: Sequence[tuple[float, ...]]) -> list[tuple[
 
 def _csv(rows: Iterable[tuple[float, ...]]) -> str:
     return "".join(",".join(map(repr, r)) + "\n" for r in rows)
+
+
+def _compact(rows: Sequence[tuple[float, ...]]) -> str:
+    """``rows`` as one compact line (protocol 3, where pushval's ``start``
+    says ``"compact": true``): ``!`` then the numbers, row after row, as
+    hexadecimal little-endian IEEE 754 binary64 (16 digits each); exact, and
+    far cheaper to write than decimal text."""
+    numbers = array.array("d", itertools.chain.from_iterable(rows))
+    if sys.byteorder != "little":
+        numbers.byteswap()
+    return "!" + numbers.tobytes().hex() + "\n"
 
 
 def answer(
@@ -802,6 +1011,7 @@ class _Server:
 
     def __init__(self, engine: Engine, out: IO[str], err: IO[str], timing: bool):
         self.engine = engine
+        self.compact = False
         self.out = out
         self.err = err
         self.timing = timing
@@ -859,25 +1069,91 @@ class _Server:
 
     def session(self, stdin: IO[str]) -> int:
         number = 0
-        while True:
-            line = stdin.readline()
-            if not line:
-                return 0
-            if not line.strip():
-                continue
-            number += 1
-            try:
-                problem = parse_problem(line)
-                text = self.solve(problem, "#end\n")
-            except ProblemError as e:
-                text = f"#error problem {number}: the document: {_one_line(str(e))}\n"
-                self.say(text[len("#error ") :].rstrip())
-            except Exception as e:  # noqa: BLE001 - every failure is answered
-                text = f"#error problem {number}: {self.failure(e)}\n"
-                self.say(text[len("#error ") :].rstrip())
-            self.out.write(text)
-            self.out.flush()
+        self.stepper: Stepper | None = None
+        try:
+            while True:
+                line = stdin.readline()
+                if not line:
+                    return 0
+                if not line.strip():
+                    continue
+                number += 1
+                text = self.request(line, number)
+                self.out.write(text)
+                self.out.flush()
+        finally:
+            self.drop_stepper()
 
+    def drop_stepper(self) -> None:
+        if self.stepper is not None:
+            stepper, self.stepper = self.stepper, None
+            stepper.close()
+
+    def request(self, line: str, number: int) -> str:
+        """The answer to one session document (its closing line included)."""
+        tag = ""
+        what = f"problem {number}"
+        try:
+            try:
+                doc = json.loads(line)
+            except ValueError as e:
+                raise ProblemError(f"not JSON: {e}") from None
+            if not isinstance(doc, dict):
+                raise ProblemError(f"must be an object, got {_kind(doc)}")
+            request = doc.get("request")
+            if request is not None:
+                if isinstance(request, bool) or not isinstance(request, int) or request <= 0:
+                    raise ProblemError(f"`request` must be a whole number > 0, got {request!r}")
+                tag = f" {request}"
+                what = f"request {request}"
+            op = doc.get("op")
+            if op is None:
+                # A whole problem (protocols 1 and 2): whatever was being
+                # stepped is abandoned.
+                self.drop_stepper()
+                return self.solve(parse_problem(doc), f"#end{tag}\n")
+            return self.step(doc, op, tag)
+        except ProblemError as e:
+            self.drop_stepper()
+            text = f"#error{tag} {what}: the document: {_one_line(str(e))}\n"
+        except Exception as e:  # noqa: BLE001 - every failure is answered
+            self.drop_stepper()
+            text = f"#error{tag} {what}: {self.failure(e)}\n"
+        self.say(text.split(" ", 1 + bool(tag))[-1].rstrip())
+        return text
+
+    def step(self, doc: dict[str, Any], op: Any, tag: str) -> str:
+        """Protocol 3: ``start``, ``advance`` or ``finish``."""
+        r = _Reader(doc, "")
+        if op == "start":
+            self.drop_stepper()
+            rows = r.string("rows") if r.has("rows") else "steps"
+            if rows not in ("steps", "samples"):
+                raise ProblemError(f"`rows` is {rows!r}; known: steps, samples")
+            problem = parse_problem(r.raw("problem"), schedule=False)
+            self.stepper = Stepper(self.engine, problem, rows)
+            self.compact = r.has("compact") and r.boolean("compact")
+            return f"#ok{tag}\n"
+        if op not in ("advance", "finish"):
+            raise ProblemError(f"`op` is {op!r}; known: start, advance, finish")
+        if self.stepper is None:
+            raise ProblemError(f"`{op}` without a `start` before it (or after a failed request)")
+        stepper = self.stepper
+        if op == "finish":
+            self.drop_stepper()
+            if self.timing:
+                self.err.write(f"step_time_s={stepper.step_time_s!r} steps={stepper.steps}\n")
+                self.err.flush()
+            return f"#end{tag}\n"
+        rows = stepper.advance(
+            r.number("speed", 0.0), r.number("phi"), r.number("duration", 0.0, strict=True)
+        )
+        head = ""
+        if not stepper.header_sent:
+            stepper.header_sent = True
+            head = stepper.header + "\n"
+        body = _compact(rows) if self.compact else _csv(rows)
+        return head + body + f"#end{tag}\n"
 
 def serve(
     engine: Engine,
@@ -920,7 +1196,7 @@ def main(engine: Callable[[argparse.Namespace], Engine], argv: Sequence[str] | N
         "--session",
         action="store_true",
         help="serve one problem document per line until standard input closes "
-        "(answers framed by #end / #error)",
+        "(answers closed by #end N, #ok N or #error N MESSAGE; pushval sets PUSHVAL_SESSION=1 instead)",
     )
     parser.add_argument(
         "--timing",

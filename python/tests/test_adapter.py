@@ -218,7 +218,7 @@ def answers(text):
     out, cur = [], []
     for line in text.splitlines():
         cur.append(line)
-        if line == "#end" or line.startswith("#error"):
+        if line.split(" ")[0] in ("#end", "#ok", "#error"):
             out.append(cur)
             cur = []
     assert not cur, f"unframed output at the end: {cur}"
@@ -266,6 +266,69 @@ class ServeTest(unittest.TestCase):
         self.assertEqual(got[2], ["#error problem 3: no licence for speed 0.7"])
         # One engine for the whole session, closed after every problem.
         self.assertEqual([c for c in e.calls if c[0] != "step"].count(("close",)), 3)
+
+    def test_session_answers_close_with_the_request_number(self):
+        failing = doc(pushes=[{"t_start": 0.0, "duration": 0.1, "speed": 0.7, "phi": 0.0}])
+        docs = [dict(DOC, request=7), dict(failing, request=8), {"request": 9, "op": "finish"}]
+        status, out, _ = self.serve(Recorder(), "\n".join(map(json.dumps, docs)) + "\n", session=True)
+        self.assertEqual(status, 0)
+        got = answers(out)
+        self.assertEqual(got[0][-1], "#end 7")
+        self.assertEqual(got[1], ["#error 8 request 8: no licence for speed 0.7"])
+        self.assertRegex(got[2][0], r"^#error 9 request 9: the document: `finish` without a `start`")
+
+    def stepped(self, rows):
+        """A protocol 3 session of DOC's two pushes on a Recorder."""
+        problem = {k: v for k, v in doc(format="pushval-problem/2", switching="impulsive").items() if k != "pushes"}
+        docs = [{"request": 1, "op": "start", "rows": rows, "problem": problem}]
+        for i, p in enumerate(DOC["pushes"]):
+            docs.append({"request": 2 + i, "op": "advance", "speed": p["speed"], "phi": p["phi"], "duration": p["duration"]})
+        docs.append({"request": 4, "op": "finish"})
+        e = Recorder()
+        status, out, _ = self.serve(e, "\n".join(map(json.dumps, docs)) + "\n", session=True)
+        self.assertEqual(status, 0)
+        return e, answers(out)
+
+    def test_protocol_3_steps_with_reset_switch_and_step(self):
+        e, got = self.stepped("steps")
+        self.assertEqual([a[-1] for a in got], ["#ok 1", "#end 2", "#end 3", "#end 4"])
+        self.assertEqual(got[0], ["#ok 1"])
+        # The header once, the row at t = 0, then ceil(0.25 / 0.03) = 9
+        # rows; the second push ceil(0.1 / 0.03) = 4 rows, no header.
+        self.assertEqual(got[1][0], "t,x,y,theta,omega")
+        self.assertEqual(len(got[1]), 1 + 1 + 9 + 1)
+        self.assertEqual(len(got[2]), 4 + 1)
+        self.assertEqual(got[3], ["#end 4"])
+        self.assertEqual(float(got[1][-2].split(",")[0]), 0.25)
+        self.assertEqual(float(got[2][-2].split(",")[0]), 0.25 + 0.1)
+        calls = [c if c[0] != "step" else c[:2] for c in e.calls]
+        self.assertEqual(
+            calls,
+            [("reset", "test")] + [("step", 0)] * 9 + [("switch", 0, 1)] + [("step", 1)] * 4 + [("close",)],
+        )
+        # The same rows as a one-shot run of the whole document.
+        _, one, _ = self.serve(Recorder(), json.dumps(DOC), session=False)
+        self.assertEqual(one.splitlines(), got[1][:-1] + got[2][:-1])
+
+    def test_protocol_3_sample_rows(self):
+        _, got = self.stepped("samples")
+        rows = [list(map(float, l.split(","))) for a in got[1:3] for l in a[:-1] if not l.startswith("t,")]
+        # The sample times 0, 0.1, 0.2, each push's end 0.25 and 0.35, and
+        # 0.3 (sample_dt 0.1).
+        self.assertEqual([r[0] for r in rows], [0.0, 0.1, 0.2, 0.25, 0.30000000000000004, 0.35])
+        # The recorder's x is the time: interpolated, x is the row's time.
+        for r in rows:
+            self.assertAlmostEqual(r[1], r[0], places=12)
+        # The steps each interval took: 9 steps of 0.25/9 s hold 0.1 and 0.2
+        # after 4 and 8 steps (ceil(0.1 / 0.02778) = 4), then 1 to 0.25;
+        # 4 steps of 0.025 s reach 0.3 after 2 and 0.35 after 2 more.
+        self.assertEqual(got[1][0], "t,x,y,theta,omega,steps")
+        self.assertEqual([len(r) for r in rows], [6] * 6)
+        self.assertEqual([r[5] for r in rows], [0, 4, 4, 1, 2, 2])
+
+    def test_compact_rows_are_little_endian_binary64_in_hex(self):
+        # 1.5 is 0x3FF8000000000000: little-endian digits 000000000000f83f.
+        self.assertEqual(adapter._compact([(0.0, 1.5)]), "!" + "0" * 16 + "000000000000f83f\n")
 
     def test_limits_fall_back_to_sample_rows_then_fail(self):
         d = doc(format="pushval-problem/2", limits={"max_rows": 6})

@@ -21,6 +21,7 @@ mod properties;
 mod readme;
 mod report;
 mod scenarios;
+mod sessions;
 mod stress;
 mod study;
 mod track;

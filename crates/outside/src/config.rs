@@ -20,10 +20,38 @@ const KEYS: &[&str] = &[
     "law_params",
     "protocol",
     "session",
+    "rows",
 ];
 
 /// The protocol version when `protocol` is absent and `session` is not set.
 pub const DEFAULT_PROTOCOL: u32 = 1;
+/// The protocol version when `protocol` is absent and `session = true`:
+/// stepping (start, advance, finish), so the engine can be a plant.
+pub const DEFAULT_SESSION_PROTOCOL: u32 = 3;
+
+/// Which rows a protocol 3 session asks the adapter for (`rows` in
+/// `[engine.NAME]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rows {
+    /// The rows at the problem's sample times and at each push's end only
+    /// (the default): the gate reads poses at the sample times and ω
+    /// steady at a segment's end, so it needs no row in between. An adapter
+    /// may still write every step (the kit does when its engine writes
+    /// load columns, whose per-step values the contact record reads).
+    Samples,
+    /// One row per engine step.
+    Steps,
+}
+
+impl Rows {
+    /// The document's value: `"samples"` or `"steps"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Rows::Samples => "samples",
+            Rows::Steps => "steps",
+        }
+    }
+}
 
 /// One outside engine as `pushval.toml` declares it.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,13 +78,20 @@ pub struct Spec {
     /// the laws of `pushval::registry::laws`; an unknown name is refused
     /// naming the known ones); None when the file names none.
     pub law: Option<String>,
-    /// The `pushval-problem/N` version the process reads: 1 (the default)
-    /// or 2 (`switching` and `limits` in the document; needed for sessions).
+    /// The `pushval-problem/N` version the process reads: 1 (the default
+    /// without `session`), 2 (`switching` and `limits` in the document) or
+    /// 3 (stepping: a session of `start`, `advance` and `finish` requests;
+    /// the default with `session = true`).
     pub protocol: u32,
-    /// One process serves many problems (`session = true`, protocol 2): one
-    /// document per line in, each answer ended by `#end` or `#error
-    /// MESSAGE`; default false (one process per run).
+    /// One process serves many problems (`session = true`, protocol 2 or
+    /// 3): one document per line in, each with a request number, each
+    /// answer closed by `#end N`, `#ok N` or `#error N MESSAGE`; default
+    /// false (one process per run).
     pub session: bool,
+    /// The rows a protocol 3 session asks for (`rows = "samples"`, the
+    /// default, or `"steps"`); ignored by protocols 1 and 2, which write
+    /// one row per step.
+    pub rows: Rows,
     /// The law's parameters (`law_params = { key = value }`: numbers and
     /// strings), checked against the law when the registry loads the file;
     /// empty when the file gives none.
@@ -334,27 +369,47 @@ fn spec(name: &str, value: &toml::Value, file: &Path, dir: &Path) -> Result<Spec
         Some(v) => return Err(err("session", format!("must be true or false, got {v}"))),
     };
     let protocol = match t.get("protocol") {
-        None if session => 2,
+        None if session => DEFAULT_SESSION_PROTOCOL,
         None => DEFAULT_PROTOCOL,
-        Some(toml::Value::Integer(n @ (1 | 2))) => *n as u32,
+        Some(toml::Value::Integer(n @ (1..=3))) => *n as u32,
         Some(v) => {
             return Err(err(
                 "protocol",
-                format!("must be 1 (pushval-problem/1) or 2 (pushval-problem/2), got {v}"),
+                format!(
+                    "must be 1 (pushval-problem/1), 2 (pushval-problem/2) or 3 (stepping sessions), got {v}"
+                ),
             ))
         }
     };
     if session && protocol < 2 {
         return Err(err(
             "protocol",
-            "session = true needs protocol 2 (sessions are part of pushval-problem/2)".into(),
+            "session = true needs protocol 2 or 3 (a protocol 1 adapter reads one document to the end of its standard input and never answers a session)".into(),
         ));
     }
+    if !session && protocol == 3 {
+        return Err(err(
+            "protocol",
+            "protocol 3 (stepping) runs in a session: set session = true as well".into(),
+        ));
+    }
+    let rows = match t.get("rows") {
+        None => Rows::Samples,
+        Some(toml::Value::String(s)) if s == "samples" => Rows::Samples,
+        Some(toml::Value::String(s)) if s == "steps" => Rows::Steps,
+        Some(v) => {
+            return Err(err(
+                "rows",
+                format!("must be \"samples\" or \"steps\", got {v}"),
+            ))
+        }
+    };
     Ok(Spec {
         law,
         law_params,
         protocol,
         session,
+        rows,
         name: name.to_string(),
         command,
         dir: dir.to_path_buf(),

@@ -26,8 +26,9 @@ const DEFAULT_GRAVITY: f64 = 9.81;
 /// `m g`, or a different support count), the frame is the centre of mass's,
 /// the outline is the convex hull of the supports and the contact, g is
 /// 9.81 m/s² and the loads share `m g` in proportion to the friction.
-/// `options` is the scenario's `[engine]` table verbatim (`dt` included when
-/// set).
+/// `options` is the scenario's `[engine]` table without its `dt`: the step
+/// of this run is the document's `dt` alone (the table's `dt` is where the
+/// dt ladder starts, and its 2·dt rung runs at another step).
 pub fn problem_document(
     engine: &str,
     problem: &Problem,
@@ -87,10 +88,10 @@ pub fn problem_document(
             json!({"t_start": t0, "duration": p.duration, "speed": p.speed, "phi": p.phi})
         })
         .collect();
+    // The step travels once, as the document's `dt`: the `[engine]` table's
+    // own `dt` is the step the ladder starts from, not this run's (its 2·dt
+    // rung differs), so `options` never carries it.
     let mut opts = serde_json::Map::new();
-    if let Some(h) = options.dt {
-        opts.insert("dt".into(), json!(h));
-    }
     for (k, v) in &options.values {
         opts.insert(k.clone(), v.clone());
     }

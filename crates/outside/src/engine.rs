@@ -4,23 +4,28 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use pushval_engine::{
-    trajectory_from_steps, ContactRecord, Engine, EngineCrate, EngineInfo, EngineOptions,
-    EngineRun, FrictionLaw, LoadRecorder, OptionKeys, StepRecord,
+    rigid_cm_velocity, trajectory_from_steps, with_pushes, ContactRecord, Engine, EngineCrate,
+    EngineInfo, EngineOptions, EngineRun, EngineSession, EngineState, FrictionLaw, LoadRecorder,
+    OptionKeys, StepRecord,
 };
-use pushval_model::{ModelError, Problem};
+use pushval_model::{ModelError, Problem, Push};
 
+use crate::check::{self, Bound};
 use crate::config::Spec;
 use crate::csv;
 use crate::document::{problem_document, problem_document_v2};
-use crate::limits::Limits;
+use crate::limits::{Limits, HEADER_BYTES};
 use crate::process::{last_lines, run_process, ProcessError};
-use crate::session;
+use crate::session::{Answer, Close, Lease};
 
 /// How many lines of a failed process's standard error a message quotes.
 const STDERR_LINES: usize = 8;
 
 /// An outside engine with a scenario's `[engine]` options: one process per
-/// run (see the crate docs).
+/// run, or a session (see the crate docs). With protocol 3 it steps: its
+/// [`Engine::session`] keeps the adapter's world between pushes, and `run`
+/// is `start`, one `advance` per push, `finish`; with protocol 1 or 2,
+/// [`dyn Engine::start`] replays the schedule applied so far.
 #[derive(Clone)]
 pub struct OutsideEngine {
     spec: Arc<Spec>,
@@ -125,6 +130,9 @@ impl Engine for OutsideEngine {
         self.law.as_deref()
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        if self.steps() {
+            return Stepping::run(self, problem, dt);
+        }
         let start = Instant::now();
         problem.check()?;
         let limits = Limits::for_problem(problem, dt);
@@ -133,24 +141,23 @@ impl Engine for OutsideEngine {
         } else {
             problem_document(&self.spec.name, problem, &self.options, dt)
         };
-        let mut input = serde_json::to_vec(&doc).expect("a JSON value serialises");
         let timeout = Duration::from_secs_f64(self.spec.timeout_s);
-        let broken = |e: ProcessError| {
-            ModelError::Adapter(format!(
-                "{}: {}; {}",
-                self.who(),
-                e.what,
-                last_lines(&e.stderr, STDERR_LINES)
-            ))
-        };
-        let input_bytes = input.len();
-        let (stdout, stderr, process_time, served_by) = if self.spec.session {
-            // One document per line (compact JSON holds no line break).
-            input.push(b'\n');
-            let a = session::answer(&self.spec, input, limits, timeout).map_err(broken)?;
-            let about = serde_json::json!({"pid": a.pid, "answered_before": a.answered_before});
-            (a.stdout, a.stderr, a.elapsed, Some(about))
+        let (stdout, stderr, process_time, input_bytes, served_by) = if self.spec.session {
+            let serde_json::Value::Object(doc) = doc else {
+                unreachable!("the document is an object")
+            };
+            let mut lease = Lease::take(&self.spec).map_err(|e| self.broken(e))?;
+            let a = lease
+                .request(doc, "problem", Close::End, limits, timeout)
+                .map_err(|e| self.broken(e))?;
+            let about = serde_json::json!({
+                "pid": a.pid,
+                "answered_before": a.answered_before,
+                "request": a.request,
+            });
+            (a.stdout, a.stderr, a.elapsed, None, Some(about))
         } else {
+            let input = serde_json::to_vec(&doc).expect("a JSON value serialises");
             let out = run_process(
                 &self.spec.program(),
                 &self.spec.command[1..],
@@ -159,9 +166,9 @@ impl Engine for OutsideEngine {
                 timeout,
                 limits,
             )
-            .map_err(broken)?;
+            .map_err(|e| self.broken(e))?;
             if !out.status.success() {
-                return Err(broken(ProcessError {
+                return Err(self.broken(ProcessError {
                     what: match out.status.code() {
                         Some(c) => format!("exited with status {c}"),
                         None => format!("was ended by a signal ({})", out.status),
@@ -169,42 +176,514 @@ impl Engine for OutsideEngine {
                     stderr: out.stderr,
                 }));
             }
-            (out.stdout, out.stderr, out.elapsed, None)
+            (out.stdout, out.stderr, out.elapsed, Some(input.len()), None)
         };
-        let fail = |what: String| {
-            ModelError::Adapter(format!(
-                "{}: {what}; {}",
-                self.who(),
-                last_lines(&stderr, STDERR_LINES)
-            ))
-        };
+        let fail = |what: String| self.fail(what, &stderr);
         let parse_start = Instant::now();
         let text = std::str::from_utf8(&stdout)
             .map_err(|e| fail(format!("wrote standard output that is not UTF-8 ({e})")))?;
         let rows = csv::read(text, problem.body.len())
             .map_err(|e| fail(format!("wrote a malformed row on its standard output: {e}")))?;
-        let history = history_from_rows(problem, &rows)
+        check::rows(&Bound::of(problem), None, &rows, |r| {
+            format!("line {}", r.line)
+        })
+        .map_err(|e| fail(format!("wrote a row that is not a motion of the push: {e}")))?;
+        let mut run = self
+            .assemble(problem, dt, &rows)
             .map_err(|e| fail(format!("wrote rows that do not cover the run: {e}")))?;
-        let trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
-        let contact = contact_from_rows(problem, &rows);
         let parse_time = parse_start.elapsed();
+        run.wall_time = start.elapsed();
+        run.diagnostics = serde_json::json!({
+            "rows": rows.len(),
+            "process_wall_time_s": process_time.as_secs_f64(),
+            "parse_resample_time_s": parse_time.as_secs_f64(),
+            "input_bytes": input_bytes,
+            "output_bytes": stdout.len(),
+            "protocol": self.spec.protocol,
+            "session": served_by,
+        });
+        Ok(run)
+    }
+
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        if !self.steps() {
+            return None;
+        }
+        Some(Stepping::start(self, problem, dt).map(|s| Box::new(s) as Box<dyn EngineSession + 'a>))
+    }
+}
+
+impl OutsideEngine {
+    /// Whether the engine steps (protocol 3 in a session): its own
+    /// [`EngineSession`]; else [`dyn Engine::start`] replays.
+    fn steps(&self) -> bool {
+        self.spec.session && self.spec.protocol >= 3
+    }
+
+    /// A process failure as the run's error.
+    fn broken(&self, e: ProcessError) -> ModelError {
+        ModelError::Adapter(format!(
+            "{}: {}; {}",
+            self.who(),
+            e.what,
+            last_lines(&e.stderr, STDERR_LINES)
+        ))
+    }
+
+    /// Bad output as the run's error.
+    fn fail(&self, what: String, stderr: &[u8]) -> ModelError {
+        ModelError::Adapter(format!(
+            "{}: {what}; {}",
+            self.who(),
+            last_lines(stderr, STDERR_LINES)
+        ))
+    }
+
+    /// The run of checked `rows` (diagnostics and wall time left to the
+    /// caller).
+    fn assemble(
+        &self,
+        problem: &Problem,
+        dt: f64,
+        rows: &[csv::Record],
+    ) -> Result<EngineRun, String> {
+        let history = history_from_rows(problem, rows)?;
+        let mut trajectory = trajectory_from_steps(&self.spec.name, problem, &history);
+        let steps = engine_steps(rows);
+        trajectory.stats.steps = steps;
+        trajectory.stats.rhs_evals = steps;
         Ok(EngineRun {
             trajectory,
             dt,
-            steps: history.len() - 1,
-            wall_time: start.elapsed(),
-            diagnostics: serde_json::json!({
-                "rows": rows.len(),
-                "process_wall_time_s": process_time.as_secs_f64(),
-                "parse_resample_time_s": parse_time.as_secs_f64(),
-                "input_bytes": input_bytes,
-                "output_bytes": stdout.len(),
-                "protocol": self.spec.protocol,
-                "session": served_by,
-            }),
-            contact,
+            steps,
+            wall_time: Duration::ZERO,
+            diagnostics: serde_json::Value::Null,
+            contact: contact_from_rows(problem, rows),
         })
     }
+}
+
+/// A protocol 3 session: the adapter keeps its world between pushes.
+struct Stepping<'a> {
+    engine: &'a OutsideEngine,
+    /// The problem at `start` (its schedule replaced by the pushes applied).
+    problem: Problem,
+    dt: f64,
+    lease: Lease,
+    applied: Vec<Push>,
+    /// The header line, once the first advance has given it.
+    header: Option<String>,
+    rows: Vec<csv::Record>,
+    state: EngineState,
+    started: Instant,
+    process_time: Duration,
+    parse_time: Duration,
+    output_bytes: usize,
+    /// The request number of each answer, for messages.
+    requests: Vec<u64>,
+    answered_before: u64,
+    /// Set once a request failed: the adapter's world is no longer the
+    /// pushes applied, so the session takes no further request.
+    failed: bool,
+}
+
+impl<'a> Stepping<'a> {
+    /// The cap of an answer that holds only its closing line.
+    const SMALL: Limits = Limits {
+        max_rows: 0,
+        max_bytes: HEADER_BYTES,
+    };
+
+    /// The `start` request of `problem` at `dt`.
+    fn start_doc(
+        engine: &OutsideEngine,
+        problem: &Problem,
+        dt: f64,
+    ) -> serde_json::Map<String, serde_json::Value> {
+        let spec = &engine.spec;
+        let limits = Limits::for_problem(problem, dt);
+        let mut doc = problem_document_v2(&spec.name, problem, &engine.options, dt, limits);
+        let o = doc.as_object_mut().expect("the document is an object");
+        // The schedule is given push by push; the cap is per answer.
+        o.remove("pushes");
+        o.remove("limits");
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "start".into());
+        request.insert("rows".into(), spec.rows.as_str().into());
+        // pushval reads compact lines in answers (the kit writes them).
+        request.insert("compact".into(), true.into());
+        request.insert("problem".into(), doc);
+        request
+    }
+
+    /// The `advance` request of `push`, and the cap of its answer.
+    fn advance_doc(
+        problem: &Problem,
+        dt: f64,
+        push: &Push,
+    ) -> (serde_json::Map<String, serde_json::Value>, Limits) {
+        let one = with_pushes(problem, vec![*push]);
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "advance".into());
+        request.insert("speed".into(), push.speed.into());
+        request.insert("phi".into(), push.phi.into());
+        request.insert("duration".into(), push.duration.into());
+        (request, Limits::for_problem(&one, dt))
+    }
+
+    fn finish_doc() -> serde_json::Map<String, serde_json::Value> {
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "finish".into());
+        request
+    }
+
+    fn timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.engine.spec.timeout_s)
+    }
+
+    fn start(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<Self, ModelError> {
+        let started = Instant::now();
+        let mut lease = Lease::take(&engine.spec).map_err(|e| engine.broken(e))?;
+        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
+        let a = lease
+            .request(
+                Self::start_doc(engine, problem, dt),
+                "start",
+                Close::Ok,
+                Self::SMALL,
+                timeout,
+            )
+            .map_err(|e| engine.broken(e))?;
+        Ok(Self::new(engine, problem, dt, lease, &a, started))
+    }
+
+    fn new(
+        engine: &'a OutsideEngine,
+        problem: &Problem,
+        dt: f64,
+        lease: Lease,
+        started_by: &Answer,
+        started: Instant,
+    ) -> Self {
+        Self {
+            engine,
+            problem: with_pushes(problem, Vec::new()),
+            dt,
+            lease,
+            applied: Vec::new(),
+            header: None,
+            rows: Vec::new(),
+            state: EngineState::initial(problem),
+            started,
+            process_time: started_by.elapsed,
+            parse_time: Duration::ZERO,
+            output_bytes: 0,
+            requests: vec![started_by.request],
+            answered_before: started_by.answered_before,
+            failed: false,
+        }
+    }
+
+    /// A whole run: start, an advance per push and finish, the documents
+    /// written at once and the answers read in order (no wait between
+    /// requests), each answer read as [`EngineSession::advance`] and
+    /// [`EngineSession::finish`] read it.
+    fn run(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        problem.check()?;
+        let started = Instant::now();
+        let mut lease = Lease::take(&engine.spec).map_err(|e| engine.broken(e))?;
+        let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
+        let mut docs = vec![(
+            Self::start_doc(engine, problem, dt),
+            "start",
+            Close::Ok,
+            Self::SMALL,
+        )];
+        for push in &problem.pushes {
+            let (doc, limits) = Self::advance_doc(problem, dt, push);
+            docs.push((doc, "advance", Close::End, limits));
+        }
+        docs.push((Self::finish_doc(), "finish", Close::End, Self::SMALL));
+        let mut answers = lease.pipeline(docs, timeout).into_iter();
+        let mut next = |what: &str| {
+            answers.next().unwrap_or_else(|| {
+                Err(ProcessError {
+                    what: format!("no answer to the {what} request (the session ended earlier)"),
+                    stderr: Vec::new(),
+                })
+            })
+        };
+        let a = next("start").map_err(|e| engine.broken(e))?;
+        let mut s = Self::new(engine, problem, dt, lease, &a, started);
+        for push in &problem.pushes {
+            let a = next("advance").map_err(|e| engine.broken(e))?;
+            s.applied.push(*push);
+            s.absorb(a, push)?;
+        }
+        let a = next("finish").map_err(|e| engine.broken(e))?;
+        s.close(a)
+    }
+
+    /// The rows of one advance's answer (`text`: the header first in the
+    /// first answer), checked against the rows before.
+    fn read(&mut self, text: &str, request: u64, push: &Push) -> Result<(), String> {
+        let problem = with_pushes(&self.problem, self.applied.clone());
+        let first = self.header.is_none();
+        if text
+            .lines()
+            .any(|l| l.trim_start().starts_with(csv::COMPACT))
+        {
+            return self.read_compact(text, request, push, problem);
+        }
+        let (rows, offset) = if first {
+            let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+            self.header = Some(header.trim().to_string());
+            (csv::read(text, problem.body.len()), 0)
+        } else {
+            let full = format!("{}\n{text}", self.header.as_deref().unwrap_or(""));
+            (csv::read(&full, problem.body.len()), 1)
+        };
+        let where_ =
+            |line: usize| format!("line {} of its answer to request {request}", line - offset);
+        let mut rows = rows.map_err(|e| {
+            let at = if e.line > offset {
+                where_(e.line)
+            } else {
+                format!("request {request}")
+            };
+            format!("wrote a malformed row ({at}): {}", e.problem)
+        })?;
+        for r in &mut rows {
+            // Lines counted in the answer.
+            r.line -= offset;
+        }
+        self.take(rows, first, request, push, problem)
+    }
+
+    /// An answer of compact lines (the header first, in the first answer).
+    fn read_compact(
+        &mut self,
+        text: &str,
+        request: u64,
+        push: &Push,
+        problem: Problem,
+    ) -> Result<(), String> {
+        let first = self.header.is_none();
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        if first {
+            let (_, header) = lines.next().unwrap_or((0, ""));
+            self.header = Some(header.trim().to_string());
+        }
+        let header = self.header.as_deref().unwrap_or("");
+        let columns = csv::Columns::of(header, problem.body.len()).map_err(|e| {
+            format!("wrote a header its compact rows cannot use (request {request}): {e}")
+        })?;
+        let mut rows = Vec::new();
+        for (i, l) in lines {
+            let Some(hex) = l.trim().strip_prefix(csv::COMPACT) else {
+                return Err(format!(
+                    "wrote a malformed row (line {} of its answer to request {request}): a text row among compact lines",
+                    i + 1
+                ));
+            };
+            rows.extend(csv::read_compact(hex, &columns, i + 1).map_err(|e| {
+                format!("wrote a malformed compact row (answer to request {request}): {e}")
+            })?);
+        }
+        self.take(rows, first, request, push, problem)
+    }
+
+    /// Checks an advance's rows against the push and the rows before, and
+    /// keeps them.
+    fn take(
+        &mut self,
+        rows: Vec<csv::Record>,
+        first: bool,
+        request: u64,
+        push: &Push,
+        problem: Problem,
+    ) -> Result<(), String> {
+        let where_ = |line: usize| format!("line {line} of its answer to request {request}");
+        let (t0, t1) = *problem.segment_times().last().expect("a push applied");
+        let tol = 1e-9 * t1.max(1.0);
+        if rows.is_empty() {
+            return Err(format!(
+                "answered request {request} (advance {} s to {t1} s) with no row",
+                t0
+            ));
+        }
+        if first && rows[0].numbers[0].abs() > tol {
+            return Err(format!(
+                "{}: the first row is at t = {} s, not at 0 (the first advance's answer starts with the header and the row at t = 0)",
+                where_(rows[0].line),
+                rows[0].numbers[0]
+            ));
+        }
+        let last = rows.last().expect("not empty");
+        if (last.numbers[0] - t1).abs() > tol {
+            return Err(format!(
+                "{}: the answer to request {request} (advance {t0} s to {t1} s) ends at t = {} s, not at the push's end",
+                where_(last.line),
+                last.numbers[0]
+            ));
+        }
+        check::rows(&Bound::of(&problem), self.rows.last(), &rows, |r| {
+            where_(r.line)
+        })
+        .map_err(|e| format!("wrote a row that is not a motion of the push: {e}"))?;
+        let s = rows.last().expect("not empty").numbers;
+        self.state = EngineState {
+            t: s[0],
+            x: s[1],
+            y: s[2],
+            theta: s[3],
+            omega: s[4],
+            v_cm: rigid_cm_velocity(&problem, Some(push), s[3], s[4]),
+        };
+        self.rows.extend(rows);
+        Ok(())
+    }
+}
+
+impl Stepping<'_> {
+    /// Reads an advance's answer for `push` (already in `applied`).
+    fn absorb(&mut self, a: Answer, push: &Push) -> Result<(), ModelError> {
+        let engine = self.engine;
+        self.failed = true;
+        self.process_time += a.elapsed;
+        self.output_bytes += a.stdout.len();
+        self.requests.push(a.request);
+        let parse = Instant::now();
+        let text = std::str::from_utf8(&a.stdout).map_err(|e| {
+            engine.fail(
+                format!(
+                    "wrote an answer to request {} that is not UTF-8 ({e})",
+                    a.request
+                ),
+                &a.stderr,
+            )
+        })?;
+        self.read(text, a.request, push)
+            .map_err(|e| engine.fail(e, &a.stderr))?;
+        self.parse_time += parse.elapsed();
+        self.failed = false;
+        Ok(())
+    }
+
+    /// Reads the finish's answer and returns the run.
+    fn close(mut self, a: Answer) -> Result<EngineRun, ModelError> {
+        let engine = self.engine;
+        if !a.stdout.iter().all(u8::is_ascii_whitespace) {
+            return Err(engine.fail(
+                format!(
+                    "wrote {} bytes before `#end {}` in its answer to request {} (finish), which holds nothing but that line",
+                    a.stdout.len(),
+                    a.request,
+                    a.request
+                ),
+                &a.stderr,
+            ));
+        }
+        self.process_time += a.elapsed;
+        self.requests.push(a.request);
+        let problem = with_pushes(&self.problem, self.applied.clone());
+        problem.check()?;
+        let parse = Instant::now();
+        let mut run = engine
+            .assemble(&problem, self.dt, &self.rows)
+            .map_err(|e| {
+                engine.fail(
+                    format!("wrote rows that do not cover the run: {e}"),
+                    &a.stderr,
+                )
+            })?;
+        self.parse_time += parse.elapsed();
+        run.wall_time = self.started.elapsed();
+        run.diagnostics = serde_json::json!({
+            "rows": self.rows.len(),
+            "process_wall_time_s": self.process_time.as_secs_f64(),
+            "parse_resample_time_s": self.parse_time.as_secs_f64(),
+            "input_bytes": serde_json::Value::Null,
+            "output_bytes": self.output_bytes,
+            "protocol": engine.spec.protocol,
+            "rows_asked": engine.spec.rows.as_str(),
+            "session": {
+                "pid": self.lease.pid(),
+                "answered_before": self.answered_before,
+                "requests": self.requests,
+            },
+            "replays": false,
+        });
+        Ok(run)
+    }
+
+    /// An error once a request of this session has failed.
+    fn usable(&self) -> Result<(), ModelError> {
+        if self.failed {
+            return Err(ModelError::Adapter(format!(
+                "{}: an earlier request of this stepping session failed (its world is no longer the pushes applied): start a new session",
+                self.engine.who()
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl EngineSession for Stepping<'_> {
+    fn state(&self) -> EngineState {
+        self.state
+    }
+
+    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        self.usable()?;
+        self.failed = true;
+        let engine = self.engine;
+        let (doc, limits) = Self::advance_doc(&self.problem, self.dt, push);
+        let timeout = self.timeout();
+        let a = self
+            .lease
+            .request(doc, "advance", Close::End, limits, timeout)
+            .map_err(|e| engine.broken(e))?;
+        self.applied.push(*push);
+        self.absorb(a, push)
+    }
+
+    fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {
+        self.usable()?;
+        let engine = self.engine;
+        let timeout = self.timeout();
+        let a = self
+            .lease
+            .request(
+                Self::finish_doc(),
+                "finish",
+                Close::End,
+                Self::SMALL,
+                timeout,
+            )
+            .map_err(|e| engine.broken(e))?;
+        self.close(a)
+    }
+
+    fn steps_taken(&self) -> usize {
+        engine_steps(&self.rows)
+    }
+}
+
+/// The engine steps `rows` took: their `steps` column where they have one
+/// (rows at the sample times), else one a row after the first.
+fn engine_steps(rows: &[csv::Record]) -> usize {
+    rows.iter()
+        .skip(1)
+        .map(|r| r.steps.map_or(1, |n| n.round().max(0.0) as usize))
+        .sum()
 }
 
 /// The contact record of an engine's rows where they carry `load_i`

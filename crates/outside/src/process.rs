@@ -64,7 +64,7 @@ pub fn run_process(
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     let mark = Mark::apply(&mut command);
-    let mut child = command.spawn().map_err(|e| ProcessError {
+    let mut child = tree::spawn(&mut command).map_err(|e| ProcessError {
         what: format!("could not start `{}`: {e}", program.display()),
         stderr: Vec::new(),
     })?;
@@ -78,8 +78,12 @@ pub fn run_process(
         let _ = stdin.write_all(&input);
     });
     let deadline = start + timeout;
-    let fail = |child: &mut std::process::Child, what: String| {
+    let fail = |child: &mut std::process::Child, what: String, timed_out: bool| {
         let _ = tree::end(child, &mark);
+        if timed_out {
+            // What it left behind outside its group and environment.
+            tree::end_orphans();
+        }
         ProcessError {
             what,
             stderr: err.get(Duration::from_millis(200)),
@@ -99,12 +103,13 @@ pub fn run_process(
                     "still running after its timeout of {} s: killed",
                     timeout.as_secs_f64()
                 ),
+                true,
             ));
         }
         match out.next(deadline.min(now + EXIT_POLL)) {
             Some(Piece::Bytes(b)) => {
                 if let Err(what) = meter.add(&b) {
-                    return Err(fail(&mut child, what));
+                    return Err(fail(&mut child, what, false));
                 }
                 stdout.extend_from_slice(&b);
             }
@@ -126,6 +131,7 @@ pub fn run_process(
                     "closed its standard output but was still running after its timeout of {} s: killed",
                     timeout.as_secs_f64()
                 ),
+                true,
             ));
         }
         std::thread::sleep(pause.min(deadline - now));

@@ -16,11 +16,37 @@
 //! called at a timeout, at a cap, when a session ends, and after every
 //! normal exit, so a daemon an adapter left behind does not outlive its run.
 //!
-//! The limit: a descendant that clears its environment, leaves the process
-//! group and whose parent has already exited is not found.
+//! A descendant that clears its environment, leaves the process group and
+//! whose parent has already exited is not found by [`end`]; on Linux it has
+//! been re-parented to pushval. [`end_orphans`] ends those: every child of
+//! pushval that is not an adapter it started (a registry of the adapters
+//! not yet reaped, filled by [`spawn`]) and not in pushval's own process
+//! group (so a process another part of pushval started is left alone), and
+//! their descendants. It runs at every timeout and when the sessions are
+//! shut down before pushval exits. Its limit: an orphan of an adapter still
+//! running (an intermediate process exited) is ended too if a timeout
+//! happens meanwhile.
 
 use std::process::{Child, Command, ExitStatus};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// The adapters pushval started and has not reaped (their pids): the
+/// children of pushval that are not orphans.
+static ROOTS: Mutex<Vec<u32>> = Mutex::new(Vec::new());
+
+fn roots() -> MutexGuard<'static, Vec<u32>> {
+    ROOTS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Starts `command` (set up with [`Mark::apply`]) and registers it as an
+/// adapter, at once: [`end_orphans`] never takes it for an orphan.
+pub(crate) fn spawn(command: &mut Command) -> std::io::Result<Child> {
+    let mut g = roots();
+    let child = command.spawn()?;
+    g.push(child.id());
+    Ok(child)
+}
 
 /// The environment variable marking an adapter's processes.
 pub(crate) const MARK: &str = "PUSHVAL_ADAPTER_RUN";
@@ -67,7 +93,21 @@ pub(crate) fn end(child: &mut Child, mark: &Mark) -> std::io::Result<ExitStatus>
     let _ = rustix::process::kill_process_group(root, rustix::process::Signal::KILL);
     // The adapter too, should it have left its group.
     let _ = child.kill();
-    child.wait()
+    let status = child.wait();
+    let id = child.id();
+    roots().retain(|&p| p != id);
+    status
+}
+
+/// Ends every process re-parented to pushval (see the module docs) and
+/// their descendants, and reaps them. Nothing to do off Linux (orphans go
+/// to init there).
+pub(crate) fn end_orphans() {
+    #[cfg(target_os = "linux")]
+    {
+        let g = roots();
+        linux::end_orphans(&g);
+    }
 }
 
 /// Whether `child` has exited, without reaping it (its pid stays its own).
@@ -170,6 +210,86 @@ mod linux {
             .collect()
     }
 
+    /// The children of pushval that are orphans: not in `roots`, not in
+    /// pushval's own process group.
+    fn orphans(procs: &HashMap<i32, Proc>, roots: &[u32], me: i32, group: i32) -> Vec<i32> {
+        procs
+            .iter()
+            .filter(|(&pid, p)| p.ppid == me && p.pgrp != group && !roots.contains(&(pid as u32)))
+            .map(|(&pid, _)| pid)
+            .collect()
+    }
+
+    pub(super) fn end_orphans(roots: &[u32]) {
+        let me = rustix::process::getpid().as_raw_nonzero().get();
+        let group = rustix::process::getpgrp().as_raw_nonzero().get();
+        let mut killed: HashSet<i32> = HashSet::new();
+        for _ in 0..ROUNDS {
+            let procs = all();
+            let mut found: Vec<i32> = orphans(&procs, roots, me, group)
+                .into_iter()
+                .filter(|pid| !killed.contains(pid))
+                .collect();
+            // And their descendants, by parent links (stopped first: a
+            // stopped process neither forks nor dies).
+            let mut frontier: HashSet<i32> = found
+                .iter()
+                .copied()
+                .chain(killed.iter().copied())
+                .collect();
+            loop {
+                let next: Vec<i32> = procs
+                    .iter()
+                    .filter(|(pid, p)| frontier.contains(&p.ppid) && !frontier.contains(pid))
+                    .map(|(&pid, _)| pid)
+                    .collect();
+                if next.is_empty() {
+                    break;
+                }
+                frontier.extend(&next);
+                found.extend(next.into_iter().filter(|pid| !killed.contains(pid)));
+            }
+            if found.is_empty() {
+                break;
+            }
+            for pid in found {
+                if let Some(p) = Pid::from_raw(pid) {
+                    let _ = kill_process(p, Signal::STOP);
+                    killed.insert(pid);
+                }
+            }
+        }
+        for &pid in &killed {
+            if let Some(p) = Pid::from_raw(pid) {
+                let _ = kill_process(p, Signal::KILL);
+            }
+        }
+        reap(killed, me);
+    }
+
+    /// Reaps the killed processes that are (or become, as their parents
+    /// die) pushval's children; the others are their parents' to reap.
+    fn reap(mut killed: HashSet<i32>, me: i32) {
+        let deadline = Instant::now() + REAP_WAIT;
+        let mut pause = Duration::from_micros(100);
+        while !killed.is_empty() && Instant::now() < deadline {
+            killed.retain(|&pid| match stat(pid) {
+                None => false,
+                Some(p) if p.zombie && p.ppid == me => {
+                    if let Some(p) = Pid::from_raw(pid) {
+                        let _ = waitpid(Some(p), WaitOptions::NOHANG);
+                    }
+                    false
+                }
+                Some(_) => true,
+            });
+            if !killed.is_empty() {
+                std::thread::sleep(pause);
+                pause = (pause * 2).min(Duration::from_millis(10));
+            }
+        }
+    }
+
     pub(super) fn end_descendants(root: Pid, mark: &Mark) {
         let me = rustix::process::getpid().as_raw_nonzero().get();
         // Stop first, kill after: a stopped process neither forks nor dies,
@@ -200,25 +320,6 @@ mod linux {
                 let _ = kill_process(p, Signal::KILL);
             }
         }
-        // Reap the killed processes that are (or become, as their parents
-        // die) pushval's children; the others are their parents' to reap.
-        let deadline = Instant::now() + REAP_WAIT;
-        let mut pause = Duration::from_micros(100);
-        while !killed.is_empty() && Instant::now() < deadline {
-            killed.retain(|&pid| match stat(pid) {
-                None => false,
-                Some(p) if p.zombie && p.ppid == me => {
-                    if let Some(p) = Pid::from_raw(pid) {
-                        let _ = waitpid(Some(p), WaitOptions::NOHANG);
-                    }
-                    false
-                }
-                Some(_) => true,
-            });
-            if !killed.is_empty() {
-                std::thread::sleep(pause);
-                pause = (pause * 2).min(Duration::from_millis(10));
-            }
-        }
+        reap(killed, me);
     }
 }

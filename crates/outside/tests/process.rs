@@ -124,6 +124,30 @@ fn a_timeout_ends_every_descendant_setsid_or_not() {
     }
 }
 
+/// The escape the process group, the mark and the parent links all miss
+/// (issue 40): a child that calls setsid() and execs with an empty
+/// environment, whose parent (a shell in the background) has exited, so
+/// it is re-parented to this process (a child subreaper). At the adapter's
+/// timeout it is ended too.
+#[test]
+fn a_timeout_ends_an_orphan_with_an_empty_environment() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("orphan");
+    let escape = "import os; os.setsid(); os.execve('/bin/sleep', ['sleep', '300'], {})";
+    let script = format!(
+        "(python3 -c \"{escape}\" </dev/null >/dev/null 2>&1 & echo $! > '{}'); sleep 1000",
+        f.display()
+    );
+    let (spec, p, options) = engine(dir.path(), &["sh", "-c", &script], "timeout_s = 2\n");
+    let e = OutsideEngine::new(spec, &options)
+        .run(&p, 1e-3)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("timeout of 2 s: killed"), "{e}");
+    let pid: u32 = std::fs::read_to_string(&f).unwrap().trim().parse().unwrap();
+    assert!(gone(pid), "the orphan {pid} survived the timeout");
+}
+
 /// An adapter that answers and exits 0 but leaves a daemon behind (double
 /// fork and setsid: re-parented away from the adapter): the daemon ends
 /// with the run.
@@ -193,12 +217,22 @@ fn each_engine_receives_its_protocol_version() {
 fn protocol_and_session_keys_are_checked() {
     let file = Path::new("/proj/pushval.toml");
     for (extra, key, what) in [
-        ("protocol = 3\n", "engine.a.protocol", "must be 1"),
+        ("protocol = 4\n", "engine.a.protocol", "must be 1"),
+        (
+            "protocol = 3\n",
+            "engine.a.protocol",
+            "runs in a session: set session = true",
+        ),
         ("session = \"yes\"\n", "engine.a.session", "true or false"),
         (
             "session = true\nprotocol = 1\n",
             "engine.a.protocol",
-            "needs protocol 2",
+            "needs protocol 2 or 3",
+        ),
+        (
+            "session = true\nrows = \"all\"\n",
+            "engine.a.rows",
+            "\"samples\" or \"steps\"",
         ),
     ] {
         let e = Config::from_toml(&format!("[engine.a]\ncommand = [\"x\"]\n{extra}"), file)

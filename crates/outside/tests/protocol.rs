@@ -114,3 +114,32 @@ fn rows_become_steps_covering_the_run() {
     let e = history_from_rows(&p, &csv::read(&text, 0).unwrap()).unwrap_err();
     assert!(e.contains("line 7: column `t`"), "{e}");
 }
+
+/// Compact lines (protocol 3): little-endian binary64 in hexadecimal, 16
+/// digits a number, whole rows. 1.5 is 0x3FF8000000000000, so its digits
+/// little-endian are `000000000000f83f`; 0.0 is sixteen zeros.
+#[test]
+fn compact_rows_decode_exactly_and_name_what_is_wrong() {
+    let zero = "0000000000000000";
+    let one_and_half = "000000000000f83f";
+    let columns = csv::Columns::of("t, x,y,theta,omega,steps", 1).unwrap();
+    let line = format!("{zero}{one_and_half}{zero}{zero}{zero}{one_and_half}");
+    let rows = csv::read_compact(&line, &columns, 7).unwrap();
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0].numbers, [0.0, 1.5, 0.0, 0.0, 0.0]);
+    assert_eq!((rows[0].steps, rows[0].line), (Some(1.5), 7));
+    // NaN (0x7FF8000000000000) in `theta`.
+    let nan = "000000000000f87f";
+    let bad = format!("{zero}{zero}{zero}{nan}{zero}{zero}");
+    let e = csv::read_compact(&bad, &columns, 3).unwrap_err();
+    assert!(
+        e.contains("line 3, row 1 of the compact line: column `theta`: NaN is not finite"),
+        "{e}"
+    );
+    let e = csv::read_compact(&line[..line.len() - 16], &columns, 2).unwrap_err();
+    assert!(e.contains("is not whole rows of 6 numbers"), "{e}");
+    let e = csv::read_compact(&line.replace('f', "g"), &columns, 2).unwrap_err();
+    assert!(e.contains("not hexadecimal"), "{e}");
+    let e = csv::Columns::of("t,x,y,theta", 1).unwrap_err();
+    assert!(e.contains("lacks the column `omega`"), "{e}");
+}

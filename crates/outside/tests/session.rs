@@ -40,7 +40,7 @@ fn fixture() -> String {
 fn spec(dir: &Path, name: &str, extra: &str) -> Arc<Spec> {
     let log = dir.join("pids").display().to_string();
     let text = format!(
-        "[engine.{name}]\ncommand = [\"python3\", {:?}, \"--pid-log\", {log:?}]\nsession = true\ntimeout_s = 20\n{extra}",
+        "[engine.{name}]\ncommand = [\"python3\", {:?}, \"--pid-log\", {log:?}]\nsession = true\nprotocol = 2\ntimeout_s = 20\n{extra}",
         fixture()
     );
     let cfg = Config::from_toml(&text, &dir.join("pushval.toml")).unwrap();
@@ -48,7 +48,7 @@ fn spec(dir: &Path, name: &str, extra: &str) -> Arc<Spec> {
     assert_eq!(
         (s.protocol, s.session),
         (2, true),
-        "session implies protocol 2"
+        "a whole-document session"
     );
     Arc::new(s)
 }
@@ -159,7 +159,8 @@ fn an_error_answer_fails_one_run_and_the_session_goes_on() {
     ok.run(&p, 1e-3).unwrap();
     let e = bad.run(&p, 1e-3).unwrap_err().to_string();
     assert!(
-        e.contains("outside engine \"refusing\"") && e.contains("`#error deliberate failure`"),
+        e.contains("outside engine \"refusing\"")
+            && e.contains("answered request 2 (problem) with `#error 2 deliberate failure`"),
         "{e}"
     );
     assert!(e.contains("problem 2 (error)"), "its standard error: {e}");
@@ -310,6 +311,74 @@ fn parallel_runs_share_at_most_one_session_per_core() {
         distinct.len() <= cores,
         "{} processes, {cores} cores",
         distinct.len()
+    );
+    shutdown_sessions();
+}
+
+/// Request numbers (issue 40): an answer closed with another request's
+/// number, with none, or a second answer to an earlier document, is a
+/// protocol error naming the engine and the request; the session is
+/// ended and the next run starts a new process.
+#[test]
+fn answers_must_carry_their_request_number() {
+    let _g = serial();
+    let dir = tempfile::tempdir().unwrap();
+    let s = spec(dir.path(), "numbered", "");
+    let (p, options) = problem();
+    let run = |mode: &str| {
+        OutsideEngine::new(s.clone(), &with(&options, &[("fixture", json!(mode))])).run(&p, 1e-3)
+    };
+    // A fresh process for each case: its first document is request 1.
+    let e = run("wrong_number").unwrap_err().to_string();
+    assert!(
+        e.contains("outside engine \"numbered\"")
+            && e.contains("closed its answer with request number 2 (`#end 2`) while request 1 (problem) was asked"),
+        "{e}"
+    );
+    let e = run("no_number").unwrap_err().to_string();
+    assert!(
+        e.contains(
+            "closed its answer to request 1 (problem) with `#end`, which carries no request number"
+        ),
+        "{e}"
+    );
+    // Answered twice: the first run reads the first answer, the second
+    // run finds the second one where its own should be.
+    run("twice").unwrap();
+    std::thread::sleep(Duration::from_millis(200));
+    let e = run("ok").unwrap_err().to_string();
+    assert!(
+        e.contains("outside engine \"numbered\"")
+            && e.contains("before request 2 was sent (a second answer"),
+        "{e}"
+    );
+    let logged = pids(dir.path());
+    assert_eq!(logged.len(), 3, "{logged:?}");
+    assert!(
+        logged[0] != logged[1] && logged[1] != logged[2],
+        "each broken session was replaced: {logged:?}"
+    );
+    shutdown_sessions();
+}
+
+/// A finite row far from its neighbours (x = 1e300 between two sample
+/// times) is bad output naming its line, not a pass.
+#[test]
+fn a_row_beyond_what_the_push_allows_names_its_line() {
+    let _g = serial();
+    let dir = tempfile::tempdir().unwrap();
+    let s = spec(dir.path(), "jumping", "");
+    let (p, options) = problem();
+    let e = OutsideEngine::new(s, &with(&options, &[("fixture", json!("far_row"))]))
+        .run(&p, 1e-3)
+        .unwrap_err()
+        .to_string();
+    // The header is line 1, rows[3] line 5, the inserted row line 6.
+    assert!(
+        e.contains("outside engine \"jumping\"")
+            && e.contains("line 6: the centre of mass jumps 1.0")
+            && e.contains("more than the push allows"),
+        "{e}"
     );
     shutdown_sessions();
 }
