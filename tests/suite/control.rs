@@ -355,3 +355,46 @@ fn loop_writes_the_applied_push_and_loop_json() {
         assert!((-1e-9..=FRAC_PI_2 + 1e-9).contains(&phi), "{l}");
     }
 }
+
+#[test]
+fn a_protocol_1_adapter_without_the_kit_is_a_plant_under_loop() {
+    // plain_protocol1.py speaks protocol 1 with no kit: it cannot step, so
+    // the loop replays the schedule applied so far every period, and says so.
+    let dir = tempfile::tempdir().unwrap();
+    let engines = dir.path().join("pushval.toml");
+    std::fs::write(
+        &engines,
+        format!(
+            "[engine.plain]\ncommand = [\"python3\", \"{}\"]\norder = 1\ndt = 0.001\ntimeout_s = 60\nversion = \"plain_protocol1.py\"\n",
+            root().join("adapters/python/plain_protocol1.py").display()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("loop");
+    let st = pushval()
+        .arg("--engines")
+        .arg(&engines)
+        .arg("loop")
+        .arg(root().join("scenarios/paper-square-v1.0.toml"))
+        .args([
+            "--goal=0.3,0.4,0.3",
+            "--speed",
+            "1.0",
+            "--engine",
+            "plain",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
+    assert_eq!(doc["success"], true);
+    assert_eq!(doc["engine_replayed_each_period"], true);
+    assert!(doc["steps"].as_u64().unwrap() >= 5, "{doc}");
+}
