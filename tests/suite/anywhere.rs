@@ -326,7 +326,9 @@ fn init_then_every_readme_line_in_an_empty_folder() {
             );
         }
     }
-    for cmd in ["(gate)", "study", "run", "fit", "track", "power"] {
+    for cmd in [
+        "(gate)", "study", "run", "fit", "track", "power", "plan", "loop",
+    ] {
         assert!(ran.contains(&cmd), "the README runs no `{cmd}`: {lines:?}");
     }
     let rows = |f: &str| {
@@ -341,9 +343,18 @@ fn init_then_every_readme_line_in_an_empty_folder() {
         "track/track.csv",
         "results/friction_models/my_engine/map.csv",
         "results/friction_models/my_engine/coulomb_fit.csv",
+        "loop/trajectory.csv",
+        "plan/plan.toml",
     ] {
         assert!(rows(f) > 0, "{f}: no rows");
     }
+    let looped: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("loop/loop.json")).unwrap()).unwrap();
+    assert_eq!(looped["success"], true, "{looped}");
+    assert_eq!(
+        looped["engine_replayed_each_period"], false,
+        "the kit steps: {looped}"
+    );
     let power = std::fs::read_to_string(d.join("power/gate_power.csv")).unwrap();
     assert!(
         power
