@@ -20,6 +20,7 @@ mod properties;
 mod readme;
 mod report;
 mod scenarios;
+mod sessions_parity;
 mod stress;
 mod study;
 mod track;

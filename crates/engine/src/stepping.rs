@@ -756,7 +756,7 @@ impl<W: PlateWorld> crate::EngineSession for PlateSession<'_, W> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pushval_model::{Body, Initial, Support, Switching, Vec2};
+    use pushval_model::{Body, Initial, Push, Support, Switching, Vec2};
 
     /// An object carried rigidly by the pusher: it moves at the commanded
     /// velocity, turns at a constant rate `w` and rises linearly; every
@@ -1022,5 +1022,107 @@ mod tests {
         for (got, want) in run.segment_tail_loads[1].iter().zip([1.0, 2.0, 3.0]) {
             assert!((got - want).abs() < 1e-12);
         }
+    }
+
+    /// A session that applies fewer pushes than the start's schedule
+    /// announced ends with the run of the pushes applied: its run tail,
+    /// loads and samples are those of a run of that schedule, bit for bit.
+    #[test]
+    fn finish_gathers_the_run_of_the_pushes_applied() {
+        let one = Push {
+            duration: 1.0,
+            speed: 0.1,
+            phi: 0.0,
+        };
+        let two = Push {
+            duration: 0.5,
+            speed: 0.1,
+            phi: 0.4,
+        };
+        let announced = problem(vec![one, two]);
+        let mut w = carried(0.7, None);
+        let start = w.state;
+        let mut s = Stepping::new(&mut w, &announced, CFG, start);
+        s.advance(&one).unwrap();
+        assert_eq!(s.time(), 1.0);
+        assert_eq!(s.steps(), 10);
+        let state = s.engine_state();
+        assert!((state.theta - 0.7).abs() < 1e-12 && state.omega == 0.7);
+        let (_, got, applied) = s.finish();
+        assert_eq!(applied.pushes, vec![one]);
+        let mut w = carried(0.7, None);
+        let start = w.state;
+        let want = run_pushes(&mut w, &problem(vec![one]), &CFG, start).unwrap();
+        assert_eq!(got, want);
+        assert_eq!(
+            got.trajectory(&applied),
+            want.trajectory(&problem(vec![one]))
+        );
+    }
+
+    /// The world is told whether the start's schedule has a push after the
+    /// one it lays out, and its own step lengths are kept, the last one
+    /// ending at the segment's end.
+    #[test]
+    fn worlds_lay_out_their_steps_knowing_what_follows() {
+        struct Laid {
+            inner: Carried,
+            followed: Vec<bool>,
+        }
+        impl PlateWorld for Laid {
+            type State = Plate;
+            fn plate(&self, s: &Plate) -> Plate {
+                *s
+            }
+            fn segment_steps(
+                &mut self,
+                _: &Push,
+                n: usize,
+                h: f64,
+                followed: bool,
+            ) -> Option<Vec<f64>> {
+                self.followed.push(followed);
+                let mut l = vec![0.25 * h, 0.75 * h];
+                l.extend(std::iter::repeat_n(h, n - 1));
+                Some(l)
+            }
+            fn drive(&mut self, s: &Plate, v: [f64; 2], h: f64) -> f64 {
+                self.inner.drive(s, v, h)
+            }
+            fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+                self.inner.step(h, t1)
+            }
+            fn state(&mut self, s: &Plate) -> Plate {
+                self.inner.state(s)
+            }
+            fn support_forces(
+                &mut self,
+                _: &Plate,
+                _: f64,
+            ) -> Result<Option<SupportForces>, ModelError> {
+                Ok(None)
+            }
+        }
+        let push = Push {
+            duration: 0.3,
+            speed: 0.1,
+            phi: 0.0,
+        };
+        let p = problem(vec![push, push]);
+        let mut w = Laid {
+            inner: carried(0.0, None),
+            followed: Vec::new(),
+        };
+        let start = w.inner.state;
+        let run = run_pushes(&mut w, &p, &CFG, start).unwrap();
+        assert_eq!(w.followed, vec![true, false]);
+        // 3 steps of 0.1 each, the first cut in two: 4 per segment.
+        assert_eq!(run.steps, 8);
+        let h = &run.history;
+        assert!((h[1].t1 - 0.025).abs() < 1e-15 && (h[2].t1 - 0.1).abs() < 1e-15);
+        assert_eq!(h[4].t1, 0.3);
+        assert_eq!(h[5].t0, 0.3);
+        assert_eq!(h[8].t1, 0.6);
+        assert!(run.contact.is_none());
     }
 }
