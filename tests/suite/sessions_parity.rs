@@ -8,9 +8,18 @@ use pushval_model::{ModelError, Problem};
 
 use crate::common::*;
 
-/// Engines of this build that are still advanced by re-running the
-/// schedule applied so far (a `ReplaySession`): correct at N times the cost.
-const REPLAYING: &[&str] = &[];
+/// Engines that are still advanced by re-running the schedule applied so
+/// far (a `ReplaySession`): correct at N times the cost. They come in with
+/// the `jolt`, `physx` and `mujoco` features.
+const REPLAYING: &[&str] = &[
+    "jolt_box",
+    "jolt_feet",
+    "physx_patch",
+    "physx_two_directional",
+    "physx_one_directional",
+    "mujoco_pyramidal",
+    "mujoco_elliptic",
+];
 
 /// The run with its wall-clock time cleared (the only field that may differ).
 fn timeless(r: Result<EngineRun, ModelError>) -> Result<EngineRun, String> {

@@ -134,18 +134,17 @@ pub trait PlateWorld {
         p.theta + 0.5 * h * p.omega
     }
 
-    /// The lengths (s) of the steps of a segment of `push`, where the world
-    /// lays them out itself; `n` steps of `h = duration / n` otherwise (None,
-    /// the default). `followed` says whether the start's schedule has a push
-    /// after this one (a switch follows). The last step ends exactly at the
-    /// segment's end; the others at the previous end plus their length.
+    /// The steps of a segment of `push`, where the world lays them out
+    /// itself; `n` steps of `h = duration / n` otherwise (None, the
+    /// default). `followed` says whether the start's schedule has a push
+    /// after this one (a switch follows).
     fn segment_steps(
         &mut self,
         _push: &Push,
         _n: usize,
         _h: f64,
         _followed: bool,
-    ) -> Option<Vec<f64>> {
+    ) -> Option<StepLayout> {
         None
     }
 
@@ -225,6 +224,9 @@ pub enum TailSteps {
     Floor,
     /// The last `max(n / 5, 1)` steps (integer division).
     LastFifth,
+    /// The steps whose middle `(t0 + t1) / 2` is in the segment's last
+    /// fifth of time (possibly none: the tail means are then zero).
+    ByTime,
 }
 
 /// How the steps of a tail are weighted in its means.
@@ -347,6 +349,18 @@ impl Stepped {
             ..Default::default()
         }
     }
+}
+
+/// A segment's steps as a world lays them out ([`PlateWorld::segment_steps`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepLayout {
+    /// Step lengths (s): each step starts where the last ended (the first
+    /// at the segment's start) and ends its length later, the last one
+    /// exactly at the segment's end.
+    Lengths(Vec<f64>),
+    /// Each step's start and end times (s), verbatim (an engine whose clock
+    /// keeps its own time, e.g. in whole nanoseconds).
+    Spans(Vec<(f64, f64)>),
 }
 
 /// One step as the loop plans it, handed to [`PlateWorld::drive_step`].
@@ -488,19 +502,30 @@ impl<W: PlateWorld> Stepping<W> {
         let t_seg = self.t_seg;
         let n = (push.duration / cfg.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
         let nominal_h = push.duration / n as f64;
-        let lengths = self.world.segment_steps(push, n, nominal_h, followed);
-        let n_steps = lengths.as_ref().map_or(n, Vec::len);
+        let layout = self.world.segment_steps(push, n, nominal_h, followed);
+        let n_steps = match &layout {
+            None => n,
+            Some(StepLayout::Lengths(l)) => l.len(),
+            Some(StepLayout::Spans(s)) => s.len(),
+        };
         let tail_from = match cfg.tail {
             TailSteps::Floor => ((1.0 - TAIL) * n_steps as f64).floor() as usize,
-            TailSteps::LastFifth => n_steps - (n_steps / 5).max(1),
+            TailSteps::LastFifth | TailSteps::ByTime => n_steps - (n_steps / 5).max(1),
         };
+        // A tail by time: the steps whose middle is in the segment's last
+        // fifth (of its duration, back from the end of its last step).
+        let seg_end = match &layout {
+            Some(StepLayout::Spans(s)) => s.last().map_or(t_seg, |s| s.1),
+            _ => t_seg + push.duration,
+        };
+        let tail_time = seg_end - TAIL * push.duration;
         let (mut acc_w, mut acc_w2, mut acc_t) = (0.0, 0.0, 0.0);
         let mut acc_n = vec![0.0; n_sup];
         let mut acc_f = vec![0.0; n_sup];
         let mut min_slip = vec![f64::INFINITY; n_sup];
         let mut t_prev = t_seg;
         for k in 0..n_steps {
-            let (t0, t1, h) = match &lengths {
+            let (t0, t1, h) = match &layout {
                 None => {
                     let t0 = t_seg + k as f64 * nominal_h;
                     let t1 = if k + 1 == n {
@@ -513,7 +538,11 @@ impl<W: PlateWorld> Stepping<W> {
                     };
                     (t0, t1, nominal_h)
                 }
-                Some(lengths) => {
+                Some(StepLayout::Spans(spans)) => {
+                    let (t0, t1) = spans[k];
+                    (t0, t1, t1 - t0)
+                }
+                Some(StepLayout::Lengths(lengths)) => {
                     let t0 = t_prev;
                     let t1 = if k + 1 == n_steps {
                         t_seg + push.duration
@@ -536,7 +565,7 @@ impl<W: PlateWorld> Stepping<W> {
                 t1,
                 h,
                 nominal_h,
-                closing: lengths.is_some() && followed && k + 1 == n_steps,
+                closing: layout.is_some() && followed && k + 1 == n_steps,
                 push: *push,
             };
             let drift = self.world.drive_step(&self.state, &plan);
@@ -556,7 +585,10 @@ impl<W: PlateWorld> Stepping<W> {
             let p = self.world.plate(&self.state);
             self.out.max_tilt = self.out.max_tilt.max(p.tilt);
             self.out.max_lift = self.out.max_lift.max((p.z - cfg.z_rest).abs());
-            let in_tail = k >= tail_from;
+            let in_tail = match cfg.tail {
+                TailSteps::ByTime => 0.5 * (t0 + t1) >= tail_time,
+                _ => k >= tail_from,
+            };
             // Forces are read on every step (for the per-sample loads); the
             // run tail and the smallest loads are taken at `finish`.
             let forces = self.world.support_forces(&self.state, h)?;
@@ -592,6 +624,12 @@ impl<W: PlateWorld> Stepping<W> {
             self.out.history.push(PlateStep::new(j, t0, t1, &p));
         }
         let out = &mut self.out;
+        // Only a tail by time can be empty (the others hold a step at least).
+        let acc_t = if acc_t > 0.0 {
+            acc_t
+        } else {
+            f64::MIN_POSITIVE
+        };
         let mean = acc_w / acc_t;
         out.segment_tail_omega.push(mean);
         out.segment_tail_omega_std
@@ -672,7 +710,13 @@ impl<W: PlateWorld + ?Sized> PlateWorld for &mut W {
     fn heading(&self, state: &Self::State, h: f64) -> f64 {
         (**self).heading(state, h)
     }
-    fn segment_steps(&mut self, push: &Push, n: usize, h: f64, followed: bool) -> Option<Vec<f64>> {
+    fn segment_steps(
+        &mut self,
+        push: &Push,
+        n: usize,
+        h: f64,
+        followed: bool,
+    ) -> Option<StepLayout> {
         (**self).segment_steps(push, n, h, followed)
     }
     fn drive_step(&mut self, state: &Self::State, plan: &StepPlan) -> f64 {
@@ -1080,11 +1124,11 @@ mod tests {
                 n: usize,
                 h: f64,
                 followed: bool,
-            ) -> Option<Vec<f64>> {
+            ) -> Option<StepLayout> {
                 self.followed.push(followed);
                 let mut l = vec![0.25 * h, 0.75 * h];
                 l.extend(std::iter::repeat_n(h, n - 1));
-                Some(l)
+                Some(StepLayout::Lengths(l))
             }
             fn drive(&mut self, s: &Plate, v: [f64; 2], h: f64) -> f64 {
                 self.inner.drive(s, v, h)

@@ -14,7 +14,7 @@ use crate::idioms::{support_force, LawContext};
 use crate::RawRun;
 use crate::{EngineSettings, FrictionModel, FrictionVelocity};
 use pushval_engine::stepping::{
-    Plate, PlateWorld, StepLoop, StepPlan, Stepped, Stepping, SupportForces,
+    Plate, PlateWorld, StepLayout, StepLoop, StepPlan, Stepped, Stepping, SupportForces,
 };
 use pushval_model::{ModelError, Problem, Push};
 
@@ -286,7 +286,7 @@ impl PlateWorld for World2d {
         n: usize,
         h: f64,
         followed: bool,
-    ) -> Option<Vec<f64>> {
+    ) -> Option<StepLayout> {
         let leapfrog = self.friction_velocity == FrictionVelocity::Leapfrog;
         let eps = self.switch_step_fraction * h;
         let closing = leapfrog && eps > 0.0 && followed;
@@ -311,7 +311,7 @@ impl PlateWorld for World2d {
         self.closing = closing;
         self.eps = eps;
         self.nodes = [(f64::NAN, f64::NAN); 2];
-        Some(lengths)
+        Some(StepLayout::Lengths(lengths))
     }
 
     fn drive_step(&mut self, state: &State, plan: &StepPlan) -> f64 {
