@@ -10,8 +10,10 @@ use crate::common::*;
 
 /// Engines that are still advanced by re-running the schedule applied so
 /// far (a `ReplaySession`): correct at N times the cost. They come in with
-/// the `jolt`, `physx` and `mujoco` features.
+/// the `avian`, `jolt`, `physx` and `mujoco` features.
 const REPLAYING: &[&str] = &[
+    "avian2d",
+    "avian3d",
     "jolt_box",
     "jolt_feet",
     "physx_patch",
