@@ -22,6 +22,7 @@ mod readme;
 mod report;
 mod scenarios;
 mod sessions;
+mod sessions_parity;
 mod stress;
 mod study;
 mod track;

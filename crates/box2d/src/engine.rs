@@ -2,9 +2,10 @@
 //! Coulomb forces, gateable) and `box2d_motor_joint` (Box2D's top-down
 //! friction idiom, informational).
 
+use pushval_engine::stepping::{PlateFinish, PlateSession};
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys, COULOMB,
+    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -133,22 +134,46 @@ impl Engine for Box2dModel {
             Friction::MotorJoint => Some(&Box2dMotorJoint),
         }
     }
+    /// [`run_via_session`]: the world of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = Box2dSimulator::new(Box2dSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The Box2D world through the shared stepping loop
+    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
+    /// with the first push of `problem`'s schedule.
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let started = std::time::Instant::now();
+        let sim = Box2dSimulator::new(Box2dSettings {
             dt,
             ..self.settings
-        })
-        .run(problem)?;
-        Ok(EngineRun {
-            contact: None,
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "max_joint_drift": r.max_joint_drift,
-                "steps": r.steps,
-            }),
-            trajectory: r.trajectory,
-        })
+        });
+        let stepping = match sim
+            .settings
+            .check()
+            .and_then(|()| crate::world::start(problem, &sim.settings))
+        {
+            Ok(s) => s,
+            Err(e) => return Some(Err(e)),
+        };
+        let finish: PlateFinish<'a, _> = Box::new(move |world, stepped, problem| {
+            let r = sim.box2d_run(problem, crate::world::raw_run(world, &stepped), started);
+            Ok(EngineRun {
+                contact: None,
+                dt,
+                steps: r.steps,
+                wall_time: r.wall_time,
+                diagnostics: serde_json::json!({
+                    "max_joint_drift": r.max_joint_drift,
+                    "steps": r.steps,
+                }),
+                trajectory: r.trajectory,
+            })
+        });
+        Some(Ok(Box::new(PlateSession::new(stepping, finish))))
     }
 }

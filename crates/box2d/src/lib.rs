@@ -204,12 +204,26 @@ impl Box2dSimulator {
         let start = std::time::Instant::now();
         problem.check()?;
         self.settings.check()?;
-        let raw = world::simulate(problem, &self.settings)?;
+        let mut stepping = world::start(problem, &self.settings)?;
+        for push in &problem.pushes {
+            stepping.advance(push)?;
+        }
+        let (w, stepped, _) = stepping.finish();
+        Ok(self.box2d_run(problem, world::raw_run(w, &stepped), start))
+    }
+
+    /// The run of `raw` on `problem` (the pushes applied), started at `start`.
+    pub(crate) fn box2d_run(
+        &self,
+        problem: &Problem,
+        raw: world::RawRun,
+        start: std::time::Instant,
+    ) -> Box2dRun {
         let segment_tail_omega = pushval_engine::step_tail_omega(problem, &raw.history, 0.2);
         let mut trajectory =
             pushval_engine::trajectory_from_steps(&self.name(), problem, &raw.history);
         trajectory.assumptions.min_support_speed = raw.min_support_speed;
-        Ok(Box2dRun {
+        Box2dRun {
             trajectory,
             max_joint_drift: raw.max_drift,
             steps: raw.steps,
@@ -218,7 +232,7 @@ impl Box2dSimulator {
             step_time: raw.step_time,
             segment_tail_omega,
             history: raw.history,
-        })
+        }
     }
 }
 

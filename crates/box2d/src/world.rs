@@ -7,6 +7,9 @@ use boxdd::{
     BodyId, BodyType, ConstraintTuning, Foundation, MassData, MotorJointDef, Position,
     RevoluteJointDef, Vec2, World,
 };
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLoop, StepPlan, Stepped, Stepping, SupportForces,
+};
 use pushval_engine::StepRecord;
 use pushval_model::{ModelError, Problem};
 
@@ -42,7 +45,7 @@ fn rot(c: f64, s: f64, a: [f64; 2]) -> [f64; 2] {
 
 /// The object's state as Box2D holds it, in f64.
 #[derive(Debug, Clone, Copy)]
-struct State {
+pub(crate) struct State {
     /// Centre of mass (m, world).
     x: f64,
     y: f64,
@@ -99,7 +102,11 @@ impl Scene {
         let (v0, w0) = if init.from_rest {
             ([0.0, 0.0], 0.0)
         } else {
-            let vc = problem.pushes[0].velocity();
+            let vc = problem
+                .pushes
+                .first()
+                .ok_or(ModelError::EmptySchedule)?
+                .velocity();
             let local = [vc.x + init.omega * pc[1], vc.y - init.omega * pc[0]];
             (rot(c0, s0, local), init.omega)
         };
@@ -268,83 +275,128 @@ impl Scene {
     }
 }
 
-/// Runs the problem in Box2D.
-pub(crate) fn simulate(problem: &Problem, settings: &Box2dSettings) -> Result<RawRun, ModelError> {
+/// The Box2D scene as the shared stepping loop sees it (a 2-D world: height
+/// and tilt zero).
+pub(crate) struct Stepper {
+    scene: Scene,
+    substeps: i32,
+    /// The object after the last step (read inside `step`, where an engine
+    /// error can be returned).
+    last: State,
+    /// The current step's start time (s), for the errors.
+    t0: f64,
+    /// An error of the pusher's or the friction's set-up, returned by the
+    /// step it was for.
+    error: Option<ModelError>,
+    max_drift: f64,
+    min_support_speed: f64,
+    step_time: Duration,
+}
+
+/// Builds the world of `problem` and hands it to the shared loop; an object
+/// not starting at rest starts with the first push of `problem`'s schedule.
+pub(crate) fn start(
+    problem: &Problem,
+    settings: &Box2dSettings,
+) -> Result<Stepping<Stepper>, ModelError> {
+    if !problem.initial.from_rest && problem.pushes.is_empty() {
+        return Err(ModelError::EmptySchedule);
+    }
     let mut scene = Scene::new(problem, settings)?;
-    let substeps = settings.substeps as i32;
-
-    let mut state = scene.read(problem.initial.theta, 0.0)?;
-    let expected_steps: f64 = problem
-        .pushes
-        .iter()
-        .map(|p| (p.duration / settings.dt).ceil())
-        .sum();
-    let mut history = Vec::with_capacity(1 + expected_steps.min(1e7) as usize);
-    history.push(StepRecord {
-        segment: 0,
+    let state = scene.read(problem.initial.theta, 0.0)?;
+    let w = Stepper {
+        scene,
+        substeps: settings.substeps as i32,
+        last: state,
         t0: 0.0,
-        t1: 0.0,
-        x: state.x,
-        y: state.y,
-        theta: state.theta,
-        omega: state.omega,
-    });
-    let mut run = RawRun {
+        error: None,
+        max_drift: 0.0,
         min_support_speed: f64::INFINITY,
-        ..Default::default()
+        step_time: Duration::ZERO,
     };
-    let mut t_seg = 0.0;
-    for (j, push) in problem.pushes.iter().enumerate() {
-        let n = (push.duration / settings.dt * (1.0 - 1e-12))
-            .ceil()
-            .max(1.0) as usize;
-        let h = push.duration / n as f64;
-        let vc = push.velocity();
-        let vc = [vc.x, vc.y];
-        let seg_end = t_seg + push.duration;
-        for k in 0..n {
-            let t0 = t_seg + k as f64 * h;
-            let t1 = if k + 1 == n { seg_end } else { t0 + h };
-            let speed = scene.apply_step_inputs(&state, vc, t0)?;
-            run.min_support_speed = run.min_support_speed.min(speed);
-            let before = Instant::now();
-            // The step's events (none: nothing has a shape) are not read.
-            drop(
-                scene
-                    .world
-                    .step(h as f32, substeps)
-                    .map_err(engine_error(t0))?,
-            );
-            run.step_time += before.elapsed();
-            run.steps += 1;
+    // No supports' forces are read: the loop's per-support vectors are empty.
+    let cfg = StepLoop::new(settings.dt, 0, 0.0);
+    Ok(Stepping::new(w, problem, cfg, state))
+}
 
-            state = scene.read(state.theta, t1)?;
-            if !(state.x.is_finite()
-                && state.y.is_finite()
-                && state.theta.is_finite()
-                && state.omega.is_finite())
-            {
-                return Err(ModelError::NonFinite {
-                    t: t1,
-                    step: run.steps,
-                });
-            }
-            run.max_drift = run.max_drift.max(scene.drift(&state, t1)?);
-            history.push(StepRecord {
-                segment: j,
-                t0,
-                t1,
-                x: state.x,
-                y: state.y,
-                theta: state.theta,
-                omega: state.omega,
-            });
+/// What the stepping hands back once the loop is done.
+pub(crate) fn raw_run(world: Stepper, stepped: &Stepped) -> RawRun {
+    RawRun {
+        history: stepped.records(),
+        steps: stepped.steps,
+        step_time: world.step_time,
+        max_drift: world.max_drift,
+        min_support_speed: if world.min_support_speed.is_finite() {
+            world.min_support_speed
+        } else {
+            0.0
+        },
+    }
+}
+
+impl PlateWorld for Stepper {
+    type State = State;
+
+    fn plate(&self, s: &State) -> Plate {
+        Plate {
+            x: s.x,
+            y: s.y,
+            z: 0.0,
+            theta: s.theta,
+            omega: s.omega,
+            tilt: 0.0,
         }
-        t_seg = seg_end;
     }
-    if !run.min_support_speed.is_finite() {
-        run.min_support_speed = 0.0;
+
+    /// The pusher velocity `v_c R(θ) n_φ` at Box2D's angle at the step start,
+    /// and the support forces for the step.
+    fn drive_step(&mut self, state: &State, plan: &StepPlan) -> f64 {
+        let vc = plan.push.velocity();
+        self.t0 = plan.t0;
+        match self.scene.apply_step_inputs(state, [vc.x, vc.y], plan.t0) {
+            Ok(speed) => self.min_support_speed = self.min_support_speed.min(speed),
+            Err(e) => self.error = Some(e),
+        }
+        // The drift is measured after the step.
+        0.0
     }
-    run.history = history;
-    Ok(run)
+
+    fn drive(&mut self, _state: &State, _velocity: [f64; 2], _h: f64) -> f64 {
+        unreachable!("the Box2D world drives its pusher in drive_step")
+    }
+
+    fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        let before = Instant::now();
+        // The step's events (none: nothing has a shape) are not read.
+        drop(
+            self.scene
+                .world
+                .step(h as f32, self.substeps)
+                .map_err(engine_error(self.t0))?,
+        );
+        self.step_time += before.elapsed();
+        self.last = self.scene.read(self.last.theta, t1)?;
+        let drift = self.scene.drift(&self.last, t1)?;
+        self.max_drift = self.max_drift.max(drift);
+        Ok(())
+    }
+
+    fn state(&mut self, _prev: &State) -> State {
+        self.last
+    }
+
+    fn support_forces(&mut self, _: &State, _h: f64) -> Result<Option<SupportForces>, ModelError> {
+        Ok(None)
+    }
+
+    fn finite(&self, s: &State) -> bool {
+        s.x.is_finite() && s.y.is_finite() && s.theta.is_finite() && s.omega.is_finite()
+    }
+
+    fn cm_velocity(&self, s: &State) -> Option<[f64; 2]> {
+        Some(s.v)
+    }
 }

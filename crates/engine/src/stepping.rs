@@ -31,7 +31,7 @@
 //! The arithmetic is written once here, in a fixed order, so that every
 //! engine using it gets the same numbers it got from its own copy of the loop.
 
-use pushval_model::{ModelError, Problem, SolverStats, Trajectory, Vec2};
+use pushval_model::{ModelError, Problem, Push, SolverStats, Trajectory};
 
 use crate::contact::{ContactRecord, LoadRecorder};
 use crate::resample::{resample, StepRecord};
@@ -134,6 +134,31 @@ pub trait PlateWorld {
         p.theta + 0.5 * h * p.omega
     }
 
+    /// The steps of a segment of `push`, where the world lays them out
+    /// itself; `n` steps of `h = duration / n` otherwise (None, the
+    /// default). `followed` says whether the start's schedule has a push
+    /// after this one (a switch follows).
+    fn segment_steps(
+        &mut self,
+        _push: &Push,
+        _n: usize,
+        _h: f64,
+        _followed: bool,
+    ) -> Option<StepLayout> {
+        None
+    }
+
+    /// Drives the pusher for the step `plan` from `state`: by default the
+    /// commanded contact velocity `v_c R(ψ) n_φ` at the heading ψ of
+    /// [`PlateWorld::heading`], through [`PlateWorld::drive`]. Returns the
+    /// pusher's drift (m) as `drive` does.
+    fn drive_step(&mut self, state: &Self::State, plan: &StepPlan) -> f64 {
+        let vc = plan.push.velocity();
+        let (sn, cs) = self.heading(state, plan.h).sin_cos();
+        let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y];
+        self.drive(state, vel, plan.h)
+    }
+
     /// Re-pins the pusher on the object's contact point and gives it the
     /// world velocity `velocity` (m/s) for a step of length `h`; returns how
     /// far (m, horizontal) it was from the contact point before.
@@ -182,6 +207,13 @@ pub trait PlateWorld {
     fn end_segment(&mut self, _tail_weight: f64, _t: f64) -> Result<(), ModelError> {
         Ok(())
     }
+
+    /// The world velocity (m/s) of the centre of mass in `state`, where the
+    /// engine gives it; None (the default) leaves the session to report the
+    /// one a rigid contact moving with the last push gives.
+    fn cm_velocity(&self, _state: &Self::State) -> Option<[f64; 2]> {
+        None
+    }
 }
 
 /// Which steps of a segment of `n` steps make its tail.
@@ -192,6 +224,9 @@ pub enum TailSteps {
     Floor,
     /// The last `max(n / 5, 1)` steps (integer division).
     LastFifth,
+    /// The steps whose middle `(t0 + t1) / 2` is in the segment's last
+    /// fifth of time (possibly none: the tail means are then zero).
+    ByTime,
 }
 
 /// How the steps of a tail are weighted in its means.
@@ -316,98 +351,247 @@ impl Stepped {
     }
 }
 
-/// Runs the push schedule of `problem` from `start` (see the module docs).
-pub fn run_pushes<W: PlateWorld>(
-    world: &mut W,
-    problem: &Problem,
-    cfg: &StepLoop,
-    start: W::State,
-) -> Result<Stepped, ModelError> {
-    let n_sup = cfg.supports;
-    let mut state = start;
-    let mut out = Stepped {
-        min_loads: vec![f64::INFINITY; n_sup],
-        ..Default::default()
-    };
-    out.history
-        .push(PlateStep::new(0, 0.0, 0.0, &world.plate(&state)));
-    // The run's last fifth (steps whose middle is past it), time-weighted.
-    let run_from = (1.0 - TAIL) * problem.duration();
-    let (mut run_n, mut run_t) = (vec![0.0; n_sup], 0.0);
-    let mut t_seg = 0.0;
-    let mut recorder = LoadRecorder::new(problem, n_sup, pushval_laws::GRAVITY);
-    for (j, push) in problem.pushes.iter().enumerate() {
+/// A segment's steps as a world lays them out ([`PlateWorld::segment_steps`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepLayout {
+    /// Step lengths (s): each step starts where the last ended (the first
+    /// at the segment's start) and ends its length later, the last one
+    /// exactly at the segment's end.
+    Lengths(Vec<f64>),
+    /// Each step's start and end times (s), verbatim (an engine whose clock
+    /// keeps its own time, e.g. in whole nanoseconds).
+    Spans(Vec<(f64, f64)>),
+}
+
+/// One step as the loop plans it, handed to [`PlateWorld::drive_step`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepPlan {
+    /// Index of the push segment (in the order the pushes were applied).
+    pub segment: usize,
+    /// Index of the step in its segment.
+    pub index: usize,
+    /// Number of steps of the segment.
+    pub steps: usize,
+    /// Start time (s).
+    pub t0: f64,
+    /// End time (s).
+    pub t1: f64,
+    /// The step length passed to [`PlateWorld::step`] (s): the segment's
+    /// nominal step `duration / n` for equal steps, `t1 − t0` for the steps
+    /// of [`PlateWorld::segment_steps`].
+    pub h: f64,
+    /// The segment's nominal step `duration / n` (s), `n = ceil(duration / dt)`.
+    pub nominal_h: f64,
+    /// Whether this is the segment's closing step (the last of a segment
+    /// that a switch follows, where the world's step layout has one).
+    pub closing: bool,
+    /// The push of the segment.
+    pub push: Push,
+}
+
+/// What the run tails need of one step, kept until [`Stepping::finish`]
+/// (the run's last fifth depends on the pushes still to come).
+#[derive(Debug, Clone)]
+struct StepLog {
+    t0: f64,
+    t1: f64,
+    h: f64,
+    rise: f64,
+    in_tail: bool,
+    normal: Option<Vec<f64>>,
+}
+
+/// The loop of [`run_pushes`] one push at a time: the world keeps its state
+/// between pushes, so the caller decides the next push from the state the
+/// last one left (see the module docs for what a push does).
+///
+/// The problem given to [`Stepping::new`] is the start's: its schedule is the
+/// pushes the caller announces, read only where the world looks ahead
+/// ([`PlateWorld::segment_steps`] is told whether a push follows). What
+/// depends on the whole run (the run's last fifth, the per-sample loads) is
+/// gathered at [`Stepping::finish`], on the pushes applied.
+pub struct Stepping<W: PlateWorld> {
+    world: W,
+    problem: Problem,
+    cfg: StepLoop,
+    state: W::State,
+    out: Stepped,
+    log: Vec<StepLog>,
+    applied: Vec<Push>,
+    t_seg: f64,
+}
+
+impl<W: PlateWorld> Stepping<W> {
+    /// The loop over `world`, whose object is in `start` (set up, settled and
+    /// given its start velocity by the engine), for `problem` (the start's:
+    /// see the type's docs).
+    pub fn new(world: W, problem: &Problem, cfg: StepLoop, start: W::State) -> Self {
+        let mut out = Stepped {
+            min_loads: vec![f64::INFINITY; cfg.supports],
+            ..Default::default()
+        };
+        out.history
+            .push(PlateStep::new(0, 0.0, 0.0, &world.plate(&start)));
+        Self {
+            world,
+            problem: problem.clone(),
+            cfg,
+            state: start,
+            out,
+            log: Vec::new(),
+            applied: Vec::new(),
+            t_seg: 0.0,
+        }
+    }
+
+    /// The world.
+    pub fn world(&self) -> &W {
+        &self.world
+    }
+
+    /// The object as the world last read it.
+    pub fn state(&self) -> &W::State {
+        &self.state
+    }
+
+    /// The pushes applied so far.
+    pub fn applied(&self) -> &[Push] {
+        &self.applied
+    }
+
+    /// Time at the end of the pushes applied so far (s).
+    pub fn time(&self) -> f64 {
+        self.t_seg
+    }
+
+    /// Engine steps taken so far.
+    pub fn steps(&self) -> usize {
+        self.out.steps
+    }
+
+    /// The start's problem with the pushes applied as its schedule.
+    pub fn applied_problem(&self) -> Problem {
+        crate::session::with_pushes(&self.problem, self.applied.clone())
+    }
+
+    /// The object's state for a session: pose and ω from
+    /// [`PlateWorld::plate`], the centre of mass's velocity from
+    /// [`PlateWorld::cm_velocity`], else the one a rigid contact moving with
+    /// the last push gives.
+    pub fn engine_state(&self) -> crate::EngineState {
+        let p = self.world.plate(&self.state);
+        let v_cm = self.world.cm_velocity(&self.state).unwrap_or_else(|| {
+            crate::rigid_cm_velocity(&self.problem, self.applied.last(), p.theta, p.omega)
+        });
+        crate::EngineState {
+            t: self.t_seg,
+            x: p.x,
+            y: p.y,
+            theta: p.theta,
+            omega: p.omega,
+            v_cm,
+        }
+    }
+
+    /// Runs one push (see the module docs).
+    pub fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        let j = self.applied.len();
+        let followed = j + 1 < self.problem.pushes.len();
+        let cfg = self.cfg;
+        let n_sup = cfg.supports;
+        let t_seg = self.t_seg;
         let n = (push.duration / cfg.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-        let h = push.duration / n as f64;
+        let nominal_h = push.duration / n as f64;
+        let layout = self.world.segment_steps(push, n, nominal_h, followed);
+        let n_steps = match &layout {
+            None => n,
+            Some(StepLayout::Lengths(l)) => l.len(),
+            Some(StepLayout::Spans(s)) => s.len(),
+        };
         let tail_from = match cfg.tail {
-            TailSteps::Floor => ((1.0 - TAIL) * n as f64).floor() as usize,
-            TailSteps::LastFifth => n - (n / 5).max(1),
+            TailSteps::Floor => ((1.0 - TAIL) * n_steps as f64).floor() as usize,
+            TailSteps::LastFifth | TailSteps::ByTime => n_steps - (n_steps / 5).max(1),
         };
-        let w = match cfg.tail_weight {
-            TailWeight::Time => h,
-            TailWeight::Steps => 1.0,
+        // A tail by time: the steps whose middle is in the segment's last
+        // fifth (of its duration, back from the end of its last step).
+        let seg_end = match &layout {
+            Some(StepLayout::Spans(s)) => s.last().map_or(t_seg, |s| s.1),
+            _ => t_seg + push.duration,
         };
+        let tail_time = seg_end - TAIL * push.duration;
         let (mut acc_w, mut acc_w2, mut acc_t) = (0.0, 0.0, 0.0);
         let mut acc_n = vec![0.0; n_sup];
         let mut acc_f = vec![0.0; n_sup];
         let mut min_slip = vec![f64::INFINITY; n_sup];
-        let vc: Vec2 = push.velocity();
-        for k in 0..n {
-            let t0 = t_seg + k as f64 * h;
-            let t1 = if k + 1 == n {
-                t_seg + push.duration
-            } else {
-                match cfg.clock {
-                    StepClock::FromStepStart => t0 + h,
-                    StepClock::FromSegmentStart => t_seg + (k + 1) as f64 * h,
+        let mut t_prev = t_seg;
+        for k in 0..n_steps {
+            let (t0, t1, h) = match &layout {
+                None => {
+                    let t0 = t_seg + k as f64 * nominal_h;
+                    let t1 = if k + 1 == n {
+                        t_seg + push.duration
+                    } else {
+                        match cfg.clock {
+                            StepClock::FromStepStart => t0 + nominal_h,
+                            StepClock::FromSegmentStart => t_seg + (k + 1) as f64 * nominal_h,
+                        }
+                    };
+                    (t0, t1, nominal_h)
+                }
+                Some(StepLayout::Spans(spans)) => {
+                    let (t0, t1) = spans[k];
+                    (t0, t1, t1 - t0)
+                }
+                Some(StepLayout::Lengths(lengths)) => {
+                    let t0 = t_prev;
+                    let t1 = if k + 1 == n_steps {
+                        t_seg + push.duration
+                    } else {
+                        t0 + lengths[k]
+                    };
+                    (t0, t1, t1 - t0)
                 }
             };
-            let (sn, cs) = world.heading(&state, h).sin_cos();
-            let vel = [cs * vc.x - sn * vc.y, sn * vc.x + cs * vc.y];
-            let drift = world.drive(&state, vel, h);
-            if k > 0 || j > 0 {
-                out.max_joint_drift = out.max_joint_drift.max(drift);
-            }
-            world.step(h, t1)?;
-            out.steps += 1;
-            state = world.state(&state);
-            if !world.finite(&state) {
-                return Err(ModelError::NonFinite {
-                    t: t1,
-                    step: out.steps,
-                });
-            }
-            world.after_step(&state);
-            let p = world.plate(&state);
-            out.max_tilt = out.max_tilt.max(p.tilt);
-            out.max_lift = out.max_lift.max((p.z - cfg.z_rest).abs());
-            let in_tail = k >= tail_from;
-            let in_run_tail = match cfg.clock {
-                StepClock::FromStepStart => 0.5 * (t0 + t1) >= run_from,
-                StepClock::FromSegmentStart => t1 - 0.5 * h >= run_from,
+            t_prev = t1;
+            let w = match cfg.tail_weight {
+                TailWeight::Time => h,
+                TailWeight::Steps => 1.0,
             };
-            // Forces are read on every step (for the per-sample loads);
-            // the smallest loads are taken where the world asks for them.
-            let forces = world.support_forces(&state, h)?;
-            recorder.step(
+            let plan = StepPlan {
+                segment: j,
+                index: k,
+                steps: n_steps,
+                t0,
                 t1,
                 h,
-                forces.as_ref().map(|f| f.normal.as_slice()),
-                Some(p.z - cfg.z_rest),
-            );
-            if let Some(f) = &forces {
-                if cfg.forces_every_step || in_tail || in_run_tail {
-                    for (m, &l) in out.min_loads.iter_mut().zip(&f.normal) {
-                        *m = m.min(l);
-                    }
-                }
-                if in_run_tail {
-                    for (a, &l) in run_n.iter_mut().zip(&f.normal) {
-                        *a += l * h;
-                    }
-                    run_t += h;
-                }
+                nominal_h,
+                closing: layout.is_some() && followed && k + 1 == n_steps,
+                push: *push,
+            };
+            let drift = self.world.drive_step(&self.state, &plan);
+            if k > 0 || j > 0 {
+                self.out.max_joint_drift = self.out.max_joint_drift.max(drift);
             }
+            self.world.step(h, t1)?;
+            self.out.steps += 1;
+            self.state = self.world.state(&self.state);
+            if !self.world.finite(&self.state) {
+                return Err(ModelError::NonFinite {
+                    t: t1,
+                    step: self.out.steps,
+                });
+            }
+            self.world.after_step(&self.state);
+            let p = self.world.plate(&self.state);
+            self.out.max_tilt = self.out.max_tilt.max(p.tilt);
+            self.out.max_lift = self.out.max_lift.max((p.z - cfg.z_rest).abs());
+            let in_tail = match cfg.tail {
+                TailSteps::ByTime => 0.5 * (t0 + t1) >= tail_time,
+                _ => k >= tail_from,
+            };
+            // Forces are read on every step (for the per-sample loads); the
+            // run tail and the smallest loads are taken at `finish`.
+            let forces = self.world.support_forces(&self.state, h)?;
             if in_tail {
                 acc_w += p.omega * w;
                 acc_w2 += p.omega * p.omega * w;
@@ -423,14 +607,29 @@ pub fn run_pushes<W: PlateWorld>(
                     }
                 }
                 for (i, m) in min_slip.iter_mut().enumerate() {
-                    if let Some(u) = world.slip(&state, i) {
+                    if let Some(u) = self.world.slip(&self.state, i) {
                         *m = m.min(u);
                     }
                 }
-                world.tail_step(&state, h)?;
+                self.world.tail_step(&self.state, h)?;
             }
-            out.history.push(PlateStep::new(j, t0, t1, &p));
+            self.log.push(StepLog {
+                t0,
+                t1,
+                h,
+                rise: p.z - cfg.z_rest,
+                in_tail,
+                normal: forces.map(|f| f.normal),
+            });
+            self.out.history.push(PlateStep::new(j, t0, t1, &p));
         }
+        let out = &mut self.out;
+        // Only a tail by time can be empty (the others hold a step at least).
+        let acc_t = if acc_t > 0.0 {
+            acc_t
+        } else {
+            f64::MIN_POSITIVE
+        };
         let mean = acc_w / acc_t;
         out.segment_tail_omega.push(mean);
         out.segment_tail_omega_std
@@ -440,21 +639,168 @@ pub fn run_pushes<W: PlateWorld>(
         out.segment_tail_friction
             .push(acc_f.iter().map(|a| a / acc_t).collect());
         out.segment_tail_min_slip.push(min_slip);
-        t_seg += push.duration;
-        world.end_segment(acc_t, t_seg)?;
+        self.t_seg += push.duration;
+        self.applied.push(*push);
+        self.world.end_segment(acc_t, self.t_seg)
     }
-    out.loads = run_n
-        .iter()
-        .map(|a| a / run_t.max(f64::MIN_POSITIVE))
-        .collect();
-    out.contact = recorder.finish();
-    Ok(out)
+
+    /// Ends the loop: the world, what the loop gathered (the run's last fifth
+    /// and the per-sample loads over the pushes applied), and the start's
+    /// problem with the pushes applied as its schedule (the one to resample
+    /// on).
+    pub fn finish(self) -> (W, Stepped, Problem) {
+        let problem = self.applied_problem();
+        let cfg = self.cfg;
+        let mut out = self.out;
+        // The run's last fifth (steps whose middle is past it), time-weighted.
+        let run_from = (1.0 - TAIL) * problem.duration();
+        let (mut run_n, mut run_t) = (vec![0.0; cfg.supports], 0.0);
+        let mut recorder = LoadRecorder::new(&problem, cfg.supports, pushval_laws::GRAVITY);
+        for s in &self.log {
+            let in_run_tail = match cfg.clock {
+                StepClock::FromStepStart => 0.5 * (s.t0 + s.t1) >= run_from,
+                StepClock::FromSegmentStart => s.t1 - 0.5 * s.h >= run_from,
+            };
+            recorder.step(s.t1, s.h, s.normal.as_deref(), Some(s.rise));
+            if let Some(normal) = &s.normal {
+                // The smallest loads are taken where the world asks for them.
+                if cfg.forces_every_step || s.in_tail || in_run_tail {
+                    for (m, &l) in out.min_loads.iter_mut().zip(normal) {
+                        *m = m.min(l);
+                    }
+                }
+                if in_run_tail {
+                    for (a, &l) in run_n.iter_mut().zip(normal) {
+                        *a += l * s.h;
+                    }
+                    run_t += s.h;
+                }
+            }
+        }
+        out.loads = run_n
+            .iter()
+            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+            .collect();
+        out.contact = recorder.finish();
+        (self.world, out, problem)
+    }
+}
+
+/// Runs the push schedule of `problem` from `start` (see the module docs):
+/// [`Stepping`] with one [`advance`](Stepping::advance) per push.
+pub fn run_pushes<W: PlateWorld>(
+    world: &mut W,
+    problem: &Problem,
+    cfg: &StepLoop,
+    start: W::State,
+) -> Result<Stepped, ModelError> {
+    let mut stepping = Stepping::new(world, problem, *cfg, start);
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    Ok(stepping.finish().1)
+}
+
+/// A world borrowed by the loop is a world.
+impl<W: PlateWorld + ?Sized> PlateWorld for &mut W {
+    type State = W::State;
+    fn plate(&self, state: &Self::State) -> Plate {
+        (**self).plate(state)
+    }
+    fn heading(&self, state: &Self::State, h: f64) -> f64 {
+        (**self).heading(state, h)
+    }
+    fn segment_steps(
+        &mut self,
+        push: &Push,
+        n: usize,
+        h: f64,
+        followed: bool,
+    ) -> Option<StepLayout> {
+        (**self).segment_steps(push, n, h, followed)
+    }
+    fn drive_step(&mut self, state: &Self::State, plan: &StepPlan) -> f64 {
+        (**self).drive_step(state, plan)
+    }
+    fn drive(&mut self, state: &Self::State, velocity: [f64; 2], h: f64) -> f64 {
+        (**self).drive(state, velocity, h)
+    }
+    fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+        (**self).step(h, t1)
+    }
+    fn state(&mut self, prev: &Self::State) -> Self::State {
+        (**self).state(prev)
+    }
+    fn support_forces(
+        &mut self,
+        state: &Self::State,
+        h: f64,
+    ) -> Result<Option<SupportForces>, ModelError> {
+        (**self).support_forces(state, h)
+    }
+    fn finite(&self, state: &Self::State) -> bool {
+        (**self).finite(state)
+    }
+    fn after_step(&mut self, state: &Self::State) {
+        (**self).after_step(state)
+    }
+    fn slip(&self, state: &Self::State, i: usize) -> Option<f64> {
+        (**self).slip(state, i)
+    }
+    fn tail_step(&mut self, state: &Self::State, h: f64) -> Result<(), ModelError> {
+        (**self).tail_step(state, h)
+    }
+    fn end_segment(&mut self, tail_weight: f64, t: f64) -> Result<(), ModelError> {
+        (**self).end_segment(tail_weight, t)
+    }
+    fn cm_velocity(&self, state: &Self::State) -> Option<[f64; 2]> {
+        (**self).cm_velocity(state)
+    }
+}
+
+/// An engine's session over the shared loop: a [`Stepping`] and how the
+/// engine turns what it gathered into its [`EngineRun`](crate::EngineRun).
+pub struct PlateSession<'a, W: PlateWorld> {
+    stepping: Stepping<W>,
+    finish: PlateFinish<'a, W>,
+}
+
+/// How a [`PlateSession`] ends: the world, what the loop gathered and the
+/// problem of the pushes applied in, the engine's run out.
+pub type PlateFinish<'a, W> =
+    Box<dyn FnOnce(W, Stepped, &Problem) -> Result<crate::EngineRun, ModelError> + 'a>;
+
+impl<'a, W: PlateWorld> PlateSession<'a, W> {
+    /// The session of `stepping`, ended by `finish`.
+    pub fn new(stepping: Stepping<W>, finish: PlateFinish<'a, W>) -> Self {
+        Self { stepping, finish }
+    }
+}
+
+impl<W: PlateWorld> crate::EngineSession for PlateSession<'_, W> {
+    fn state(&self) -> crate::EngineState {
+        self.stepping.engine_state()
+    }
+    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        self.stepping.advance(push)
+    }
+    fn finish(self: Box<Self>) -> Result<crate::EngineRun, ModelError> {
+        let this = *self;
+        if this.stepping.applied.is_empty() {
+            return Err(ModelError::EmptySchedule);
+        }
+        let (world, stepped, problem) = this.stepping.finish();
+        (this.finish)(world, stepped, &problem)
+    }
+    fn steps_taken(&self) -> usize {
+        self.stepping.steps()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pushval_model::{Body, Initial, Push, Support, Switching};
+    use pushval_model::{Body, Initial, Push, Support, Switching, Vec2};
 
     /// An object carried rigidly by the pusher: it moves at the commanded
     /// velocity, turns at a constant rate `w` and rises linearly; every
@@ -720,5 +1066,107 @@ mod tests {
         for (got, want) in run.segment_tail_loads[1].iter().zip([1.0, 2.0, 3.0]) {
             assert!((got - want).abs() < 1e-12);
         }
+    }
+
+    /// A session that applies fewer pushes than the start's schedule
+    /// announced ends with the run of the pushes applied: its run tail,
+    /// loads and samples are those of a run of that schedule, bit for bit.
+    #[test]
+    fn finish_gathers_the_run_of_the_pushes_applied() {
+        let one = Push {
+            duration: 1.0,
+            speed: 0.1,
+            phi: 0.0,
+        };
+        let two = Push {
+            duration: 0.5,
+            speed: 0.1,
+            phi: 0.4,
+        };
+        let announced = problem(vec![one, two]);
+        let mut w = carried(0.7, None);
+        let start = w.state;
+        let mut s = Stepping::new(&mut w, &announced, CFG, start);
+        s.advance(&one).unwrap();
+        assert_eq!(s.time(), 1.0);
+        assert_eq!(s.steps(), 10);
+        let state = s.engine_state();
+        assert!((state.theta - 0.7).abs() < 1e-12 && state.omega == 0.7);
+        let (_, got, applied) = s.finish();
+        assert_eq!(applied.pushes, vec![one]);
+        let mut w = carried(0.7, None);
+        let start = w.state;
+        let want = run_pushes(&mut w, &problem(vec![one]), &CFG, start).unwrap();
+        assert_eq!(got, want);
+        assert_eq!(
+            got.trajectory(&applied),
+            want.trajectory(&problem(vec![one]))
+        );
+    }
+
+    /// The world is told whether the start's schedule has a push after the
+    /// one it lays out, and its own step lengths are kept, the last one
+    /// ending at the segment's end.
+    #[test]
+    fn worlds_lay_out_their_steps_knowing_what_follows() {
+        struct Laid {
+            inner: Carried,
+            followed: Vec<bool>,
+        }
+        impl PlateWorld for Laid {
+            type State = Plate;
+            fn plate(&self, s: &Plate) -> Plate {
+                *s
+            }
+            fn segment_steps(
+                &mut self,
+                _: &Push,
+                n: usize,
+                h: f64,
+                followed: bool,
+            ) -> Option<StepLayout> {
+                self.followed.push(followed);
+                let mut l = vec![0.25 * h, 0.75 * h];
+                l.extend(std::iter::repeat_n(h, n - 1));
+                Some(StepLayout::Lengths(l))
+            }
+            fn drive(&mut self, s: &Plate, v: [f64; 2], h: f64) -> f64 {
+                self.inner.drive(s, v, h)
+            }
+            fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+                self.inner.step(h, t1)
+            }
+            fn state(&mut self, s: &Plate) -> Plate {
+                self.inner.state(s)
+            }
+            fn support_forces(
+                &mut self,
+                _: &Plate,
+                _: f64,
+            ) -> Result<Option<SupportForces>, ModelError> {
+                Ok(None)
+            }
+        }
+        let push = Push {
+            duration: 0.3,
+            speed: 0.1,
+            phi: 0.0,
+        };
+        let p = problem(vec![push, push]);
+        let mut w = Laid {
+            inner: carried(0.0, None),
+            followed: Vec::new(),
+        };
+        let start = w.inner.state;
+        let run = run_pushes(&mut w, &p, &CFG, start).unwrap();
+        assert_eq!(w.followed, vec![true, false]);
+        // 3 steps of 0.1 each, the first cut in two: 4 per segment.
+        assert_eq!(run.steps, 8);
+        let h = &run.history;
+        assert!((h[1].t1 - 0.025).abs() < 1e-15 && (h[2].t1 - 0.1).abs() < 1e-15);
+        assert_eq!(h[4].t1, 0.3);
+        assert_eq!(h[5].t0, 0.3);
+        assert_eq!(h[8].t1, 0.6);
+        assert!(run.contact.is_none());
     }
 }

@@ -1,16 +1,19 @@
 //! The rapier2d models as pushval engine plug-ins: `rapier2d` (per-support
 //! Coulomb forces, gated by default) and the four 2-D friction idioms.
 
+use std::time::Instant;
+
+use pushval_engine::stepping::{PlateSession, PlateWorld, Stepped, Stepping};
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys, COULOMB,
+    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys, COULOMB,
 };
 use pushval_laws::idioms::{
     ImpulseBox, ImpulseDisk, RegularisedLinear, RegularisedTanh, RowsDisk, DEFAULT_SLIP_SPEED,
 };
 use pushval_model::{ModelError, Problem};
 
-use crate::{EngineSettings, FrictionModel, FrictionVelocity, Precision, RapierSimulator};
+use crate::{EngineSettings, FrictionModel, FrictionVelocity, Precision, RapierSimulator, RawRun};
 
 /// The engine crate and version this adapter is built against (the
 /// `rapier2d-f64` and `rapier2d` entries of the workspace's Cargo.toml; a
@@ -229,25 +232,70 @@ impl Engine for Rapier2dModel {
             _ => Some(&self.settings.friction_model),
         }
     }
+    /// [`run_via_session`]: the world of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = RapierSimulator::new(EngineSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The rapier world through the shared stepping loop
+    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
+    /// with the first push of `problem`'s schedule, and in leapfrog mode a
+    /// segment closes with a half kick when that schedule has a push after
+    /// it.
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let start = Instant::now();
+        let sim = RapierSimulator::new(EngineSettings {
             dt,
             ..self.settings
+        });
+        if let Err(e) = sim.settings.check() {
+            return Some(Err(e));
+        }
+        Some(match sim.settings.precision {
+            Precision::F64 => crate::f64_engine::world::start(problem, &sim.settings, &[])
+                .map(|s| self.session_of(sim, s, crate::f64_engine::world::raw_run, start)),
+            Precision::F32 => crate::f32_engine::world::start(problem, &sim.settings, &[])
+                .map(|s| self.session_of(sim, s, crate::f32_engine::world::raw_run, start)),
         })
-        .run(problem)?;
-        let mut trajectory = r.trajectory;
-        trajectory.model = self.info.name.clone();
-        Ok(EngineRun {
-            contact: None,
-            trajectory,
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "max_joint_drift": r.max_joint_drift,
-                "steps": r.steps,
+    }
+}
+
+impl Rapier2dModel {
+    /// The session over `stepping`, whose world `raw` reads once it is done.
+    fn session_of<'a, W>(
+        &'a self,
+        sim: RapierSimulator,
+        stepping: Stepping<W>,
+        raw: fn(W, &Stepped) -> RawRun,
+        start: Instant,
+    ) -> Box<dyn EngineSession + 'a>
+    where
+        W: PlateWorld + 'a,
+        W::State: 'a,
+    {
+        Box::new(PlateSession::new(
+            stepping,
+            Box::new(move |world, stepped, problem| {
+                let r = sim.rapier_run(problem, raw(world, &stepped), start);
+                let mut trajectory = r.trajectory;
+                trajectory.model = self.info.name.clone();
+                Ok(EngineRun {
+                    contact: None,
+                    trajectory,
+                    dt: sim.settings.dt,
+                    steps: r.steps,
+                    wall_time: start.elapsed(),
+                    diagnostics: serde_json::json!({
+                        "max_joint_drift": r.max_joint_drift,
+                        "steps": r.steps,
+                    }),
+                })
             }),
-        })
+        ))
     }
 }
 

@@ -326,16 +326,35 @@ impl RapierSimulator {
         problem.check()?;
         self.settings.check()?;
         let raw = match self.settings.precision {
-            Precision::F64 => f64_engine::world::simulate(problem, &self.settings, outline)?,
-            Precision::F32 => f32_engine::world::simulate(problem, &self.settings, outline)?,
+            Precision::F64 => {
+                let mut s = f64_engine::world::start(problem, &self.settings, outline)?;
+                for push in &problem.pushes {
+                    s.advance(push)?;
+                }
+                let (world, stepped, _) = s.finish();
+                f64_engine::world::raw_run(world, &stepped)
+            }
+            Precision::F32 => {
+                let mut s = f32_engine::world::start(problem, &self.settings, outline)?;
+                for push in &problem.pushes {
+                    s.advance(push)?;
+                }
+                let (world, stepped, _) = s.finish();
+                f32_engine::world::raw_run(world, &stepped)
+            }
         };
+        Ok(self.rapier_run(problem, raw, start))
+    }
+
+    /// The run of `raw` on `problem` (the pushes applied), started at `start`.
+    pub(crate) fn rapier_run(&self, problem: &Problem, raw: RawRun, start: Instant) -> RapierRun {
         let segment_tail_omega = pushval_engine::step_tail_omega(problem, &raw.history, 0.2);
         let mut trajectory =
             pushval_engine::trajectory_from_steps(&self.name(), problem, &raw.history);
         trajectory.stats.steps = raw.steps;
         trajectory.stats.rhs_evals = raw.steps;
         trajectory.assumptions.min_support_speed = raw.min_support_speed;
-        Ok(RapierRun {
+        RapierRun {
             trajectory,
             max_joint_drift: raw.max_drift,
             steps: raw.steps,
@@ -345,7 +364,7 @@ impl RapierSimulator {
             stepping_time: raw.loop_time,
             segment_tail_omega,
             history: raw.history,
-        })
+        }
     }
 }
 

@@ -13,8 +13,10 @@ use super::rapier::prelude::*;
 use crate::idioms::{support_force, LawContext};
 use crate::RawRun;
 use crate::{EngineSettings, FrictionModel, FrictionVelocity};
-use pushval_engine::StepRecord;
-use pushval_model::{ModelError, Problem};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLayout, StepLoop, StepPlan, Stepped, Stepping, SupportForces,
+};
+use pushval_model::{ModelError, Problem, Push};
 
 /// Sliding speeds (m/s) at or below this give no friction force (the direction
 /// is undefined there); it keeps every force finite.
@@ -71,7 +73,7 @@ impl Rot {
 
 /// The object's state as read from the engine, in f64.
 #[derive(Clone, Copy)]
-struct State {
+pub(crate) struct State {
     x: f64,
     y: f64,
     /// Unwrapped angle.
@@ -79,18 +81,59 @@ struct State {
     /// The engine's rotation (its `cos θ`, `sin θ`).
     rot: Rot,
     omega: f64,
+    /// World velocity of the centre of mass (m/s).
+    v: [f64; 2],
 }
 
 /// Radius (m) of the pusher's collider when the scene has colliders.
 const PUSHER_RADIUS: Real = 0.005;
 
-/// Runs the problem in this precision's rapier build; `outline` is the
-/// object's outline for its collider (see `RapierSimulator::run_with_outline`).
-pub(crate) fn simulate(
+/// The rapier world of one run and what its steps carry from one to the
+/// next, as the shared loop's [`PlateWorld`] (a 2-D world: height and tilt
+/// zero).
+pub(crate) struct World2d {
+    world: PhysicsWorld,
+    object: RigidBodyHandle,
+    pusher: RigidBodyHandle,
+    /// Contact point (m, object frame).
+    pc: [f64; 2],
+    /// Support positions (m, object frame) and friction magnitudes `F_i` (N).
+    supports: Vec<([f64; 2], f64)>,
+    mass: f64,
+    inertia_cm: f64,
+    friction_velocity: FrictionVelocity,
+    friction_model: FrictionModel,
+    switch_step_fraction: f64,
+    /// The segment's friction-law constants (the impulse cap uses its
+    /// nominal step).
+    law: LawContext,
+    /// Whether the segment ends with a closing step (leapfrog, a switch
+    /// follows).
+    closing: bool,
+    /// The segment's switch-step length (s).
+    eps: f64,
+    /// Step velocities of this segment, placed at step middles, for the
+    /// midpoint extrapolation.
+    nodes: [(f64, f64); 2],
+    /// Leapfrog: the time the object's current velocity stands for (s).
+    v_time: f64,
+    /// The current step's start and end times (s).
+    span: (f64, f64),
+    max_drift: f64,
+    min_speed: f64,
+    step_time: Duration,
+    loop_start: Instant,
+}
+
+/// Builds the world of `problem` in this precision's rapier build and hands
+/// it to the shared loop; `outline` is the object's outline for its collider
+/// (see `RapierSimulator::run_with_outline`). An object not starting at rest
+/// starts with the first push of `problem`'s schedule.
+pub(crate) fn start(
     problem: &Problem,
     settings: &EngineSettings,
     outline: &[[f64; 2]],
-) -> Result<RawRun, ModelError> {
+) -> Result<Stepping<World2d>, ModelError> {
     let body = &problem.body;
     let init = problem.initial;
     let pc = [body.contact().x, body.contact().y];
@@ -108,7 +151,7 @@ pub(crate) fn simulate(
     let (v0, w0) = if init.from_rest {
         ([0.0, 0.0], 0.0)
     } else {
-        let p = problem.pushes[0];
+        let p = *problem.pushes.first().ok_or(ModelError::EmptySchedule)?;
         let vc = p.velocity();
         // v_cm = R(θ)(v n_φ − ω D p_c), D p_c = (−p_c,y, p_c,x)
         let local = [vc.x + init.omega * pc[1], vc.y - init.omega * pc[0]];
@@ -148,63 +191,105 @@ pub(crate) fn simulate(
     world.integration_parameters.dt = 0.0;
     world.step();
 
-    let read = |world: &PhysicsWorld, prev_theta: f64| -> State {
-        let rb = &world.bodies[object];
-        let t = rb.translation();
-        let r = rb.rotation();
-        let a = r.angle() as f64;
-        // Unwrap: the engine's angle lives in (−π, π].
-        let mut d = a - prev_theta.rem_euclid(std::f64::consts::TAU);
-        d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-        State {
-            x: t.x as f64,
-            y: t.y as f64,
-            theta: prev_theta + d,
-            rot: Rot {
-                c: r.re as f64,
-                s: r.im as f64,
-            },
-            omega: rb.angvel() as f64,
-        }
+    let state = read(&world, object, init.theta);
+    let w = World2d {
+        world,
+        object,
+        pusher,
+        pc,
+        supports,
+        mass: body.mass(),
+        inertia_cm: body.inertia_cm(),
+        friction_velocity: settings.friction_velocity,
+        friction_model: settings.friction_model,
+        switch_step_fraction: settings.switch_step_fraction,
+        law: LawContext {
+            mass: body.mass(),
+            inertia_cm: body.inertia_cm(),
+            dt: settings.dt,
+        },
+        closing: false,
+        eps: 0.0,
+        nodes: [(f64::NAN, f64::NAN); 2],
+        v_time: 0.0,
+        span: (0.0, 0.0),
+        max_drift: 0.0,
+        min_speed: f64::INFINITY,
+        step_time: Duration::ZERO,
+        loop_start: Instant::now(),
     };
+    // No supports' forces are read: the loop's per-support vectors are empty.
+    let cfg = StepLoop::new(settings.dt, 0, 0.0);
+    Ok(Stepping::new(w, problem, cfg, state))
+}
 
-    let mut state = read(&world, init.theta);
-    let expected_steps: f64 = problem
-        .pushes
-        .iter()
-        .map(|p| (p.duration / settings.dt).ceil() + 2.0)
-        .sum();
-    let mut history = Vec::with_capacity(1 + expected_steps.min(1e7) as usize);
-    history.push(StepRecord {
-        segment: 0,
-        t0: 0.0,
-        t1: 0.0,
-        x: state.x,
-        y: state.y,
-        theta: state.theta,
-        omega: state.omega,
-    });
-    let mut steps = 0usize;
-    let mut max_drift = 0.0f64;
-    let mut min_speed = f64::INFINITY;
-    let mut t_seg = 0.0;
-    // Leapfrog: the time the object's current velocity stands for.
-    let mut v_time = 0.0;
-    let mut step_time = Duration::ZERO;
-    let loop_start = Instant::now();
+/// What the engine code hands back once the loop is done.
+pub(crate) fn raw_run(world: World2d, stepped: &Stepped) -> RawRun {
+    RawRun {
+        history: stepped.records(),
+        steps: stepped.steps,
+        step_time: world.step_time,
+        loop_time: world.loop_start.elapsed(),
+        max_drift: world.max_drift,
+        min_support_speed: if world.min_speed.is_finite() {
+            world.min_speed
+        } else {
+            0.0
+        },
+    }
+}
 
-    for (j, push) in problem.pushes.iter().enumerate() {
-        let n = (push.duration / settings.dt * (1.0 - 1e-12))
-            .ceil()
-            .max(1.0) as usize;
-        let h = push.duration / n as f64;
-        let leapfrog = settings.friction_velocity == FrictionVelocity::Leapfrog;
-        // Step lengths of this segment: an optional switch step, then n steps
-        // whose first one is shortened by the switch step's length. In
-        // leapfrog mode, a segment followed by a switch also ends with a
-        // closing step of the same length, taken off the step before it.
-        let eps = settings.switch_step_fraction * h;
-        let closing = leapfrog && eps > 0.0 && j + 1 < problem.pushes.len();
+/// The object's state; `prev_theta` unwraps the angle.
+fn read(world: &PhysicsWorld, object: RigidBodyHandle, prev_theta: f64) -> State {
+    let rb = &world.bodies[object];
+    let t = rb.translation();
+    let r = rb.rotation();
+    let a = r.angle() as f64;
+    // Unwrap: the engine's angle lives in (−π, π].
+    let mut d = a - prev_theta.rem_euclid(std::f64::consts::TAU);
+    d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    let lv = rb.linvel();
+    State {
+        x: t.x as f64,
+        y: t.y as f64,
+        theta: prev_theta + d,
+        rot: Rot {
+            c: r.re as f64,
+            s: r.im as f64,
+        },
+        omega: rb.angvel() as f64,
+        v: [lv.x as f64, lv.y as f64],
+    }
+}
+
+impl PlateWorld for World2d {
+    type State = State;
+
+    fn plate(&self, s: &State) -> Plate {
+        Plate {
+            x: s.x,
+            y: s.y,
+            z: 0.0,
+            theta: s.theta,
+            omega: s.omega,
+            tilt: 0.0,
+        }
+    }
+
+    /// An optional switch step, then `n` steps whose first one is shortened
+    /// by the switch step's length. In leapfrog mode, a segment followed by
+    /// a switch also ends with a closing step of the same length, taken off
+    /// the step before it.
+    fn segment_steps(
+        &mut self,
+        _push: &Push,
+        n: usize,
+        h: f64,
+        followed: bool,
+    ) -> Option<StepLayout> {
+        let leapfrog = self.friction_velocity == FrictionVelocity::Leapfrog;
+        let eps = self.switch_step_fraction * h;
+        let closing = leapfrog && eps > 0.0 && followed;
         let mut lengths: Vec<f64> = Vec::with_capacity(n + 2);
         if eps > 0.0 {
             lengths.push(eps);
@@ -218,155 +303,154 @@ pub(crate) fn simulate(
             lengths.push(eps);
         }
         // The friction law's constants; the impulse cap uses the nominal step.
-        let law = LawContext {
-            mass: body.mass(),
-            inertia_cm: body.inertia_cm(),
+        self.law = LawContext {
+            mass: self.mass,
+            inertia_cm: self.inertia_cm,
             dt: h,
         };
-        let closing_step = if closing {
-            lengths.len() - 1
-        } else {
-            usize::MAX
-        };
-
-        // Step velocities of this segment, placed at step middles, for the
-        // midpoint extrapolation.
-        let mut nodes: [(f64, f64); 2] = [(f64::NAN, f64::NAN); 2];
-        let mut t = t_seg;
-        let seg_end = t_seg + push.duration;
-        for (k, &len) in lengths.iter().enumerate() {
-            let t1 = if k + 1 == lengths.len() {
-                seg_end
-            } else {
-                t + len
-            };
-            let hk = t1 - t;
-            let omega_at = |tq: f64| -> f64 {
-                // k = number of steps of this segment already taken.
-                match k {
-                    0 => state.omega,
-                    1 => nodes[1].1,
-                    _ => {
-                        let (a, b) = (nodes[0], nodes[1]);
-                        b.1 + (b.1 - a.1) * (tq - b.0) / (b.0 - a.0)
-                    }
-                }
-            };
-            let vc = push.velocity();
-            let vc = [vc.x, vc.y];
-            // ω the friction sees, the pusher velocity, and the factor on the
-            // friction forces.
-            let (omega_f, vp, friction_scale) = match settings.friction_velocity {
-                FrictionVelocity::Body | FrictionVelocity::Constraint => {
-                    (state.omega, state.rot.apply(vc), 1.0)
-                }
-                FrictionVelocity::Midpoint => {
-                    let w_mid = omega_at(t + 0.5 * hk);
-                    (omega_at(t), rot(state.theta + 0.5 * hk * w_mid, vc), 1.0)
-                }
-                FrictionVelocity::Leapfrog => {
-                    // The time the coming step's velocity stands for: the
-                    // switch time for the switch step (the velocity just
-                    // after the impulse) and for the closing step (the
-                    // velocity just before the next switch), the step's
-                    // middle otherwise.
-                    let (t_v, reach) = if k == 0 && eps > 0.0 {
-                        (t, 0.0)
-                    } else if k == closing_step {
-                        (t1, hk)
-                    } else {
-                        (t + 0.5 * hk, 0.5 * hk)
-                    };
-                    let w = omega_at(t_v);
-                    // rapier turns the body by atan(h ω) over a step.
-                    let rot_v = state.rot.then(Rot::atan(reach * w));
-                    let a = rot_v.apply(vc);
-                    let c0 = state.rot.apply(pc);
-                    let c1 = rot_v.apply(pc);
-                    // v_c R(θ_v) n_φ + ω D (R(θ) − R(θ_v)) p_c: the joint,
-                    // whose lever arm is R(θ) p_c, then gives the centre of
-                    // mass the velocity R(θ_v)(v_c n_φ − ω D p_c) it has at
-                    // t_v: for a mid-step t_v, the chord of the arc it
-                    // should follow over the step.
-                    let vp = [a[0] - w * (c0[1] - c1[1]), a[1] + w * (c0[0] - c1[0])];
-                    // The friction impulse takes the velocity from the time
-                    // the previous one stands for to t_v (a half kick at the
-                    // start of a segment, a full step's in its body).
-                    let scale = (t_v - v_time) / hk;
-                    v_time = t_v;
-                    (omega_at(t), vp, scale)
-                }
-            };
-            let repin = leapfrog;
-            if repin {
-                // Pin the pusher on the object's contact point: no position
-                // error for the joint's bias to correct, so the body moves
-                // with the velocity the joint solved for.
-                let rc = state.rot.apply(pc);
-                world.bodies[pusher].set_translation(v(state.x + rc[0], state.y + rc[1]), true);
-            }
-            apply_step_forces(
-                &mut world,
-                object,
-                pusher,
-                vc,
-                vp,
-                &supports,
-                pc,
-                &state,
-                omega_f,
-                settings.friction_velocity,
-                friction_scale,
-                &mut min_speed,
-                (settings.friction_model, &law),
-            );
-            world.integration_parameters.dt = hk as Real;
-            let before = Instant::now();
-            world.step();
-            step_time += before.elapsed();
-            steps += 1;
-
-            state = read(&world, state.theta);
-            if !(state.x.is_finite()
-                && state.y.is_finite()
-                && state.theta.is_finite()
-                && state.omega.is_finite())
-            {
-                return Err(ModelError::NonFinite { t: t1, step: steps });
-            }
-            let anchor = world.bodies[pusher].translation();
-            let rc = state.rot.apply(pc);
-            let drift = ((anchor.x as f64 - state.x - rc[0]).powi(2)
-                + (anchor.y as f64 - state.y - rc[1]).powi(2))
-            .sqrt();
-            max_drift = max_drift.max(drift);
-            history.push(StepRecord {
-                segment: j,
-                t0: t,
-                t1,
-                x: state.x,
-                y: state.y,
-                theta: state.theta,
-                omega: state.omega,
-            });
-            nodes[0] = nodes[1];
-            nodes[1] = (if leapfrog { v_time } else { 0.5 * (t + t1) }, state.omega);
-            t = t1;
-        }
-        t_seg = seg_end;
+        self.closing = closing;
+        self.eps = eps;
+        self.nodes = [(f64::NAN, f64::NAN); 2];
+        Some(StepLayout::Lengths(lengths))
     }
-    Ok(RawRun {
-        history,
-        steps,
-        step_time,
-        loop_time: loop_start.elapsed(),
-        max_drift,
-        min_support_speed: if min_speed.is_finite() {
-            min_speed
-        } else {
-            0.0
-        },
-    })
+
+    fn drive_step(&mut self, state: &State, plan: &StepPlan) -> f64 {
+        let (k, t, t1, hk) = (plan.index, plan.t0, plan.t1, plan.h);
+        let eps = self.eps;
+        let closing_step = self.closing && k + 1 == plan.steps;
+        let nodes = self.nodes;
+        let omega_at = |tq: f64| -> f64 {
+            // k = number of steps of this segment already taken.
+            match k {
+                0 => state.omega,
+                1 => nodes[1].1,
+                _ => {
+                    let (a, b) = (nodes[0], nodes[1]);
+                    b.1 + (b.1 - a.1) * (tq - b.0) / (b.0 - a.0)
+                }
+            }
+        };
+        let pc = self.pc;
+        let vc = plan.push.velocity();
+        let vc = [vc.x, vc.y];
+        // ω the friction sees, the pusher velocity, and the factor on the
+        // friction forces.
+        let (omega_f, vp, friction_scale) = match self.friction_velocity {
+            FrictionVelocity::Body | FrictionVelocity::Constraint => {
+                (state.omega, state.rot.apply(vc), 1.0)
+            }
+            FrictionVelocity::Midpoint => {
+                let w_mid = omega_at(t + 0.5 * hk);
+                (omega_at(t), rot(state.theta + 0.5 * hk * w_mid, vc), 1.0)
+            }
+            FrictionVelocity::Leapfrog => {
+                // The time the coming step's velocity stands for: the
+                // switch time for the switch step (the velocity just
+                // after the impulse) and for the closing step (the
+                // velocity just before the next switch), the step's
+                // middle otherwise.
+                let (t_v, reach) = if k == 0 && eps > 0.0 {
+                    (t, 0.0)
+                } else if closing_step {
+                    (t1, hk)
+                } else {
+                    (t + 0.5 * hk, 0.5 * hk)
+                };
+                let w = omega_at(t_v);
+                // rapier turns the body by atan(h ω) over a step.
+                let rot_v = state.rot.then(Rot::atan(reach * w));
+                let a = rot_v.apply(vc);
+                let c0 = state.rot.apply(pc);
+                let c1 = rot_v.apply(pc);
+                // v_c R(θ_v) n_φ + ω D (R(θ) − R(θ_v)) p_c: the joint,
+                // whose lever arm is R(θ) p_c, then gives the centre of
+                // mass the velocity R(θ_v)(v_c n_φ − ω D p_c) it has at
+                // t_v: for a mid-step t_v, the chord of the arc it
+                // should follow over the step.
+                let vp = [a[0] - w * (c0[1] - c1[1]), a[1] + w * (c0[0] - c1[0])];
+                // The friction impulse takes the velocity from the time
+                // the previous one stands for to t_v (a half kick at the
+                // start of a segment, a full step's in its body).
+                let scale = (t_v - self.v_time) / hk;
+                self.v_time = t_v;
+                (omega_at(t), vp, scale)
+            }
+        };
+        if self.friction_velocity == FrictionVelocity::Leapfrog {
+            // Pin the pusher on the object's contact point: no position
+            // error for the joint's bias to correct, so the body moves
+            // with the velocity the joint solved for.
+            let rc = state.rot.apply(pc);
+            self.world.bodies[self.pusher]
+                .set_translation(v(state.x + rc[0], state.y + rc[1]), true);
+        }
+        apply_step_forces(
+            &mut self.world,
+            self.object,
+            self.pusher,
+            vc,
+            vp,
+            &self.supports,
+            pc,
+            state,
+            omega_f,
+            self.friction_velocity,
+            friction_scale,
+            &mut self.min_speed,
+            (self.friction_model, &self.law),
+        );
+        self.span = (t, t1);
+        // The drift is measured after the step (`after_step`).
+        0.0
+    }
+
+    fn drive(&mut self, _state: &State, _velocity: [f64; 2], _h: f64) -> f64 {
+        unreachable!("the rapier2d world drives its pusher in drive_step")
+    }
+
+    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
+        self.world.integration_parameters.dt = h as Real;
+        let before = Instant::now();
+        self.world.step();
+        self.step_time += before.elapsed();
+        Ok(())
+    }
+
+    fn state(&mut self, prev: &State) -> State {
+        read(&self.world, self.object, prev.theta)
+    }
+
+    fn support_forces(&mut self, _: &State, _h: f64) -> Result<Option<SupportForces>, ModelError> {
+        Ok(None)
+    }
+
+    fn finite(&self, s: &State) -> bool {
+        s.x.is_finite() && s.y.is_finite() && s.theta.is_finite() && s.omega.is_finite()
+    }
+
+    fn after_step(&mut self, state: &State) {
+        let anchor = self.world.bodies[self.pusher].translation();
+        let rc = state.rot.apply(self.pc);
+        let drift = ((anchor.x as f64 - state.x - rc[0]).powi(2)
+            + (anchor.y as f64 - state.y - rc[1]).powi(2))
+        .sqrt();
+        self.max_drift = self.max_drift.max(drift);
+        let (t, t1) = self.span;
+        let leapfrog = self.friction_velocity == FrictionVelocity::Leapfrog;
+        self.nodes[0] = self.nodes[1];
+        self.nodes[1] = (
+            if leapfrog {
+                self.v_time
+            } else {
+                0.5 * (t + t1)
+            },
+            state.omega,
+        );
+    }
+
+    fn cm_velocity(&self, s: &State) -> Option<[f64; 2]> {
+        Some(s.v)
+    }
 }
 
 /// Attaches the massless, non-interacting colliders of

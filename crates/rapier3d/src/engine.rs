@@ -2,11 +2,14 @@
 //! `FrictionModel::Coulomb`) and `rapier3d_simplified` (its default,
 //! `Simplified`), the plate on ball feet on a ground plane.
 
+use std::time::Instant;
+
+use pushval_engine::stepping::{PlateFinish, PlateSession};
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys,
+    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys,
 };
-use pushval_model::{ModelError, Problem};
+use pushval_model::{ModelError, Problem, Simulator};
 
 use crate::predict::{Law, Rapier3dTilt, SceneParams};
 use crate::{ContactFriction, FeetColliders, Rapier3dSettings, Rapier3dSimulator};
@@ -116,26 +119,51 @@ impl Engine for Rapier3dModel {
             "label": s.label(),
         })
     }
+    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = Rapier3dSimulator::new(Rapier3dSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The scene, settled, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
+    /// with the first push of `problem`'s schedule.
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let started = Instant::now();
+        let sim = Rapier3dSimulator::new(Rapier3dSettings {
             dt,
             ..self.settings
-        })
-        .run(problem)?;
-        Ok(EngineRun {
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "steps": r.steps,
-                "max_joint_drift": r.max_joint_drift,
-                "max_tilt": r.max_tilt,
-                "max_lift": r.max_lift,
-                "loads": r.loads,
-            }),
-            trajectory: r.trajectory,
-            contact: r.contact,
-        })
+        });
+        let (stepping, set_up) = match sim
+            .settings
+            .check()
+            .and_then(|()| crate::world::start(problem, &sim.settings))
+        {
+            Ok(s) => s,
+            Err(e) => return Some(Err(e)),
+        };
+        let finish: PlateFinish<'a, _> = Box::new(move |_, stepped, problem| {
+            let mut r = crate::world::finish(set_up, stepped, problem);
+            r.trajectory.model = sim.name();
+            Ok(EngineRun {
+                dt,
+                steps: r.steps,
+                wall_time: started.elapsed(),
+                diagnostics: serde_json::json!({
+                    "steps": r.steps,
+                    "max_joint_drift": r.max_joint_drift,
+                    "max_tilt": r.max_tilt,
+                    "max_lift": r.max_lift,
+                    "loads": r.loads,
+                }),
+                trajectory: r.trajectory,
+                contact: r.contact,
+            })
+        });
+        Some(Ok(Box::new(PlateSession::new(stepping, finish))))
     }
 }
 

@@ -2,7 +2,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use pushval_engine::stepping::{self, Plate, PlateWorld, StepLoop, SupportForces};
+use pushval_engine::stepping::{Plate, PlateWorld, StepLoop, Stepped, Stepping, SupportForces};
 use pushval_model::{ModelError, Problem};
 use rapier3d_f64::prelude::*;
 
@@ -29,7 +29,7 @@ fn v3(x: f64, y: f64, z: f64) -> Vector {
 
 /// The object's state as read from the engine.
 #[derive(Clone, Copy)]
-struct State {
+pub(crate) struct State {
     pose: Pose,
     theta: f64,
     omega: f64,
@@ -116,7 +116,7 @@ fn nearest(points: &[[f64; 2]], x: f64, y: f64) -> usize {
 }
 
 /// The scene as the shared stepping loop sees it.
-struct Scene3d {
+pub(crate) struct Scene3d {
     world: PhysicsWorld,
     object: RigidBodyHandle,
     pusher: RigidBodyHandle,
@@ -172,6 +172,11 @@ impl PlateWorld for Scene3d {
         let u = rb.velocity_at_point(wp);
         Some((u.x * u.x + u.y * u.y).sqrt())
     }
+
+    fn cm_velocity(&self, _st: &State) -> Option<[f64; 2]> {
+        let v = self.world.bodies[self.object].linvel();
+        Some([v.x, v.y])
+    }
 }
 
 impl Scene3d {
@@ -189,8 +194,32 @@ impl Scene3d {
     }
 }
 
+/// What the set-up measured, for the run's outputs.
+pub(crate) struct SetUp {
+    settings: Rapier3dSettings,
+    mu: Vec<f64>,
+    nominal_loads: Vec<f64>,
+    rest_loads: Vec<f64>,
+    manifolds: usize,
+    manifold_points: usize,
+}
+
 /// Runs the problem.
 pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier3dRun, ModelError> {
+    let (mut stepping, set_up) = start(problem, s)?;
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    let (_, run, problem) = stepping.finish();
+    Ok(finish(set_up, run, &problem))
+}
+
+/// Builds the scene, settles it and hands it to the shared loop; an object
+/// not starting at rest starts with the first push of `problem`'s schedule.
+pub(crate) fn start(
+    problem: &Problem,
+    s: &Rapier3dSettings,
+) -> Result<(Stepping<Scene3d>, SetUp), ModelError> {
     let scene = scene_of(problem, s)?;
     let nominal_loads = scene.rest_loads();
     let init = problem.initial;
@@ -323,7 +352,7 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
 
     // Start: moving with the first push at ω = initial.omega, unless from rest.
     if !init.from_rest {
-        let p = problem.pushes[0];
+        let p = *problem.pushes.first().ok_or(ModelError::EmptySchedule)?;
         let vc = p.velocity();
         let local = [vc.x + init.omega * pc[1], vc.y - init.omega * pc[0]];
         let (sn, cs) = state.theta.sin_cos();
@@ -342,15 +371,28 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
     }
 
     let cfg = StepLoop::new(s.dt, n_feet, z_rest);
-    let run = stepping::run_pushes(&mut w, problem, &cfg, state)?;
-    Ok(Rapier3dRun {
-        trajectory: run.trajectory(problem),
+    let set_up = SetUp {
         settings: *s,
-        steps: run.steps,
-        wall_time: Default::default(),
         mu: scene.mu.clone(),
         nominal_loads,
         rest_loads,
+        manifolds,
+        manifold_points,
+    };
+    Ok((Stepping::new(w, problem, cfg, state), set_up))
+}
+
+/// The run of the pushes applied (`problem`'s schedule), from what the loop
+/// gathered.
+pub(crate) fn finish(set_up: SetUp, run: Stepped, problem: &Problem) -> Rapier3dRun {
+    Rapier3dRun {
+        trajectory: run.trajectory(problem),
+        settings: set_up.settings,
+        steps: run.steps,
+        wall_time: Default::default(),
+        mu: set_up.mu,
+        nominal_loads: set_up.nominal_loads,
+        rest_loads: set_up.rest_loads,
         segment_tail_omega: run.segment_tail_omega,
         segment_tail_loads: run.segment_tail_loads,
         loads: run.loads,
@@ -361,8 +403,8 @@ pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier
         max_tilt: run.max_tilt,
         max_lift: run.max_lift,
         max_joint_drift: run.max_joint_drift,
-        manifolds,
-        manifold_points,
+        manifolds: set_up.manifolds,
+        manifold_points: set_up.manifold_points,
         history: run.history,
-    })
+    }
 }
