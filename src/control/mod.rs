@@ -185,7 +185,11 @@ pub fn push_cone(problem: &Problem) -> (f64, f64) {
     if hi - lo < 1e-9 {
         (lo - 0.9 * widen, hi + 0.9 * widen)
     } else {
-        (lo, hi)
+        // A corner: the cone between its two normals, widened by half the
+        // contact's friction angle either side (the pusher may slant
+        // a little while its force stays in the friction cone; the
+        // model's checks say where it does not).
+        (lo - 0.5 * widen, hi + 0.5 * widen)
     }
 }
 

@@ -195,7 +195,11 @@ pub fn run_loop(
     let (mut planner, first) = plan_from_rest(problem, goal, spec.plan, spec.reach)
         .context("the predictor failed on every starting guess from rest")?;
     let plan_converged = first.converged;
-    let plant = spec.plant.apply(problem)?;
+    // The session starts on the first plan's schedule: what an engine reads
+    // of the schedule at `start` (a push following a segment) is the best
+    // guess there is of what the loop will apply.
+    let mut plant = spec.plant.apply(problem)?;
+    plant.pushes = first.pushes.clone();
     let mut session = engine
         .start(&plant, dt)
         .with_context(|| format!("{}: starting a session", engine.name()))?;
@@ -225,8 +229,8 @@ pub fn run_loop(
             gave_up = true;
             break;
         }
-        if remaining <= n as f64 * spec.period * (1.0 + 1e-9) {
-            // Too little time left to re-plan per period: the rest as planned.
+        if remaining <= spec.period * (1.0 + 1e-9) {
+            // The last period: the rest as planned.
             for p in &pushes {
                 session.advance(p)?;
                 applied.push(Applied { t0: t, push: *p });
@@ -255,7 +259,11 @@ pub fn run_loop(
             },
         };
         let clock = Instant::now();
-        let warm = planner.with_duration(&params, remaining);
+        // As the time left shrinks, so does the number of pushes: each keeps
+        // at least one period (down to one push: then the least-squares
+        // pose nearest the goal).
+        let segments = ((remaining / spec.period * (1.0 + 1e-9)).floor() as usize).clamp(1, n);
+        let warm = planner.with_duration(&resample(&params, segments), remaining);
         let mut solved = planner.solve(&start, warm.clone(), 4);
         if !solved.as_ref().is_some_and(|s| s.converged) {
             // The warm start stalled: a fresh Jacobian and more steps, then
@@ -264,7 +272,7 @@ pub fn run_loop(
             let retry = planner.solve(&start, warm, 30);
             solved = nearest(solved, retry);
             if !solved.as_ref().is_some_and(|s| s.converged) {
-                let fresh = planner.plan_with_time(&start, remaining);
+                let fresh = planner.plan_with_time(&start, remaining, segments);
                 solved = nearest(solved, fresh);
             }
         }
@@ -300,6 +308,21 @@ pub fn run_loop(
         plan_converged,
         replayed,
     })
+}
+
+/// `params` with `segments` pushes: each new push takes the direction of the
+/// old push at its middle (the same piecewise-constant schedule, coarser).
+fn resample(params: &super::plan::Params, segments: usize) -> super::plan::Params {
+    let old = params.u.len();
+    if old == segments {
+        return params.clone();
+    }
+    super::plan::Params {
+        u: (0..segments)
+            .map(|k| params.u[(((k as f64 + 0.5) / segments as f64) * old as f64) as usize % old])
+            .collect(),
+        s: params.s,
+    }
 }
 
 /// The nearer of two solutions to the goal.

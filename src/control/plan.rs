@@ -474,11 +474,17 @@ impl Planner {
     /// directions at the cone's middle and either side), the first that
     /// converges, else the nearest.
     pub fn plan(&mut self, start: &Start) -> Option<Solution> {
-        self.plan_with_time(start, self.t_ref)
+        self.plan_with_time(start, self.t_ref, self.spec.segments)
     }
 
-    /// [`Planner::plan`] with the starting guesses' durations scaled from `t0` (s).
-    pub fn plan_with_time(&mut self, start: &Start, t0: f64) -> Option<Solution> {
+    /// [`Planner::plan`] with `segments` pushes and the starting guesses'
+    /// durations scaled from `t0` (s).
+    pub fn plan_with_time(
+        &mut self,
+        start: &Start,
+        t0: f64,
+        segments: usize,
+    ) -> Option<Solution> {
         let guesses = [
             (1.0, 0.0),
             (1.0, 0.5),
@@ -491,7 +497,8 @@ impl Planner {
         let mut best: Option<Solution> = None;
         for (tm, off) in guesses {
             self.forget();
-            let p = self.initial_params(t0 * tm, off);
+            let mut p = self.initial_params(t0 * tm, off);
+            p.u.truncate(segments.max(1));
             if let Some(s) = self.solve(start, p, 40) {
                 if s.converged {
                     return Some(s);

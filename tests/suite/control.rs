@@ -64,9 +64,12 @@ fn a_dynamic_plan_reaches_its_goal_when_the_model_runs_it_at_full_accuracy() {
         let d = (f[0] - GOAL.x).hypot(f[1] - GOAL.y);
         assert!(d < 2e-3, "{v} m/s: {d} m from the goal");
         assert!((f[2] - GOAL.theta).abs() < 5e-3, "{v} m/s: {f:?}");
-        // Every push points into the object (the pushing cone of the corner).
+        // Every push stays in the pushing cone: the corner's normals [0, π/2]
+        // widened by half the contact's friction angle (μ_c = 0.8) each side.
+        let w = 0.5 * 0.8_f64.atan();
+        assert_eq!(pushval::control::push_cone(&p), (-w, FRAC_PI_2 + w));
         for q in &out.solution.pushes {
-            assert!((-1e-9..=FRAC_PI_2 + 1e-9).contains(&q.phi), "{q:?}");
+            assert!((-w - 1e-9..=FRAC_PI_2 + w + 1e-9).contains(&q.phi), "{q:?}");
         }
     }
 }
@@ -352,7 +355,8 @@ fn loop_writes_the_applied_push_and_loop_json() {
         let speed: f64 = f[6].parse().unwrap();
         let phi: f64 = f[7].parse().unwrap();
         assert_eq!(speed, 1.0, "{l}");
-        assert!((-1e-9..=FRAC_PI_2 + 1e-9).contains(&phi), "{l}");
+        let w = 0.5 * 0.8_f64.atan();
+        assert!((-w - 1e-9..=FRAC_PI_2 + w + 1e-9).contains(&phi), "{l}");
     }
 }
 
