@@ -80,7 +80,7 @@ fn identified(sc: &pushval_scenario::Scenario, s: &Settings) -> anyhow::Result<V
 /// of [`COLUMNS`] (NaN where not fitted).
 pub fn fit_engine(engine: &dyn Engine, k: usize, study_dt: f64) -> anyhow::Result<Vec<f64>> {
     let settings = Settings::default();
-    let sc = crate::registry::load(crate::registry::default_scenario_dir().join(SCHEDULES[k]))?;
+    let sc = crate::registry::load(crate::scenario_dir::default_scenario_dir().join(SCHEDULES[k]))?;
     let problem = sc.problem();
     let dt = study_dt / STEP_DIVISOR;
     let run = |h: f64| {
