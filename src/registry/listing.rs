@@ -5,6 +5,7 @@
 //! (`Engine::law`, an outside engine `law = "NAME"` in `pushval.toml`), and
 //! the laws' listing joins the two here.
 
+use pushval_engine::FrictionLaw;
 use pushval_laws::{LawEntry, ParamKind, ParamSpec};
 use pushval_scenario::ANALYTIC_MODELS;
 
@@ -68,16 +69,16 @@ pub fn engines_table() -> String {
 
 /// Each catalogue law with the engines that declare it, in catalogue order.
 ///
-/// A compiled-in model declares the entry whose default law has the name of
-/// the law it follows with its default options (`Engine::law`); an outside
-/// engine of the loaded `pushval.toml` declares the entry it names
+/// A compiled-in model declares the entry whose default law is the law it
+/// follows with its default options (`Engine::law`), told by [`law_key`]; an
+/// outside engine of the loaded `pushval.toml` declares the entry it names
 /// (`law = "NAME"`). Compiled-in models come first, in registry order.
 pub fn declarations() -> Vec<(LawEntry, Vec<String>)> {
-    let models: Vec<(String, String)> = crate_entries()
+    let models: Vec<(String, &'static str)> = crate_entries()
         .iter()
         .filter_map(|m| {
             let engine = m.default_engine();
-            let law = engine.law()?.law_name().to_string();
+            let law = law_key(engine.law()?);
             Some((m.name.to_string(), law))
         })
         .collect();
@@ -85,7 +86,7 @@ pub fn declarations() -> Vec<(LawEntry, Vec<String>)> {
     pushval_laws::catalog()
         .into_iter()
         .map(|entry| {
-            let law = entry.default_law().law_name().to_string();
+            let law = law_key(&*entry.default_law());
             let engines = models
                 .iter()
                 .filter(|(_, l)| *l == law)
@@ -100,6 +101,13 @@ pub fn declarations() -> Vec<(LawEntry, Vec<String>)> {
             (entry, engines)
         })
         .collect()
+}
+
+/// What tells a law's catalogue entry: the entry it names
+/// ([`FrictionLaw::catalog_name`]), else its name ([`FrictionLaw::law_name`];
+/// a test checks that these keys tell every catalogue entry apart).
+pub fn law_key(law: &dyn FrictionLaw) -> &'static str {
+    law.catalog_name().unwrap_or_else(|| law.law_name())
 }
 
 /// A parameter's default as `pushval laws` shows it (`0.01 m/s`, `"welded"`).

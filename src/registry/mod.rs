@@ -21,7 +21,7 @@ mod models;
 mod project;
 
 pub use check::{check, from_toml, load};
-pub use listing::{declarations, engines_table, laws_json, laws_table};
+pub use listing::{declarations, engines_table, law_key, laws_json, laws_table};
 pub use models::{
     engine, engine_options, entries, entry, feature_of, known_models, outside_law,
     use_engines_file, CrateRow, Entry, ENGINE_CRATES,

@@ -689,3 +689,26 @@ fn crates_depend_downwards() {
         }
     }
 }
+
+/// The registry's rows name exactly the root package's features: an engine
+/// behind a feature is one row that says so, and `.ci/run` builds every
+/// feature `Cargo.toml` has.
+#[test]
+fn registry_rows_name_the_root_features() {
+    let doc: toml::Table = std::fs::read_to_string(root().join("Cargo.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let features: BTreeSet<&str> = doc["features"]
+        .as_table()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .filter(|f| *f != "default")
+        .collect();
+    let rows: BTreeSet<&str> = pushval::registry::ENGINE_CRATES
+        .iter()
+        .filter_map(|c| c.feature)
+        .collect();
+    assert_eq!(rows, features);
+}

@@ -117,22 +117,23 @@ const DECLARED: &[(&str, &[&str])] = &[
 /// declares a law (with default options) is listed under exactly one
 /// catalogue law, whose default value is the same law (same name, steady ω
 /// bit for bit, class and loads on the paper plate), the join is the one
-/// `DECLARED` states, and the join's key (a law's name) tells the
-/// catalogue's laws apart.
+/// `DECLARED` states, and the join's key (`registry::law_key`: a law's
+/// catalogue name where it has one, else its name) tells the catalogue's
+/// laws apart.
 #[test]
 fn every_compiled_in_law_is_in_the_catalogue() {
     let models: Vec<_> = pushval::registry::ENGINE_CRATES
         .iter()
         .flat_map(|c| (c.models)())
         .collect();
-    let names: Vec<&str> = catalog()
+    let keys: Vec<&str> = catalog()
         .iter()
-        .map(|e| e.default_law().law_name())
+        .map(|e| pushval::registry::law_key(&*e.default_law()))
         .collect();
-    for (i, n) in names.iter().enumerate() {
+    for (i, k) in keys.iter().enumerate() {
         assert!(
-            !names[..i].contains(n),
-            "two catalogue laws are named {n:?}"
+            !keys[..i].contains(k),
+            "two catalogue laws have the key {k:?}"
         );
     }
     // Other tests load pushval.toml files: keep the compiled-in models.
