@@ -189,7 +189,7 @@ fn main() {
     let runs = if quick { 3 } else { 11 };
     let sc = Scenario::from_path(root().join("scenarios/paper-square-v1.0.toml")).unwrap();
     let problem: Problem = sc.problem();
-    let options: EngineOptions = sc.engine.clone();
+    let options: EngineOptions = pushval::registry::engine_options(&sc);
     let py = resolved_python();
     let input =
         serde_json::to_vec(&problem_document("pure_python", &problem, &options, DT)).unwrap();

@@ -3,6 +3,7 @@
 //! `trajectory.csv`). The command line in `main.rs` is a thin layer over this.
 
 pub mod atomic;
+pub mod compare;
 pub mod control;
 pub mod fit;
 pub mod harness;
@@ -11,12 +12,12 @@ pub mod inject;
 pub mod manifest;
 pub mod outdir;
 pub mod output;
-pub mod outside;
 pub mod parallel;
 pub mod plot;
 pub mod power;
 pub mod registry;
 pub mod report;
+pub mod scenario_dir;
 pub mod shard;
 pub mod shipped;
 pub mod stress;

@@ -512,8 +512,8 @@ fn run(file: PathBuf, out: PathBuf) -> anyhow::Result<ExitCode> {
 
 fn compare(file: PathBuf, csv: PathBuf, model: Option<String>) -> anyhow::Result<ExitCode> {
     let sc = pushval::registry::load(&file)?;
-    let outside = pushval::outside::read_trajectory(&csv, model.as_deref())?;
-    let (mut report, comparisons) = pushval::outside::compare_outside(&sc, &outside)?;
+    let outside = pushval::compare::read_trajectory(&csv, model.as_deref())?;
+    let (mut report, comparisons) = pushval::compare::compare_outside(&sc, &outside)?;
     report.comparisons = comparisons;
     print!("{}", output::table(std::slice::from_ref(&report)));
     if let Some(note) = outside.omega_note() {
@@ -551,11 +551,12 @@ fn problem(
         .or_else(|| sc.gate.first().cloned())
         .unwrap_or_default();
     let problem = sc.problem();
+    let options = pushval::registry::engine_options(&sc);
     let doc = if protocol == 2 {
-        let limits = pushval_outside::Limits::for_problem(&problem, dt);
-        pushval_outside::problem_document_v2(&engine, &problem, &sc.engine, dt, limits)
+        let limits = pushval::registry::Limits::for_problem(&problem, dt);
+        pushval::registry::problem_document_v2(&engine, &problem, &options, dt, limits)
     } else {
-        pushval::registry::problem_document(&engine, &problem, &sc.engine, dt)
+        pushval::registry::problem_document(&engine, &problem, &options, dt)
     };
     println!("{}", serde_json::to_string_pretty(&doc)?);
     Ok(ExitCode::SUCCESS)
@@ -718,7 +719,7 @@ fn main() -> ExitCode {
             },
         ),
     };
-    pushval_outside::shutdown_sessions();
+    pushval::registry::shutdown_sessions();
     match result {
         Ok(code) => code,
         Err(e) => {

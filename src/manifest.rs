@@ -15,7 +15,8 @@
 //! the registry (the outside engines of `pushval.toml` included), `*` any
 //! run of characters within one segment. The command's `{model}` is the
 //! model the folder names. A command `pushval ARGS` runs on the default
-//! build; for a model of a crate behind a cargo feature ([`FEATURES`]) it
+//! build; for a model of a crate behind a cargo feature (the registry's
+//! row for the crate says which, [`crate::registry::feature_of`]) it
 //! becomes `cargo run --release --features F -- ARGS`.
 //!
 //! Not walked: hidden files (an interrupted atomic write's `.tmp*`) and
@@ -29,7 +30,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
-use pushval_engine::ModelEntry;
 
 /// The manifest, relative to the repository root.
 pub const MANIFEST: &str = "results/MANIFEST.csv";
@@ -239,24 +239,10 @@ pub const RULES: &[Rule] = &[
 /// gone fails `--check`: remove it here then).
 pub const STALE: &[(&str, &str)] = &[];
 
-/// An engine crate's model table (as [`crate::registry::ENGINE_CRATES`] holds it).
-pub type ModelTable = fn() -> Vec<ModelEntry>;
-
-/// The cargo feature behind each engine crate that has one (the root
-/// package's `[features]`), by the crate's model table.
-pub const FEATURES: &[(&str, ModelTable)] = &[
-    ("mujoco", pushval_mujoco::models),
-    ("physx", pushval_physx::models),
-    ("avian", pushval_avian::models),
-    ("jolt", pushval_jolt::models),
-];
-
-/// The cargo feature a build needs for `model`, if any.
+/// The cargo feature a build needs for `model`, if any (the registry's
+/// row for its crate).
 pub fn feature_of(model: &str) -> Option<&'static str> {
-    FEATURES
-        .iter()
-        .find(|(_, models)| models().iter().any(|e| e.name == model))
-        .map(|(f, _)| *f)
+    crate::registry::feature_of(model)
 }
 
 /// A command line for `model`: `{model}` replaced and, for a `pushval`

@@ -203,7 +203,7 @@ pub fn engine_of(
         )
     })?;
     let engine = entry
-        .build(&sc.engine)
+        .build(&crate::registry::engine_options(sc))
         .map_err(|e| anyhow::anyhow!("{}: [engine]: {e}", sc.path.display()))?;
     if let Err(why) = engine.availability() {
         bail!("--engine {name}: not available in this build: {why}");

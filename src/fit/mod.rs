@@ -572,7 +572,7 @@ pub fn cli(req: &Request) -> anyhow::Result<ExitCode> {
         }
     }
     let csv = &req.trajectory;
-    let outside = crate::outside::read_trajectory(csv, req.model.as_deref())?;
+    let outside = crate::compare::read_trajectory(csv, req.model.as_deref())?;
     if let Some(note) = outside.omega_note() {
         println!("{note}");
     }

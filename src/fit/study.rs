@@ -1020,7 +1020,7 @@ fn text(study: &Study, o: &Outcome, quick: bool) -> String {
 /// when one does not.
 pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {
     let start = std::time::Instant::now();
-    let o = run(&crate::registry::default_scenario_dir(), out, quick)?;
+    let o = run(&crate::scenario_dir::default_scenario_dir(), out, quick)?;
     match o.best(true) {
         Some((v, phi, d)) => println!(
             "shortest push (model assumptions holding) for μ within {} % and I_cm within {} % at {}σ: {d:.2} s at {v} m/s, φ = {phi:.4} rad",

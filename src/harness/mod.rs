@@ -213,7 +213,7 @@ pub fn reference_engine(sc: &Scenario) -> Box<dyn Engine> {
         .gate
         .first()
         .map_or(pushval_scenario::DEFAULT_GATE[0], String::as_str);
-    registry::engine(name, &sc.engine)
+    registry::engine(name, &registry::engine_options(sc))
 }
 
 /// The analytic model called `name`, with its settings record; None for an
@@ -612,7 +612,7 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             }
             continue;
         }
-        let engine = registry::engine(name, &sc.engine);
+        let engine = registry::engine(name, &registry::engine_options(sc));
         if let Err(why) = engine.availability() {
             unavailable.push((name.to_string(), why));
             continue;

@@ -85,7 +85,7 @@ impl Gate {
             .iter()
             .find(|r| &r.name == name)
             .context("engine run")?;
-        let outside_tolerance = crate::outside::outside_tolerance(sc, &report);
+        let outside_tolerance = crate::compare::outside_tolerance(sc, &report);
         Ok(Self {
             sc: sc.clone(),
             engine: name.clone(),
@@ -510,7 +510,7 @@ pub fn replot(out: &Path) -> anyhow::Result<std::process::ExitCode> {
 
 /// `pushval power`: measure and write OUT/gate_power.{csv,svg}.
 pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {
-    let dir = crate::registry::default_scenario_dir();
+    let dir = crate::scenario_dir::default_scenario_dir();
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .with_context(|| format!("reading {}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))

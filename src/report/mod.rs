@@ -63,7 +63,7 @@ impl Options {
             quick: false,
             shard: None,
             merge: false,
-            scenarios: crate::registry::default_scenario_dir(),
+            scenarios: crate::scenario_dir::default_scenario_dir(),
             progress: true,
         }
     }

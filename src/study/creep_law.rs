@@ -1,12 +1,12 @@
 //! MuJoCo's creep ladder as a README section: `creep_law.csv` (one row per
-//! run, written by `examples/creep_law.rs` from
-//! [`pushval_mujoco::creep::measure`] and the closed form) read back and
+//! run, written by `examples/creep_law.rs` from MuJoCo's creep measurement
+//! and the closed form) read back and
 //! written up as `creep_law.md`. Every number of the section is taken from
 //! the CSV's text; the engine crate only simulates and predicts.
 
 use std::fmt::Write as _;
 
-use pushval_mujoco::creep::{CreepScene, CHATTER_HEIGHT_STD, SLIDING_SPEED};
+use crate::registry::mujoco_creep::{CreepScene, CHATTER_HEIGHT_STD, SLIDING_SPEED};
 
 /// The CSV columns of `creep_law.csv`, in order.
 pub const CSV_COLUMNS: [&str; 25] = [

@@ -3,6 +3,7 @@
 
 mod adapters;
 mod anywhere;
+mod architecture;
 mod assumptions;
 mod bad_input;
 mod cli;

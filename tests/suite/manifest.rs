@@ -193,8 +193,8 @@ fn feature_table_matches_the_build() {
         "jolt" => cfg!(feature = "jolt"),
         other => panic!("feature `{other}` is not in Cargo.toml's [features]"),
     };
-    for models in pushval::registry::ENGINE_CRATES {
-        for e in models() {
+    for row in pushval::registry::ENGINE_CRATES {
+        for e in (row.models)() {
             let available = e.default_engine().availability().is_ok();
             let want = manifest::feature_of(e.name).is_none_or(enabled);
             assert_eq!(

@@ -307,7 +307,8 @@ fn scenario_engine_colliders_change_nothing(#[files("scenarios/*.toml")] path: P
         .iter()
         .map(|p| [p.x - sc.center_of_mass.x, p.y - sc.center_of_mass.y])
         .collect();
-    let settings = pushval_rapier2d::engine::settings_from(&sc.engine).unwrap();
+    let settings =
+        pushval_rapier2d::engine::settings_from(&pushval::registry::engine_options(&sc)).unwrap();
     let a = RapierSimulator::new(settings).run(&problem).unwrap();
     let b = RapierSimulator::new(EngineSettings {
         colliders: true,

@@ -2,11 +2,13 @@
 
 use std::collections::BTreeMap;
 
-/// The `[engine]` table of a scenario: the time step every engine reads, and
-/// the other keys by name, for the engines that read them. The scenario
-/// loader checks `dt`; each engine checks the keys it reads
-/// ([`crate::Engine::option_keys`]) and the command line refuses keys no
-/// engine reads.
+/// The `[engine]` table of a scenario as the engines read it: the time step
+/// every engine reads, the other keys by name, for the engines that read
+/// them, and the scene the table belongs to. The scenario loader checks `dt`
+/// and keeps the table as read (`pushval_scenario::EngineTable`, which knows
+/// no engine); [`EngineOptions::from_table`] makes the options of it; each
+/// engine checks the keys it reads ([`crate::Engine::option_keys`]) and the
+/// command line refuses keys no engine reads.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct EngineOptions {
     /// `[engine] dt` (s), kept exactly when set.
@@ -55,6 +57,17 @@ impl std::fmt::Display for OptionError {
 impl std::error::Error for OptionError {}
 
 impl EngineOptions {
+    /// The options of a scenario's `[engine]` table: `dt` as the scenario
+    /// loader checked it, the other keys verbatim, and the scene they belong
+    /// to (None: not read from a scenario).
+    pub fn from_table(
+        dt: Option<f64>,
+        values: BTreeMap<String, serde_json::Value>,
+        scene: Option<SceneFrame>,
+    ) -> Self {
+        Self { dt, values, scene }
+    }
+
     fn bad(key: &str, problem: String) -> OptionError {
         OptionError {
             key: key.into(),

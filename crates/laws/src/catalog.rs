@@ -1,5 +1,7 @@
 //! The catalogue: every law of this crate by a stable name, with its
-//! parameters and the compiled-in engine models that declare it.
+//! parameters. It names no engine: engines declare their laws
+//! (`Engine::law`, or `law = "NAME"` for an outside engine) and the command
+//! line's listing (`pushval laws`) joins the two.
 
 use serde_json::{Map, Value};
 
@@ -164,9 +166,6 @@ impl Values {
 pub struct LawEntry {
     /// Its stable name (snake_case), as `law = "NAME"` declares it.
     pub name: &'static str,
-    /// The compiled-in engine models whose law (`Engine::law`) it is, with
-    /// their default options.
-    pub engines: &'static [&'static str],
     /// Its parameters, with defaults.
     pub params: Vec<ParamSpec>,
     /// Where its support loads come from.
@@ -299,7 +298,6 @@ pub fn catalog() -> Vec<LawEntry> {
     vec![
         LawEntry {
             name: "coulomb",
-            engines: &["rapier2d", "box2d", "avian2d"],
             params: vec![],
             loads: Loads::Problem,
             about: "Coulomb friction −μN u/|u| at every support: the analytic model's own law.",
@@ -307,7 +305,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "impulse_disk",
-            engines: &["rapier2d_impulse_disk"],
             params: vec![],
             loads: Loads::Problem,
             about: "The friction joint of Box2D and Chipmunk at every support: the stopping impulse −K⁻¹u capped in length at μNΔt.",
@@ -315,7 +312,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "impulse_box",
-            engines: &["rapier2d_impulse_box"],
             params: vec![],
             loads: Loads::Problem,
             about: "The stopping impulse capped per world axis at μNΔt (joint motors, pyramid friction): depends on the object's angle, mean ω over a turn.",
@@ -323,7 +319,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "impulse_rows_disk",
-            engines: &[],
             params: vec![],
             loads: Loads::Problem,
             about: "Bullet's contact friction: two world-axis rows per support, each with its own effective mass, the pair scaled back onto the disc μNΔt.",
@@ -331,7 +326,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "regularised_linear",
-            engines: &["rapier2d_regularised_linear"],
             params: vec![slip_speed()],
             loads: Loads::Problem,
             about: "Coulomb made viscous below the slip speed: −μN u/v_s for |u| < v_s.",
@@ -343,7 +337,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "regularised_tanh",
-            engines: &["rapier2d_regularised_tanh"],
             params: vec![slip_speed()],
             loads: Loads::Problem,
             about: "Coulomb smoothed everywhere: −μN tanh(|u|/v_s) u/|u|.",
@@ -355,7 +348,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "rapier3d_contact_disk",
-            engines: &["rapier3d"],
             params: {
                 let mut p = rapier3d_params();
                 p.push(ParamSpec::choice(
@@ -374,7 +366,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "rapier3d_simplified_twist",
-            engines: &["rapier3d_simplified"],
             params: rapier3d_params(),
             loads: Loads::Law,
             about: "rapier3d's Simplified friction on one manifold: one disc μΣN at the feet's mean plus a twist limit μΣN|p−c|, loads from the tilting balance.",
@@ -382,7 +373,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "mujoco_elliptic",
-            engines: &["mujoco_elliptic"],
             params: vec![
                 ParamSpec::number("cm_height", mujoco.cm_height, "m", CM_HEIGHT),
                 ParamSpec::number("push_height", mujoco.push_height, "m", PUSH_HEIGHT),
@@ -400,7 +390,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "physx_patch",
-            engines: &["physx_patch"],
             params: physx_params(),
             loads: Loads::Law,
             about: "PhysX's ePATCH friction: t0/t1 rows clamped on their own (a box, not a disc) at two anchors of the welded patch, each capped at half μΣN; loads of the PGS split at rest.",
@@ -408,7 +397,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "physx_two_directional",
-            engines: &["physx_two_directional"],
             params: physx_params(),
             loads: Loads::Law,
             about: "PhysX's eTWO_DIRECTIONAL friction: at every foot a row along the centre of mass's velocity and one across it, each clamped at μN; loads of the PGS split at rest.",
@@ -416,7 +404,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "physx_one_directional",
-            engines: &["physx_one_directional"],
             params: physx_params(),
             loads: Loads::Law,
             about: "PhysX's eONE_DIRECTIONAL friction: one clamped row per foot, along and across the centre of mass's velocity by turns on a welded patch, along it on separate feet.",
@@ -424,7 +411,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "box2d_motor_joint",
-            engines: &["box2d_motor_joint"],
             params: vec![],
             loads: Loads::Problem,
             about: "Box2D's top-down idiom: a motor joint to the ground whose force is capped at ΣμN and torque at ΣμN|p_i|, each on its own.",
@@ -432,7 +418,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "avian3d_tilt",
-            engines: &["avian3d"],
             params: vec![
                 ParamSpec::number("cm_height", plate.cm_height, "m", CM_HEIGHT),
                 ParamSpec::number("plate_thickness", plate.plate_thickness, "m", PLATE),
@@ -452,7 +437,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "jolt_box",
-            engines: &["jolt_box"],
             params: vec![],
             loads: Loads::Problem,
             about: "Jolt on one box collider: one friction disc μΣN at the corners' unweighted mean with world-axis rows, plus a twist row clamped to μΣ d_i N_i.",
@@ -460,7 +444,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "jolt_feet",
-            engines: &["jolt_feet"],
             params: vec![],
             loads: Loads::Problem,
             about: "Jolt on sphere feet: a disc μN per foot along the effective-mass direction of world-axis rows (yaw-dependent, no twist row); the mean ω over the segment's last fifth.",
@@ -468,7 +451,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "drake_sap",
-            engines: &[],
             params: drake_params(Approximation::Sap),
             loads: Loads::Law,
             about: "Drake's SAP on sphere feet: Coulomb at every foot with the loads of the convex relaxation's lift (N = k(x + (δt+τ_d)(μ|v_t| − v_n))): a glide plane's twist while every foot penetrates, else hops and the statics' loads.",
@@ -476,7 +458,6 @@ pub fn catalog() -> Vec<LawEntry> {
         },
         LawEntry {
             name: "drake_similar",
-            engines: &[],
             params: drake_params(Approximation::Similar),
             loads: Loads::Law,
             about: "Drake's Similar on sphere feet: Coulomb at every foot with the loads of Hunt–Crossley at z = v_n − μ|v_t|: a glide plane's twist while every foot penetrates, else hops and the statics' loads.",

@@ -498,6 +498,13 @@ impl FrictionLaw for FrictionModel {
             _ => "Coulomb regularised below the slip speed (pushval_rapier2d::idioms)",
         }
     }
+    fn catalog_name(&self) -> Option<&'static str> {
+        match self {
+            FrictionModel::RegularisedLinear { .. } => Some("regularised_linear"),
+            FrictionModel::RegularisedTanh { .. } => Some("regularised_tanh"),
+            _ => None,
+        }
+    }
     /// The per-axis laws repeat when the object turns by π (the world axes'
     /// rows see `r_x², r_y²` again), by π/2 where the supports are symmetric
     /// under a quarter turn about the centre of mass (the square plate).
@@ -596,6 +603,9 @@ macro_rules! idiom_law {
         impl FrictionLaw for $name {
             fn law_name(&self) -> &'static str {
                 self.model().law_name()
+            }
+            fn catalog_name(&self) -> Option<&'static str> {
+                self.model().catalog_name()
             }
             fn steady(&self, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
                 self.model().steady(problem, segment, dt)

@@ -73,6 +73,12 @@ pub trait FrictionLaw: Send + Sync {
     /// One line naming the law and where its closed form lives, e.g.
     /// `"motor joint: force and torque capped apart (pushval_box2d::predict)"`.
     fn law_name(&self) -> &'static str;
+    /// The law's entry in the [`crate::catalog`], for laws whose
+    /// [`FrictionLaw::law_name`] another entry's law shares (the regularised
+    /// idioms); None (the default): the name alone tells the entry.
+    fn catalog_name(&self) -> Option<&'static str> {
+        None
+    }
     /// The steady state of segment `segment` of `problem` under the law, for
     /// a run at time step `dt` (s; laws whose caps scale with the step read
     /// it), or None where the law has no steady state there.

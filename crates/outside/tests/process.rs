@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+mod common;
+
 use pushval_engine::{Engine, EngineOptions};
 use pushval_model::Problem;
 use pushval_outside::{problem_document, problem_document_v2, Config, Limits, OutsideEngine, Spec};
@@ -24,7 +26,7 @@ fn engine(dir: &Path, command: &[&str], extra: &str) -> (Arc<Spec>, Problem, Eng
     (
         Arc::new(cfg.engines.into_iter().next().unwrap()),
         sc.problem(),
-        sc.engine.clone(),
+        common::options(&sc),
     )
 }
 

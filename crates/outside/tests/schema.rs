@@ -5,6 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
+mod common;
+
 use pushval_outside::problem_document;
 use pushval_scenario::Scenario;
 use serde_json::Value;
@@ -115,7 +117,7 @@ fn errors(doc: &Value) -> Vec<String> {
 
 fn doc_of(file: &str, dt: f64) -> (Scenario, Value) {
     let sc = Scenario::from_path(root().join("scenarios").join(file)).unwrap();
-    let doc = problem_document("mysim", &sc.problem(), &sc.engine, dt);
+    let doc = problem_document("mysim", &sc.problem(), &common::options(&sc), dt);
     (sc, doc)
 }
 
@@ -228,8 +230,13 @@ fn version_2_documents_validate_against_their_schema() {
         if path.extension().is_some_and(|e| e == "toml") {
             let sc = Scenario::from_path(&path).unwrap();
             let p = sc.problem();
-            let doc =
-                problem_document_v2("mysim", &p, &sc.engine, 1e-3, Limits::for_problem(&p, 1e-3));
+            let doc = problem_document_v2(
+                "mysim",
+                &p,
+                &common::options(&sc),
+                1e-3,
+                Limits::for_problem(&p, 1e-3),
+            );
             assert_eq!(errors2(&doc), Vec::<String>::new(), "{}", path.display());
             switchings.insert(doc["switching"].as_str().unwrap().to_string());
         }

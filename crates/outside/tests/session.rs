@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
+mod common;
+
 use pushval_engine::{Engine, EngineOptions};
 use pushval_model::Problem;
 use pushval_outside::{shutdown_sessions, Config, Limits, OutsideEngine, Spec};
@@ -64,7 +66,7 @@ fn pids(dir: &Path) -> Vec<u32> {
 
 fn problem() -> (Problem, EngineOptions) {
     let sc = Scenario::from_path(root().join("scenarios/paper-square-v1.0.toml")).unwrap();
-    (sc.problem(), sc.engine.clone())
+    (sc.problem(), common::options(&sc))
 }
 
 fn with(options: &EngineOptions, pairs: &[(&str, serde_json::Value)]) -> EngineOptions {

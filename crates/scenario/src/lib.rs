@@ -16,8 +16,8 @@ mod scene;
 
 pub use error::ScenarioError;
 pub use geometry::{polygon_mass_properties, PolygonProperties};
-pub use pushval_engine::EngineOptions;
 pub use scene::{
-    check_sample_count, Limit, Loosened, Scenario, SupportLoad, Tolerance, ANALYTIC_MODELS,
-    DEFAULT_AUTO_CEILING, DEFAULT_GATE, DEFAULT_MODELS, MAX_ENGINE_STEPS, MAX_SAMPLES,
+    check_sample_count, EngineTable, Limit, Loosened, Scenario, SupportLoad, Tolerance,
+    ANALYTIC_MODELS, DEFAULT_AUTO_CEILING, DEFAULT_GATE, DEFAULT_MODELS, MAX_ENGINE_STEPS,
+    MAX_SAMPLES,
 };

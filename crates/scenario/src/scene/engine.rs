@@ -1,9 +1,9 @@
 //! `[engine]`: `dt` is checked here, every other key by the engines that
 //! read it.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
-use pushval_engine::EngineOptions;
 use pushval_model::Push;
 
 use super::check::finite_pos;
@@ -17,16 +17,30 @@ use crate::ScenarioError;
 /// than `duration / 1e7` is refused, not attempted.
 pub const MAX_ENGINE_STEPS: f64 = 1e7;
 
-/// The engine options: `dt` a finite number > 0 (s) giving at most
+/// The scenario's `[engine]` table: the time step every engine reads,
+/// checked here, and the other keys verbatim (as JSON values) for the
+/// engines that read them. This crate knows no engine: the command line's
+/// registry turns the table into each engine's options
+/// (`pushval_engine::EngineOptions::from_table`) and refuses keys no engine
+/// reads, naming the file and `engine.KEY`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EngineTable {
+    /// `[engine] dt` (s), kept exactly when set; None: each engine's default.
+    pub dt: Option<f64>,
+    /// The other keys with their values.
+    pub values: BTreeMap<String, serde_json::Value>,
+}
+
+/// The `[engine]` table: `dt` a finite number > 0 (s) giving at most
 /// [`MAX_ENGINE_STEPS`] steps over the schedule, the other keys as JSON
 /// values for the engines.
 pub(super) fn from_raw(
     raw: Option<RawEngine>,
     file: &Path,
     pushes: &[Push],
-) -> Result<EngineOptions, ScenarioError> {
+) -> Result<EngineTable, ScenarioError> {
     let err = |key: &str, msg: String| ScenarioError::new(file, key, msg);
-    let mut engine = EngineOptions::default();
+    let mut engine = EngineTable::default();
     for (key, value) in raw.unwrap_or_default() {
         if key == "dt" {
             let dt = value

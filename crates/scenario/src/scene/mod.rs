@@ -19,10 +19,9 @@ mod tolerance;
 
 use std::path::{Path, PathBuf};
 
-use pushval_engine::{EngineOptions, SceneFrame};
 use pushval_model::{Body, ContactLimits, Initial, Problem, Push, Support, Switching, Vec2};
 
-pub use engine::MAX_ENGINE_STEPS;
+pub use engine::{EngineTable, MAX_ENGINE_STEPS};
 pub use run::{check_sample_count, ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS, MAX_SAMPLES};
 pub use supports::SupportLoad;
 pub use tolerance::{Limit, Loosened, Tolerance, DEFAULT_AUTO_CEILING};
@@ -79,7 +78,7 @@ pub struct Scenario {
     /// `[tolerance]`: what is asserted for the gated engines.
     pub tolerance: Tolerance,
     /// `[engine]`: `dt` checked here, the other keys by the engines.
-    pub engine: EngineOptions,
+    pub engine: EngineTable,
 }
 
 impl Scenario {
@@ -145,13 +144,7 @@ impl Scenario {
         let initial = schedule::initial(raw.initial, file)?;
         let run = run::from_raw(raw.run, &pushes, file)?;
         let tolerance = tolerance::from_raw(raw.tolerance, file)?;
-        let mut engine = engine::from_raw(raw.engine, file, &pushes)?;
-        engine.scene = Some(SceneFrame {
-            center_of_mass: [object.center_of_mass.x, object.center_of_mass.y],
-            polygon: object.polygon.iter().map(|p| [p.x, p.y]).collect(),
-            gravity: supports.gravity,
-            normal_forces: supports.list.iter().map(|s| s.load).collect(),
-        });
+        let engine = engine::from_raw(raw.engine, file, &pushes)?;
         let sc = Self {
             name: raw.name,
             description: raw.description.unwrap_or_default(),
