@@ -121,5 +121,76 @@ fn control(c: &mut Criterion) {
     g.finish();
 }
 
+/// The targets over the study's whole goal list, into
+/// `results/control_cost.csv`: every plan from rest (20 goals × 3 speeds,
+/// each the median of 5 solves, wall clock), and every MPC period's re-plan
+/// of the dynamic predictor with rapier2d as the perturbed plant (20 goals
+/// at 1 m/s; `loop.json`'s `predictor_us_*` over the pooled periods).
+fn cost_table() {
+    use pushval::control::mpc::{median_p99, run_loop, LoopSpec};
+    let problem = scene().unwrap();
+    let speeds = [0.1, 0.5, 1.0];
+    let goals = goals(&problem, &speeds, 20);
+    let start = Start::of_problem(&problem);
+    let reach = Reach::default();
+    let mut plan_us = Vec::new();
+    for &v in &speeds {
+        for goal in &goals {
+            let spec = PlanSpec {
+                segments: 6,
+                speed: v,
+                predictor: Predictor::Dynamic,
+            };
+            let planner =
+                Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
+            let mut t: Vec<f64> = (0..5)
+                .map(|_| {
+                    let mut p = planner.clone();
+                    let c = std::time::Instant::now();
+                    std::hint::black_box(p.plan(&start));
+                    c.elapsed().as_secs_f64() * 1e6
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            plan_us.push(t[2]);
+        }
+    }
+    let engine = pushval::registry::engine("rapier2d", &Default::default());
+    let mut period_us = Vec::new();
+    for goal in &goals {
+        let spec = LoopSpec {
+            plan: PlanSpec {
+                segments: 6,
+                speed: 1.0,
+                predictor: Predictor::Dynamic,
+            },
+            period: 0.02,
+            plant: PlantScale::PERTURBED,
+            reach,
+        };
+        let out = run_loop(&problem, engine.as_ref(), engine.default_dt(), *goal, spec).unwrap();
+        period_us.extend(out.predictor_us);
+    }
+    let (pm, pp) = median_p99(&plan_us);
+    let (mm, mp) = median_p99(&period_us);
+    let csv = format!(
+        "quantity,value,unit,target,note\n\
+         plan_solve_median,{pm:.1},us,1000,\"{} plans from rest (20 study goals x 0.1/0.5/1 m/s), 6 pushes, each the median of 5 solves\"\n\
+         plan_solve_p99,{pp:.1},us,,\"same plans\"\n\
+         mpc_period_median,{mm:.1},us,100,\"{} re-plans of the dynamic predictor, rapier2d plant with mu x 0.8 and I_cm x 1.2, 20 goals at 1 m/s, period 0.02 s\"\n\
+         mpc_period_p99,{mp:.1},us,1000,\"same periods (a stalled warm start falls back on a fresh Jacobian, then on the starting guesses)\"\n",
+        plan_us.len(),
+        period_us.len()
+    );
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results/control_cost.csv");
+    pushval::atomic::write_atomic(&path, csv.as_bytes()).unwrap();
+    eprint!("{csv}");
+}
+
 criterion_group!(benches, control);
-criterion_main!(benches);
+
+fn main() {
+    benches();
+    cost_table();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -121,6 +121,23 @@ pub const RULES: &[Rule] = &[
         ],
     },
     Rule {
+        command: "pushval control-study",
+        source: "src/control/study.rs",
+        files: &[
+            "results/closed_loop/success.csv",
+            "results/closed_loop/runs.csv",
+            "results/closed_loop/goals.csv",
+            "results/closed_loop/success.svg",
+            "results/closed_loop/paths.svg",
+            "results/closed_loop/README.md",
+        ],
+    },
+    Rule {
+        command: "cargo bench --bench control",
+        source: "benches/control.rs",
+        files: &["results/control_cost.csv"],
+    },
+    Rule {
         command: "pushval manifest",
         source: "src/manifest.rs",
         files: &[MANIFEST],

@@ -479,12 +479,7 @@ impl Planner {
 
     /// [`Planner::plan`] with `segments` pushes and the starting guesses'
     /// durations scaled from `t0` (s).
-    pub fn plan_with_time(
-        &mut self,
-        start: &Start,
-        t0: f64,
-        segments: usize,
-    ) -> Option<Solution> {
+    pub fn plan_with_time(&mut self, start: &Start, t0: f64, segments: usize) -> Option<Solution> {
         let guesses = [
             (1.0, 0.0),
             (1.0, 0.5),
