@@ -53,7 +53,7 @@ fn cases() -> Vec<(String, Problem, Box<dyn Engine>, f64)> {
         let sc = load(&path);
         for entry in pushval::registry::entries() {
             let engine = entry
-                .build(&sc.engine)
+                .build(&pushval::registry::engine_options(&sc))
                 .unwrap_or_else(|_| entry.default_engine());
             if engine.availability().is_err() || engine.adapter().starts_with("outside") {
                 continue;
@@ -63,7 +63,7 @@ fn cases() -> Vec<(String, Problem, Box<dyn Engine>, f64)> {
                 let mut problem = sc.problem();
                 problem.initial.from_rest = from_rest;
                 let engine = entry
-                    .build(&sc.engine)
+                    .build(&pushval::registry::engine_options(&sc))
                     .unwrap_or_else(|_| entry.default_engine());
                 let name = format!(
                     "{} on {}{}",

@@ -18,6 +18,8 @@ use pushval_model::Problem;
 use pushval_outside::{shutdown_sessions, Config, OutsideEngine, Spec};
 use pushval_scenario::Scenario;
 
+mod common;
+
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
 fn serial() -> MutexGuard<'static, ()> {
@@ -38,7 +40,7 @@ fn spec(script: &str, extra: &str) -> Arc<Spec> {
 
 fn problem() -> (Problem, EngineOptions) {
     let sc = Scenario::from_path(root().join("scenarios/paper-square-v1.0.toml")).unwrap();
-    (sc.problem(), sc.engine.clone())
+    (sc.problem(), common::options(&sc))
 }
 
 const DT: f64 = 1e-3;
