@@ -214,6 +214,7 @@ pub fn run_loop(
     let mut predictor_us = Vec::new();
     let mut steps = 0;
     let mut gave_up = false;
+    let mut cooldown = 0usize;
     loop {
         if t + remaining > give_up {
             // The plan keeps growing: the plant does not move as predicted.
@@ -265,16 +266,24 @@ pub fn run_loop(
         let segments = ((remaining / spec.period * (1.0 + 1e-9)).floor() as usize).clamp(1, n);
         let warm = planner.with_duration(&resample(&params, segments), remaining);
         let mut solved = planner.solve(&start, warm.clone(), 4);
-        if !solved.as_ref().is_some_and(|s| s.converged) {
+        if !solved.as_ref().is_some_and(|s| s.converged) && cooldown == 0 {
             // The warm start stalled: a fresh Jacobian and more steps, then
-            // the starting guesses from scratch; keep the nearest.
+            // the starting guesses from scratch; keep the nearest. A plant
+            // the predictor cannot follow would stall every period, so after
+            // a fallback that did not converge the next ten periods keep
+            // their warm start only.
             planner.forget();
-            let retry = planner.solve(&start, warm, 30);
+            let retry = planner.solve(&start, warm, 12);
             solved = nearest(solved, retry);
             if !solved.as_ref().is_some_and(|s| s.converged) {
                 let fresh = planner.plan_with_time(&start, remaining, segments);
                 solved = nearest(solved, fresh);
             }
+            if !solved.as_ref().is_some_and(|s| s.converged) {
+                cooldown = 10;
+            }
+        } else {
+            cooldown = cooldown.saturating_sub(1);
         }
         predictor_us.push(clock.elapsed().as_secs_f64() * 1e6);
         match solved {
