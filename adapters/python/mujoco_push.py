@@ -9,7 +9,7 @@ progress, --timing) is pushval.adapter's (adapters/python/README.md). MuJoCo's
 contact makes the pusher's velocity jumps itself: impulsive switching only.
 
 The scene is the one of pushval's compiled-in MuJoCo 3.17 adapter
-(crates/mujoco/src/scene.rs and sim.rs), so the two versions can be run side
+(crates/engines/mujoco/src/scene.rs and sim.rs), so the two versions can be run side
 by side on one problem:
 
   * the object: a free body (mass m, inertia I_cm about z, half that about x
@@ -54,7 +54,7 @@ UNSTABLE = ("mjWARN_BADQACC", "mjWARN_BADQVEL", "mjWARN_BADQPOS")
 
 
 def mjcf(problem, cone, dt, mus):
-    """The scene's MJCF, the object at its initial pose (crates/mujoco/src/scene.rs)."""
+    """The scene's MJCF, the object at its initial pose (crates/engines/mujoco/src/scene.rs)."""
     m = problem.mass
     i_z = problem.inertia_cm
     th = problem.initial.theta
@@ -124,7 +124,7 @@ def yaw_and_omega(data):
 
 
 class MujocoPush(Engine):
-    """The scene of crates/mujoco in MuJoCo 4's Python bindings."""
+    """The scene of crates/engines/mujoco in MuJoCo 4's Python bindings."""
 
     name = "mujoco_push.py"
     switching_rules = ("impulsive",)

@@ -173,7 +173,7 @@ pub fn markdown(csv: &str) -> Result<String, String> {
     let _ = writeln!(o, "\n## The closed form\n");
     let _ = writeln!(
         o,
-        "Derived in `crates/mujoco/src/creep/mod.rs` from MuJoCo's regularised constraint problem. Inside the \
+        "Derived in `crates/engines/mujoco/src/creep/mod.rs` from MuJoCo's regularised constraint problem. Inside the \
          friction cone MuJoCo's solver returns the linear solution (A + R) f = a_ref − a₀, so the \
          constraint acceleration is a = a_ref − R f. A steady creep has a = 0 on every contact row, hence \
          **R f = a_ref**: the mass matrix A and the time step drop out. With MuJoCo's bookkeeping \

@@ -656,8 +656,29 @@ fn crates_depend_downwards() {
             .filter(|k| k.starts_with("pushval"))
             .cloned()
             .collect();
+        // Engine crates live under crates/engines/, the core beside it.
+        let parent = m.parent().unwrap().parent().unwrap();
+        let core_crate = [
+            "pushval-model",
+            "pushval-scenario",
+            "pushval-laws",
+            "pushval-engine",
+            "pushval-outside",
+        ]
+        .contains(&name.as_str());
+        let expected = if core_crate {
+            crates.clone()
+        } else {
+            crates.join("engines")
+        };
+        assert_eq!(parent, expected, "{name} is in {}", parent.display());
         deps.insert(name, normal);
     }
+    assert!(
+        manifests.len() >= 12,
+        "found {} crates under crates/",
+        manifests.len()
+    );
     let set = |names: &[&str]| names.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>();
     assert_eq!(deps["pushval-model"], set(&[]));
     assert_eq!(deps["pushval-scenario"], set(&["pushval-model"]));

@@ -437,7 +437,7 @@ pub struct JoltFeet;
 
 /// From ω = 0 at yaw 0, with the problem's loads (`F_i = μ_i N_i`; the
 /// engine's own split of four feet's loads is undetermined and may differ:
-/// crates/jolt/README.md).
+/// crates/engines/jolt/README.md).
 fn jolt_steady(feet: bool, problem: &Problem, segment: usize, dt: f64) -> Option<LawSteady> {
     let push = problem.pushes.get(segment)?;
     let body = &problem.body;

@@ -25,7 +25,7 @@ fn main() {
     let dt: f64 = args.next().map(|s| s.parse().unwrap()).unwrap_or(1e-3);
     let mut files: Vec<PathBuf> = args.map(PathBuf::from).collect();
     if files.is_empty() {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../scenarios");
         files = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().path())

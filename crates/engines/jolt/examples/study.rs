@@ -163,7 +163,7 @@ fn band(scene: Scene, p: &Problem, mu: f64, t: f64) -> (f64, f64) {
 
 /// The workspace's `target/jolt-study/`.
 fn default_out() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/jolt-study")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../target/jolt-study")
 }
 
 fn main() {

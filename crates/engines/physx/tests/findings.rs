@@ -1,4 +1,4 @@
-//! The PhysX findings (crates/physx/README.md), asserted: expected values
+//! The PhysX findings (crates/engines/physx/README.md), asserted: expected values
 //! come from the Coulomb model and the closed forms of
 //! `pushval_physx::predict`, evaluated with the friction magnitudes PhysX
 //! gives the feet at rest (`μ̄ N_i`), never from engine output alone.

@@ -11,7 +11,7 @@ fn main() {
     let file = args.next().unwrap_or_else(|| {
         concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../scenarios/paper-square-v1.0.toml"
+            "/../../../scenarios/paper-square-v1.0.toml"
         )
         .to_string()
     });

@@ -26,7 +26,7 @@ fn main() {
     let file = std::env::args().nth(1).unwrap_or_else(|| {
         concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../scenarios/paper-square-v1.0.toml"
+            "/../../../scenarios/paper-square-v1.0.toml"
         )
         .into()
     });

@@ -14,7 +14,7 @@ use pushval_scenario::Scenario;
 fn main() {
     let mut files: Vec<String> = std::env::args().skip(1).collect();
     if files.is_empty() {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../scenarios");
         let mut all: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
             .filter_map(|e| e.ok().map(|e| e.path()))
