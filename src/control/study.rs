@@ -176,27 +176,52 @@ pub fn goals(problem: &Problem, speeds: &[f64], count: usize) -> Vec<Goal> {
 /// Every engine of the build and of the project that this build can run
 /// (or those of `only`).
 pub fn engines(only: Option<&str>) -> anyhow::Result<Vec<String>> {
-    let all: Vec<String> = crate::registry::entries()
-        .into_iter()
-        .filter(|e| e.default_engine().availability().is_ok())
-        .map(|e| e.name)
-        .collect();
+    let entries = crate::registry::entries();
     match only {
-        None => Ok(all),
+        None => Ok(entries
+            .into_iter()
+            .filter(|e| e.default_engine().availability().is_ok())
+            .map(|e| e.name)
+            .collect()),
         Some(list) => {
             let mut out = Vec::new();
             for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-                if !all.iter().any(|a| a == name) {
+                if !entries.iter().any(|a| a.name == name) {
                     bail!(
-                        "--only: `{name}` is not an available engine of this build or of {} (see `pushval engines`)",
+                        "--only: `{name}` is not an engine of this build or of {} (see `pushval engines`)",
                         crate::registry::engines_file()
                     );
+                }
+                if out.iter().any(|o| o == name) {
+                    bail!("--only: `{name}` is named twice");
                 }
                 out.push(name.to_string());
             }
             Ok(out)
         }
     }
+}
+
+/// The engines that run `tasks`, built, each checked available: a shard
+/// needs only its own engines (a list may name engines of another build,
+/// whose shards run there; `--merge` joins the parts).
+fn build_engines(
+    names: &[String],
+    tasks: &[&Task],
+) -> anyhow::Result<BTreeMap<String, Box<dyn Engine>>> {
+    let mut built = BTreeMap::new();
+    for name in names {
+        if !tasks.iter().any(|t| &t.engine == name) {
+            continue;
+        }
+        let e = crate::registry::entry(name).expect("listed by engines()");
+        let engine = e.default_engine();
+        if let Err(why) = engine.availability() {
+            bail!("engine `{name}` is not available in this build: {why}");
+        }
+        built.insert(name.clone(), engine);
+    }
+    Ok(built)
 }
 
 /// The task list: engines × speeds × goals × predictors × modes × plants.
@@ -363,15 +388,9 @@ pub fn cli(
             Some(s) => s.indices(&keys),
             None => (0..list.len()).collect(),
         };
-        let plans = plans(&problem, speeds, &goals);
-        let built: BTreeMap<String, Box<dyn Engine>> = names
-            .iter()
-            .map(|n| {
-                let e = crate::registry::entry(n).expect("listed above");
-                (n.clone(), e.default_engine())
-            })
-            .collect();
         let mine: Vec<&Task> = indices.iter().map(|&i| &list[i]).collect();
+        let built = build_engines(&names, &mine)?;
+        let plans = plans(&problem, speeds, &goals);
         // Progress on stderr (a bar on a terminal; a line per tenth
         // elsewhere, e.g. in CI logs).
         let done = std::sync::atomic::AtomicUsize::new(0);

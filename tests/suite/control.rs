@@ -402,3 +402,51 @@ fn a_protocol_1_adapter_without_the_kit_is_a_plant_under_loop() {
     assert_eq!(doc["engine_replayed_each_period"], true);
     assert!(doc["steps"].as_u64().unwrap() >= 5, "{doc}");
 }
+
+/// A control-study list may name an engine this build lacks: the shard of
+/// the engines it has runs (one engine per `K/N` range shard when N is the
+/// number of engines), the other shard says which engine is missing and
+/// why, and the merge names the shard still to run.
+#[test]
+fn a_shard_needs_only_its_own_engines() {
+    if cfg!(feature = "mujoco") {
+        return; // mujoco_elliptic is compiled in: nothing is missing.
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("study");
+    let study = |extra: &[&str]| {
+        pushval()
+            .current_dir(root())
+            .args([
+                "control-study",
+                "--quick",
+                "--only",
+                "rapier2d,mujoco_elliptic",
+            ])
+            .args(extra)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    let first = study(&["--shard", "1/2"]);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    let part = std::fs::read_to_string(out.join("parts/control-1-of-2.csv")).unwrap();
+    let rows = part.lines().skip(1).count();
+    assert!(rows > 0 && rows % 8 == 0, "{rows} rows in part 1");
+    let second = study(&["--shard", "2/2"]);
+    assert!(!second.status.success());
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert!(
+        err.contains("mujoco_elliptic") && err.contains("not available"),
+        "{err}"
+    );
+    let merge = study(&["--merge"]);
+    assert!(!merge.status.success());
+    let err = String::from_utf8_lossy(&merge.stderr);
+    assert!(err.contains("2/2"), "{err}");
+}
