@@ -229,6 +229,7 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
     };
     let out = run_loop(&problem, engine.as_ref(), dt, p.goal, spec)?;
     let (med, p99) = median_p99(&out.predictor_us);
+    let (cpu_med, cpu_p99) = median_p99(&out.predictor_cpu_us);
     let last = out
         .run
         .trajectory
@@ -254,6 +255,8 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         "gave_up_at_twice_the_plan": out.gave_up,
         "predictor_us_median": json_num(med),
         "predictor_us_p99": json_num(p99),
+        "predictor_cpu_us_median": json_num(cpu_med),
+        "predictor_cpu_us_p99": json_num(cpu_p99),
         "plan_from_rest_converged": out.plan_converged,
         "engine_replayed_each_period": out.replayed,
         "engine_steps": out.run.steps,

@@ -15,7 +15,7 @@ use anyhow::{bail, Context};
 use pushval_engine::{Engine, EngineRun};
 use pushval_model::{Body, Problem, Push, Support};
 
-use super::plan::{straight_time, Motion, PlanSpec, Planner, Start};
+use super::plan::{straight_time, Motion, PlanSpec, Planner, Start, GUESSES};
 use super::{pose_errors, Goal, Predictor, Reach};
 
 /// How the plant differs from the predictor's scene.
@@ -138,6 +138,9 @@ pub struct LoopOutcome {
     pub steps: usize,
     /// Wall time of each re-plan (µs).
     pub predictor_us: Vec<f64>,
+    /// The calling thread's CPU time of each re-plan (µs): what the
+    /// predictor computed, without the waits a busy machine adds.
+    pub predictor_cpu_us: Vec<f64>,
     /// Whether the plan from rest converged on the predictor.
     pub plan_converged: bool,
     /// Whether the engine re-ran its schedule at every period (it cannot step).
@@ -181,6 +184,11 @@ pub fn open_loop(
     Ok((run, pe, ae))
 }
 
+/// Levenberg–Marquardt steps of one fallback stage (with its fresh
+/// Jacobian). A stage that does not converge hands its nearest plan to the
+/// next period's warm start, so the search goes on.
+pub const STAGE_STEPS: usize = 6;
+
 /// Model-predictive control of `engine` towards `goal`.
 pub fn run_loop(
     problem: &Problem,
@@ -212,9 +220,10 @@ pub fn run_loop(
     let mut applied: Vec<Applied> = Vec::new();
     let mut t = 0.0;
     let mut predictor_us = Vec::new();
+    let mut predictor_cpu_us = Vec::new();
     let mut steps = 0;
     let mut gave_up = false;
-    let mut cooldown = 0usize;
+    let mut stage = 0usize;
     loop {
         if t + remaining > give_up {
             // The plan keeps growing: the plant does not move as predicted.
@@ -260,32 +269,37 @@ pub fn run_loop(
             },
         };
         let clock = Instant::now();
+        let cpu = crate::track::thread_cpu_time();
         // As the time left shrinks, so does the number of pushes: each keeps
         // at least one period (down to one push: then the least-squares
         // pose nearest the goal).
         let segments = ((remaining / spec.period * (1.0 + 1e-9)).floor() as usize).clamp(1, n);
         let warm = planner.with_duration(&resample(&params, segments), remaining);
         let mut solved = planner.solve(&start, warm.clone(), 4);
-        if !solved.as_ref().is_some_and(|s| s.converged) && cooldown == 0 {
-            // The warm start stalled: a fresh Jacobian and more steps, then
-            // the starting guesses from scratch; keep the nearest. A plant
-            // the predictor cannot follow would stall every period, so after
-            // a fallback that did not converge the next ten periods keep
-            // their warm start only.
-            planner.forget();
-            let retry = planner.solve(&start, warm, 12);
-            solved = nearest(solved, retry);
-            if !solved.as_ref().is_some_and(|s| s.converged) {
-                let fresh = planner.plan_with_time(&start, remaining, segments);
-                solved = nearest(solved, fresh);
-            }
-            if !solved.as_ref().is_some_and(|s| s.converged) {
-                cooldown = 10;
-            }
+        if solved.as_ref().is_some_and(|s| s.converged) {
+            stage = 0;
         } else {
-            cooldown = cooldown.saturating_sub(1);
+            // The warm start stalled: one stage of the fallback search per
+            // period, so no period pays for the whole search (stage 0 a
+            // fresh Jacobian and more steps from the warm start, stage k
+            // the k-th starting guess from scratch); the nearest plan is
+            // applied meanwhile, and the search goes on next period from
+            // the next stage until a plan converges.
+            let stage_solved = if stage == 0 {
+                planner.forget();
+                planner.solve(&start, warm, STAGE_STEPS)
+            } else {
+                planner.from_guess(&start, remaining, segments, stage - 1, STAGE_STEPS)
+            };
+            solved = nearest(solved, stage_solved);
+            stage = if solved.as_ref().is_some_and(|s| s.converged) {
+                0
+            } else {
+                (stage + 1) % (GUESSES.len() + 1)
+            };
         }
         predictor_us.push(clock.elapsed().as_secs_f64() * 1e6);
+        predictor_cpu_us.push((crate::track::thread_cpu_time() - cpu) * 1e6);
         match solved {
             Some(s) => {
                 params = s.params;
@@ -314,6 +328,7 @@ pub fn run_loop(
         gave_up,
         steps,
         predictor_us,
+        predictor_cpu_us,
         plan_converged,
         replayed,
     })

@@ -480,21 +480,9 @@ impl Planner {
     /// [`Planner::plan`] with `segments` pushes and the starting guesses'
     /// durations scaled from `t0` (s).
     pub fn plan_with_time(&mut self, start: &Start, t0: f64, segments: usize) -> Option<Solution> {
-        let guesses = [
-            (1.0, 0.0),
-            (1.0, 0.5),
-            (1.0, -0.5),
-            (1.6, 0.0),
-            (1.6, 0.5),
-            (1.6, -0.5),
-            (2.5, 0.0),
-        ];
         let mut best: Option<Solution> = None;
-        for (tm, off) in guesses {
-            self.forget();
-            let mut p = self.initial_params(t0 * tm, off);
-            p.u.truncate(segments.max(1));
-            if let Some(s) = self.solve(start, p, 40) {
+        for k in 0..GUESSES.len() {
+            if let Some(s) = self.from_guess(start, t0, segments, k, 40) {
                 if s.converged {
                     return Some(s);
                 }
@@ -504,6 +492,25 @@ impl Planner {
             }
         }
         best
+    }
+
+    /// Levenberg–Marquardt from the `k`-th starting guess of
+    /// [`Planner::plan_with_time`] alone (a fresh Jacobian, at most
+    /// `max_iter` steps): one bounded stage of a search the loop spreads
+    /// over control periods.
+    pub fn from_guess(
+        &mut self,
+        start: &Start,
+        t0: f64,
+        segments: usize,
+        k: usize,
+        max_iter: usize,
+    ) -> Option<Solution> {
+        let (tm, off) = GUESSES[k % GUESSES.len()];
+        self.forget();
+        let mut p = self.initial_params(t0 * tm, off);
+        p.u.truncate(segments.max(1));
+        self.solve(start, p, max_iter)
     }
 
     /// Why the nearest plan misses: which of its unknowns sit at a limit.
@@ -530,6 +537,19 @@ impl Planner {
         why.join("; ")
     }
 }
+
+/// The starting guesses of a plan: (duration as a multiple of the
+/// reference time, direction offset from the cone's middle as a share of
+/// its half-width).
+pub const GUESSES: [(f64, f64); 7] = [
+    (1.0, 0.0),
+    (1.0, 0.5),
+    (1.0, -0.5),
+    (1.6, 0.0),
+    (1.6, 0.5),
+    (1.6, -0.5),
+    (2.5, 0.0),
+];
 
 /// The straight-line time to the goal at `speed` (s), at least 0.1 s.
 pub fn straight_time(start: &Start, goal: &Goal, speed: f64) -> f64 {
