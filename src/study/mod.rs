@@ -2,7 +2,7 @@
 //! lists (outside engines included): where the engine's friction disagrees
 //! with Coulomb support friction, and whether the engine's own friction law
 //! in closed form ([`pushval_engine::FrictionLaw`], declared by the engine
-//! through [`Engine::law`]) explains it.
+//! through [`Engine::law`](pushval_engine::Engine::law)) explains it.
 //!
 //! For a model, in `results/friction_models/MODEL/` (or `--out DIR`):
 //! `paper_plate.csv` (steady ω at v_c 0.2, 0.5, 1 m/s against Coulomb's ω*
