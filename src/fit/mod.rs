@@ -70,6 +70,7 @@
 pub mod noise;
 pub mod params;
 mod residual;
+mod settings;
 pub mod study;
 
 use std::path::{Path, PathBuf};
@@ -83,6 +84,7 @@ use pushval_scenario::Scenario;
 use serde_json::{json, Value};
 
 pub use params::{parse_list, shifted_loads, Invalid, Param, Parametrised};
+pub use settings::Settings;
 
 /// Rule 1: a component whose information is below this share of the largest
 /// (in units of the components' scales) is unidentifiable.
@@ -96,39 +98,6 @@ pub const DIRECTION_SHARE: f64 = 0.1;
 /// Rule 3: a component whose Fisher std at the stated noise exceeds this
 /// many times its scale is unidentifiable.
 pub const RELATIVE_STD_LIMIT: f64 = 1e3;
-
-/// How a fit weighs and computes. Every field's default is the command
-/// line's.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Settings {
-    /// Noise level of x and y (m); position residuals are divided by it.
-    /// Default 1e-3.
-    pub sigma_position: f64,
-    /// Noise level of θ (rad); θ residuals are divided by it. Default 1e-3.
-    pub sigma_theta: f64,
-    /// DOP853 tolerance of the model's trajectory (m, rad). Default 1e-11:
-    /// the trajectory's error must stay far below the effect of a
-    /// finite-difference step.
-    pub tolerance: f64,
-    /// Central-difference step relative to each component's scale.
-    /// Default 1e-5.
-    pub fd_step: f64,
-    /// Levenberg–Marquardt's patience: at most `patience × (n + 1)` residual
-    /// evaluations. Default 100.
-    pub patience: usize,
-}
-
-impl Default for Settings {
-    fn default() -> Self {
-        Self {
-            sigma_position: 1e-3,
-            sigma_theta: 1e-3,
-            tolerance: 1e-11,
-            fd_step: 1e-5,
-            patience: 100,
-        }
-    }
-}
 
 /// The Fisher information of a set of components and what follows from it.
 #[derive(Debug, Clone)]

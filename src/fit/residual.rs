@@ -7,7 +7,7 @@ use nalgebra034::{DMatrix, DVector, Dyn, Owned};
 use pushval_model::{DynamicModel, Integrator, Sample, Simulator};
 
 use super::params::Parametrised;
-use super::Settings;
+use super::settings::Settings;
 
 /// Whitened residuals: per sample `(x_m − x_d)/σ_p, (y_m − y_d)/σ_p,
 /// (θ_m − θ_d)/σ_θ`, samples in time order.

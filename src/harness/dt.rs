@@ -4,12 +4,12 @@
 
 use std::time::{Duration, Instant};
 
-use pushval_engine::{Engine, EngineRun};
+use pushval_engine::{rel_err, Engine, EngineRun};
 use pushval_model::{ModelError, Problem, Trajectory};
 use pushval_scenario::Scenario;
 
-use super::tolerance::{ladder_targets, Figures};
-use super::{rel_err, tail_omega, Convergence, SegmentInfo};
+use super::figures::{ladder_targets, Figures};
+use super::segments::{tail_omega, SegmentInfo};
 
 /// The largest engine time step the automatic choice tries (s): 1/60 s,
 /// rapier's own default step and the usual game-engine frame. Coarser steps
@@ -435,6 +435,58 @@ pub fn trajectory_order(runs: &[(f64, &Trajectory)], floor: [f64; 2]) -> Traject
         }
     }
     out
+}
+
+/// How an engine's steady ω converges as its time step shrinks: runs at 4h,
+/// 2h and h (h the gated run's step; runs the time-step search made are
+/// reused), the observed order `p = log2(|ω(4h) − ω(2h)| / |ω(2h) − ω(h)|)`, and Richardson extrapolations
+/// to dt → 0 with the scheme's expected order p: `ω(h) + (ω(h) − ω(2h)) / (2^p − 1)`,
+/// and the same applied again for the order p + 1 term.
+#[derive(Debug, Clone)]
+pub struct Convergence {
+    /// The order the friction-velocity scheme should show (1, or 2 for leapfrog).
+    pub expected_order: f64,
+    /// The three time steps (s), largest first.
+    pub dts: [f64; 3],
+    /// The order observed on the trajectory (positions and angle at the
+    /// samples, every run of the ladder): [`trajectory_order`].
+    pub trajectory: TrajectoryOrder,
+    /// Observed order of the steady ω per settled segment.
+    pub orders: Vec<(usize, f64)>,
+    /// Largest relative error of the extrapolation at the expected order,
+    /// against the dynamic model's tail-mean ω (within 1e-6 of ω*).
+    pub richardson1_rel_max: f64,
+    /// The same after removing the next order as well.
+    pub richardson2_rel_max: f64,
+    /// The same for the plain run at h.
+    pub plain_rel_max: f64,
+    /// Per settled segment, `|ω(2h) − ω(h)|` relative (with [`rel_err`]'s
+    /// floor): below the auto target the order is not resolved (the
+    /// difference is at the level of the tail mean's own noise).
+    pub diff_rel: Vec<(usize, f64)>,
+}
+
+impl Convergence {
+    /// Median observed order over the settled segments.
+    pub fn order(&self) -> Option<f64> {
+        self.order_resolved(0.0)
+    }
+
+    /// Median observed order over the settled segments whose
+    /// `|ω(2h) − ω(h)|` (relative, [`Convergence::diff_rel`]) is at least
+    /// `floor`.
+    pub fn order_resolved(&self, floor: f64) -> Option<f64> {
+        let mut o: Vec<f64> = self
+            .orders
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| self.diff_rel.get(*i).is_none_or(|d| d.1 >= floor))
+            .map(|(_, p)| p.1)
+            .filter(|p| p.is_finite())
+            .collect();
+        o.sort_by(f64::total_cmp);
+        (!o.is_empty()).then(|| o[o.len() / 2])
+    }
 }
 
 /// Runs the engine at 2h and 4h beside the run at h and measures how its

@@ -4,22 +4,24 @@ use std::time::{Duration, Instant};
 
 use pushval_engine::{Engine, EngineRun};
 use pushval_model::{
-    kinematic, limit_surface, DynamicModel, InertialTerm, Integrator, KinematicModel,
-    LimitSurfaceModel, ModelError, Problem, RootKind, Sample, SegmentDynamics, Simulator,
-    SteadyState, Trajectory,
+    DynamicModel, Integrator, KinematicModel, LimitSurfaceModel, ModelError, Problem, Sample,
+    Simulator, Trajectory,
 };
 use pushval_scenario::Scenario;
 
 use crate::registry;
 
 mod dt;
+mod figures;
+mod segments;
 pub mod tolerance;
 
 pub use dt::{
-    choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, trajectory_order, DtChoice,
-    DtEstimate, DtSource, TrajectoryOrder, DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
+    choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, trajectory_order, Convergence,
+    DtChoice, DtEstimate, DtSource, TrajectoryOrder, DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
 };
-pub use tolerance::{Figures, Resolved};
+pub use segments::{analyse_segments, analyse_segments_with, tail_omega, SegmentInfo, SETTLED_REL};
+pub use tolerance::{Catches, Figures, Resolved, CATCH_PROBE};
 
 /// Settings of a harness run.
 #[derive(Debug, Clone, Copy)]
@@ -53,60 +55,6 @@ pub struct ModelRun {
     pub diagnostics: serde_json::Value,
 }
 
-/// The steady-state analysis of one push segment.
-#[derive(Debug, Clone)]
-pub struct SegmentInfo {
-    pub index: usize,
-    pub t_start: f64,
-    pub t_end: f64,
-    pub speed: f64,
-    pub phi: f64,
-    pub froude: f64,
-    /// `v_c ψ(φ)` (rad/s), None where ψ does not exist.
-    pub omega_kinematic: Option<f64>,
-    /// The ellipsoidal limit surface's ω (rad/s).
-    pub omega_limit_surface: f64,
-    /// κ = ω*/ω_kinematic (the steady state reached over the kinematic ω);
-    /// None where either is missing or ω_kinematic = 0 (|ω_kinematic| L ≤
-    /// 1e-12 v_c, rounding).
-    pub kappa: Option<f64>,
-    /// dκ/dFr as Fr → 0, in closed form (`pushval_model::kappa`); None where
-    /// ω_kinematic = 0 or the kinematic root is a pivot.
-    pub kappa_slope: Option<f64>,
-    /// All roots of ω̇, sorted, with their stability.
-    pub steady_states: Vec<SteadyState>,
-    /// The steady state the dynamic run converges to in this segment (None: runaway).
-    pub omega_steady: Option<SteadyState>,
-    /// ω at the start of the segment, just after the switch (rad/s).
-    pub omega_start: f64,
-    /// Relative distance of the dynamic model's tail-mean ω (last 20 % of the
-    /// segment) from ω*, with the floor of [`rel_err`]; None without a root.
-    pub tail_deviation: Option<f64>,
-}
-
-impl SegmentInfo {
-    /// Relaxation time τ (s) of the steady state reached, if smooth and stable.
-    pub fn tau(&self) -> Option<f64> {
-        self.omega_steady.and_then(|s| s.tau)
-    }
-    /// Whether a steady ω can be read off the segment's tail: a smooth stable
-    /// root, and the dynamic model's tail mean within 1e-6 (relative) of it.
-    pub fn settles(&self) -> bool {
-        matches!(
-            self.omega_steady,
-            Some(SteadyState {
-                kind: RootKind::Stable,
-                tau: Some(_),
-                ..
-            })
-        ) && self.tail_deviation.is_some_and(|d| d <= SETTLED_REL)
-    }
-}
-
-/// Largest relative deviation of the dynamic model's tail-mean ω from ω* for
-/// a segment to count as settled (100 times below the tightest engine target).
-pub const SETTLED_REL: f64 = 1e-6;
-
 /// One model measured against the dynamic model.
 #[derive(Debug, Clone)]
 pub struct Comparison {
@@ -128,58 +76,6 @@ pub struct Comparison {
     pub convergence: Option<Convergence>,
     /// Gated rows: the tolerances asserted and where they came from.
     pub tolerance: Option<Resolved>,
-}
-
-/// How an engine's steady ω converges as its time step shrinks: runs at 4h,
-/// 2h and h (h the gated run's step; runs the time-step search made are
-/// reused), the observed order `p = log2(|ω(4h) − ω(2h)| / |ω(2h) − ω(h)|)`, and Richardson extrapolations
-/// to dt → 0 with the scheme's expected order p: `ω(h) + (ω(h) − ω(2h)) / (2^p − 1)`,
-/// and the same applied again for the order p + 1 term.
-#[derive(Debug, Clone)]
-pub struct Convergence {
-    /// The order the friction-velocity scheme should show (1, or 2 for leapfrog).
-    pub expected_order: f64,
-    /// The three time steps (s), largest first.
-    pub dts: [f64; 3],
-    /// The order observed on the trajectory (positions and angle at the
-    /// samples, every run of the ladder): [`dt::trajectory_order`].
-    pub trajectory: TrajectoryOrder,
-    /// Observed order of the steady ω per settled segment.
-    pub orders: Vec<(usize, f64)>,
-    /// Largest relative error of the extrapolation at the expected order,
-    /// against the dynamic model's tail-mean ω (within 1e-6 of ω*).
-    pub richardson1_rel_max: f64,
-    /// The same after removing the next order as well.
-    pub richardson2_rel_max: f64,
-    /// The same for the plain run at h.
-    pub plain_rel_max: f64,
-    /// Per settled segment, `|ω(2h) − ω(h)|` relative (with [`rel_err`]'s
-    /// floor): below the auto target the order is not resolved (the
-    /// difference is at the level of the tail mean's own noise).
-    pub diff_rel: Vec<(usize, f64)>,
-}
-
-impl Convergence {
-    /// Median observed order over the settled segments.
-    pub fn order(&self) -> Option<f64> {
-        self.order_resolved(0.0)
-    }
-
-    /// Median observed order over the settled segments whose
-    /// `|ω(2h) − ω(h)|` (relative, [`Convergence::diff_rel`]) is at least
-    /// `floor`.
-    pub fn order_resolved(&self, floor: f64) -> Option<f64> {
-        let mut o: Vec<f64> = self
-            .orders
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| self.diff_rel.get(*i).is_none_or(|d| d.1 >= floor))
-            .map(|(_, p)| p.1)
-            .filter(|p| p.is_finite())
-            .collect();
-        o.sort_by(f64::total_cmp);
-        (!o.is_empty()).then(|| o[o.len() / 2])
-    }
 }
 
 /// Everything a scenario run produced.
@@ -233,90 +129,6 @@ fn analytic(name: &str, opts: &RunOptions) -> Option<(Box<dyn Simulator>, serde_
         "limit_surface" => Some((Box::new(LimitSurfaceModel), serde_json::json!({}))),
         _ => None,
     }
-}
-
-/// Steady ω per segment read off a trajectory: the mean ω over the last 20 %
-/// of the segment (samples strictly before its end).
-pub fn tail_omega(tr: &Trajectory, t_start: f64, t_end: f64) -> Option<f64> {
-    let from = t_end - 0.2 * (t_end - t_start);
-    let eps = 1e-9 * (t_end - t_start);
-    let w: Vec<f64> = tr
-        .samples
-        .iter()
-        .filter(|s| s.t >= from - eps && s.t < t_end - eps)
-        .map(|s| s.omega)
-        .collect();
-    (!w.is_empty()).then(|| w.iter().sum::<f64>() / w.len() as f64)
-}
-
-/// The steady-state analysis of every segment, following ω across switches.
-pub fn analyse_segments(
-    sc: &Scenario,
-    problem: &Problem,
-    dynamic: &Trajectory,
-) -> Vec<SegmentInfo> {
-    analyse_segments_with(sc, problem, dynamic, InertialTerm::Derived)
-}
-
-/// [`analyse_segments`] for a chosen reading of the inertial term.
-pub fn analyse_segments_with(
-    sc: &Scenario,
-    problem: &Problem,
-    dynamic: &Trajectory,
-    term: InertialTerm,
-) -> Vec<SegmentInfo> {
-    problem
-        .pushes
-        .iter()
-        .zip(problem.segment_times())
-        .enumerate()
-        .map(|(j, (push, (t0, t1)))| {
-            let seg = SegmentDynamics::with_inertial_term(&problem.body, push, term);
-            let roots = if push.speed > 0.0 {
-                seg.steady_states()
-            } else {
-                vec![]
-            };
-            let omega_start = dynamic.segments.get(j).map_or(0.0, |s| s.omega_start);
-            let omega_steady = if push.speed > 0.0 {
-                seg.attractor(&roots, omega_start)
-            } else {
-                None
-            };
-            let tail_deviation = omega_steady.and_then(|r| {
-                tail_omega(dynamic, t0, t1)
-                    .map(|w| rel_err(w, r.omega, push.speed, sc.froude_length()))
-            });
-            let omega_kinematic = kinematic::omega(&problem.body, push);
-            // ω_kinematic = 0 within rounding (a push through the centre of
-            // friction): κ is undefined there.
-            let has_kinematic =
-                omega_kinematic.is_some_and(|w| w.abs() * sc.froude_length() > 1e-12 * push.speed);
-            let kappa = match (omega_steady, omega_kinematic) {
-                (Some(s), Some(k)) if has_kinematic => Some(s.omega / k),
-                _ => None,
-            };
-            let kappa_slope = has_kinematic
-                .then(|| pushval_model::kappa_series(&problem.body, push.phi).map(|k| k.kappa1))
-                .flatten();
-            SegmentInfo {
-                index: j,
-                t_start: t0,
-                t_end: t1,
-                speed: push.speed,
-                phi: push.phi,
-                froude: sc.froude(push.speed),
-                omega_kinematic,
-                kappa,
-                kappa_slope,
-                omega_limit_surface: limit_surface::omega(&problem.body, push),
-                omega_steady,
-                steady_states: roots,
-                omega_start,
-                tail_deviation,
-            }
-        })
-        .collect()
 }
 
 pub use pushval_engine::rel_err;
@@ -450,46 +262,6 @@ pub fn compare_trajectory(
         error: None,
         convergence: None,
         tolerance: None,
-    }
-}
-
-/// The smallest model errors a gated row's tolerances would catch, from
-/// the model's sensitivities: each error is injected at ±[`CATCH_PROBE`]
-/// (relative) into the dynamic model ([`crate::inject::inject`]), each gated
-/// figure's change divided by the probe is its sensitivity `|∂X/∂p|`, and
-/// `tolerance / |∂X/∂p|` is the error that moves that figure past its
-/// tolerance. Any figure failing fails the row, so the most sensitive
-/// figure decides. Linear: `pushval power` bisects the same question with
-/// the engine in the loop (results/gate_power.csv, column
-/// `linear_estimate`, compares the two).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Catches {
-    /// Smallest relative error in I_cm caught, and the figure that catches
-    /// it; None where no figure sees I_cm.
-    pub inertia_cm: Option<(f64, &'static str)>,
-    /// The same for every support's μ scaled together.
-    pub mu_all: Option<(f64, &'static str)>,
-}
-
-/// The relative probe of [`Catches`]: small enough to stay linear (the
-/// figures are smooth in the parameters except at a switch of sticking),
-/// large enough to sit far above the model's own error (about 1e-10 m).
-pub const CATCH_PROBE: f64 = 1e-4;
-
-impl Catches {
-    /// The record in summary.json.
-    pub fn json(&self) -> serde_json::Value {
-        let one = |c: &Option<(f64, &str)>| match c {
-            Some((m, by)) => {
-                serde_json::json!({"relative": crate::outdir::json_num(*m), "figure": by})
-            }
-            None => serde_json::Value::Null,
-        };
-        serde_json::json!({
-            "method": format!("linear: tolerance / |dX/dp| per gated figure, the smallest deciding; probe ±{CATCH_PROBE} relative"),
-            "inertia_cm": one(&self.inertia_cm),
-            "mu_all": one(&self.mu_all),
-        })
     }
 }
 

@@ -9,30 +9,9 @@
 use pushval_model::{DynamicModel, Integrator, Problem, Simulator, Trajectory};
 use pushval_scenario::{Limit, Scenario};
 
-use super::DtEstimate;
-
-/// The three gated figures: largest centre-of-mass distance (m), largest
-/// angle difference (rad), largest relative steady-ω error.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Figures {
-    /// m
-    pub position_max: f64,
-    /// rad
-    pub theta_max: f64,
-    /// relative
-    pub omega_steady_rel: f64,
-}
-
-/// What the dt ladder aims for on an `"auto"` figure: the engine's
-/// self-convergence estimate at the chosen step is at most this. Small enough
-/// that model errors of a fraction of a per cent move the trajectory past the
-/// resulting tolerance (results/gate_power.csv), large enough that a
-/// second-order engine reaches it at 1/2000 s or so on the shipped scenes.
-pub const AUTO_TARGET: Figures = Figures {
-    position_max: 2e-6,
-    theta_max: 2e-6,
-    omega_steady_rel: 2e-6,
-};
+use super::dt::{Convergence, DtEstimate, DtSource, TrajectoryOrder};
+use super::figures::limits;
+pub use super::figures::{ladder_targets, Figures, AUTO_TARGET};
 
 /// An `"auto"` tolerance is this multiple of the engine's self-convergence
 /// estimate (itself not trusted below [`AUTO_TARGET`]): the estimate assumes
@@ -79,10 +58,10 @@ pub struct Resolved {
     /// The smallest relative errors in I_cm and in every μ the tolerances
     /// would catch (linear estimate from the model's sensitivities); None
     /// until [`super::catchable`] fills it.
-    pub catches: Option<super::Catches>,
+    pub catches: Option<Catches>,
     /// The gated engine's time step (s), where it came from and whether the
     /// ladder's estimate met its targets there; None outside `validate`.
-    pub dt: Option<(f64, super::DtSource, bool)>,
+    pub dt: Option<(f64, DtSource, bool)>,
     /// The order the engine declares, the order its trajectory shows over
     /// the ladder (None: not observed) and the order the self-convergence
     /// estimate used ([`check_order`]); None outside `validate`.
@@ -130,21 +109,43 @@ impl Resolved {
     }
 }
 
-/// The scenario's `[tolerance]` limits in [`Figures`] order.
-fn limits(sc: &Scenario) -> [Limit; 3] {
-    let t = &sc.tolerance;
-    [t.position_max, t.theta_max, t.omega_steady_rel]
+/// The smallest model errors a gated row's tolerances would catch, from
+/// the model's sensitivities: each error is injected at ±[`CATCH_PROBE`]
+/// (relative) into the dynamic model ([`crate::inject::inject`]), each gated
+/// figure's change divided by the probe is its sensitivity `|∂X/∂p|`, and
+/// `tolerance / |∂X/∂p|` is the error that moves that figure past its
+/// tolerance. Any figure failing fails the row, so the most sensitive
+/// figure decides. Linear: `pushval power` bisects the same question with
+/// the engine in the loop (results/gate_power.csv, column
+/// `linear_estimate`, compares the two).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Catches {
+    /// Smallest relative error in I_cm caught, and the figure that catches
+    /// it; None where no figure sees I_cm.
+    pub inertia_cm: Option<(f64, &'static str)>,
+    /// The same for every support's μ scaled together.
+    pub mu_all: Option<(f64, &'static str)>,
 }
 
-/// What the dt ladder aims for per figure: a share of the scenario's number,
-/// or [`AUTO_TARGET`] for an auto figure.
-pub fn ladder_targets(sc: &Scenario, fraction: f64) -> Figures {
-    let l = limits(sc);
-    let pick = |l: Limit, auto: f64| l.value().map_or(auto, |v| fraction * v);
-    Figures {
-        position_max: pick(l[0], AUTO_TARGET.position_max),
-        theta_max: pick(l[1], AUTO_TARGET.theta_max),
-        omega_steady_rel: pick(l[2], AUTO_TARGET.omega_steady_rel),
+/// The relative probe of [`Catches`]: small enough to stay linear (the
+/// figures are smooth in the parameters except at a switch of sticking),
+/// large enough to sit far above the model's own error (about 1e-10 m).
+pub const CATCH_PROBE: f64 = 1e-4;
+
+impl Catches {
+    /// The record in summary.json.
+    pub fn json(&self) -> serde_json::Value {
+        let one = |c: &Option<(f64, &str)>| match c {
+            Some((m, by)) => {
+                serde_json::json!({"relative": crate::outdir::json_num(*m), "figure": by})
+            }
+            None => serde_json::Value::Null,
+        };
+        serde_json::json!({
+            "method": format!("linear: tolerance / |dX/dp| per gated figure, the smallest deciding; probe ±{CATCH_PROBE} relative"),
+            "inertia_cm": one(&self.inertia_cm),
+            "mu_all": one(&self.mu_all),
+        })
     }
 }
 
@@ -268,7 +269,7 @@ pub struct OrderCheck {
 /// order below the declared one fails: the estimate then understates the
 /// engine's error by `(2^declared − 1) / (2^observed − 1)`; one above it
 /// only overstates the error, and the gate stays sound.
-pub fn check_order(declared: f64, observed: &super::TrajectoryOrder) -> OrderCheck {
+pub fn check_order(declared: f64, observed: &TrajectoryOrder) -> OrderCheck {
     let on = observed.describe();
     match observed.observed() {
         Some(p) if p < declared - ORDER_BAND => {
@@ -349,7 +350,7 @@ pub const ORDER_BAND: f64 = 0.5;
 /// the auto target, runs at 4h, 2h, h) strays from the
 /// declared one by more than [`ORDER_BAND`]; None when it does not, or when
 /// no figure is auto, or no segment settles.
-pub fn order_problem(res: &Resolved, conv: &super::Convergence) -> Option<String> {
+pub fn order_problem(res: &Resolved, conv: &Convergence) -> Option<String> {
     if !res.source.contains(&Source::Auto) {
         return None;
     }
@@ -401,7 +402,7 @@ pub fn model_error(problem: &Problem, reference: &Trajectory, model_tol: f64) ->
         .zip(&reference.segments)
         .zip(&problem.pushes)
     {
-        let e = super::rel_err(a.omega_end, b.omega_end, push.speed, length);
+        let e = pushval_engine::rel_err(a.omega_end, b.omega_end, push.speed, length);
         f.omega_steady_rel = f.omega_steady_rel.max(e);
     }
     f

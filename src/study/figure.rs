@@ -9,8 +9,7 @@
 
 use plotters::style::RGBColor;
 
-use super::err;
-use super::plate::froude;
+use super::plate::{err, froude};
 use super::records::{num, parse};
 use crate::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, GREY, PURPLE};
 

@@ -3,6 +3,7 @@
 
 use std::f64::consts::FRAC_PI_4;
 
+use pushval_engine::rel_err;
 use pushval_model::{Body, Initial, Problem, Push, Support, Switching, Vec2};
 
 /// Friction coefficient of every support (dimensionless).
@@ -107,5 +108,16 @@ pub fn frs(quick: bool) -> &'static [f64] {
         &FRS_QUICK
     } else {
         &FRS
+    }
+}
+
+/// The engine against a reference ω: relative with the gate's floor
+/// (`rel_err`); against a lock (reference 0), |ω| over |ω*|, the size of
+/// what the lock removes.
+pub fn err(engine: f64, reference: f64, coulomb: f64, speed: f64) -> f64 {
+    if reference == 0.0 {
+        rel_err(engine, 0.0, speed, length()).min(engine.abs() / coulomb.abs())
+    } else {
+        rel_err(engine, reference, speed, length())
     }
 }

@@ -4,9 +4,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::plate::{froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
+use super::fit;
+use super::plan::{class_name, law_integrates, Plan, Task, LAW_RUN, LOADS};
+use super::plate::{err, froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
 use super::records::{num, parse, Records};
-use super::{class_name, err, fit, opt, Plan, Task, LAW_RUN, LOADS};
 use crate::outdir::Writer;
 
 /// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
@@ -533,7 +534,7 @@ fn readme(
         .any(|r| num(r, "max_rise_m").is_finite())
         && e.law().is_some_and(|l| {
             let p = super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None);
-            super::law_integrates(l, &p, 0, plan.dt)
+            law_integrates(l, &p, 0, plan.dt)
         });
     let _ = write!(
         s,
@@ -720,4 +721,13 @@ pub fn index(root: &Path, models: &[String], quick: bool, w: &mut Writer) -> any
         );
     }
     w.file("README.md", s.as_bytes())
+}
+
+/// A number for a data file, blank where it is NaN (undefined).
+pub fn opt(v: f64) -> String {
+    if v.is_nan() {
+        String::new()
+    } else {
+        format!("{v}")
+    }
 }

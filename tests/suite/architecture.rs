@@ -19,9 +19,12 @@
 //! themselves form a circle (registry/a.rs → shipped.rs → registry/b.rs) is
 //! refused too, because these modules are the units the architecture names
 //! and the ones that would move into crates, where any cycle is fatal.
-//! Inside one top-level module a `mod.rs` and its children may use each
-//! other (they compile and move as one); the modules where they still do are
-//! listed in `FILE_CYCLES_INSIDE`, and any other file circle fails.
+//! A circle of files inside one top-level module fails as well: where a
+//! `mod.rs` uses a child (its entry points calling it, its re-exports), the
+//! child does not use the `mod.rs` back, and what both need lives in a child
+//! file of its own (`harness/segments.rs`, `study/plan.rs`, …).
+//! A child that writes `super::X` names `mod.rs` even where `X` is only
+//! re-exported there; it names the file `X` lives in (`super::segments::X`).
 //!
 //! Limits: a path spelled through a `use` alias of an outside crate, or
 //! written by a macro, is not seen; the check reads text, not the compiler's
@@ -43,10 +46,6 @@ const ENGINE_CRATES: &[&str] = &[
     "pushval_jolt",
     "pushval_outside",
 ];
-
-/// Top-level modules whose `mod.rs` and children still use each other:
-/// tolerated there, a circle of files anywhere else fails.
-const FILE_CYCLES_INSIDE: &[&str] = &["harness", "fit", "study"];
 
 /// One file of the library.
 struct File {
@@ -453,9 +452,9 @@ fn top(path: &str) -> String {
 }
 
 /// The circles of the library under `src`: the cycles between top-level
-/// modules, then the file circles inside a module not in `tolerated`; each
-/// as a message naming the edges and the lines that make them.
-fn circles(src: &Path, tolerated: &[&str]) -> Vec<String> {
+/// modules, then the file circles inside one module; each as a message
+/// naming the edges and the lines that make them.
+fn circles(src: &Path) -> Vec<String> {
     let (_, edges) = file_graph(src);
     let evidence = |a: &str, b: &str, same_module: bool| -> Vec<String> {
         edges
@@ -493,7 +492,7 @@ fn circles(src: &Path, tolerated: &[&str]) -> Vec<String> {
     for comp in cycles(&files) {
         // A circle across modules is a cycle of modules, reported above.
         let module = top(&comp[0]);
-        if comp.iter().any(|f| top(f) != module) || tolerated.contains(&module.as_str()) {
+        if comp.iter().any(|f| top(f) != module) {
             continue;
         }
         let mut lines = vec![format!("files in a circle: {}", comp.join(", "))];
@@ -507,11 +506,11 @@ fn circles(src: &Path, tolerated: &[&str]) -> Vec<String> {
     found
 }
 
-/// No circle between the library's top-level modules, nor between files
-/// outside the modules listed in `FILE_CYCLES_INSIDE`.
+/// No circle between the library's top-level modules, nor between any of
+/// its files.
 #[test]
 fn no_circle_between_modules() {
-    let found = circles(&root().join("src"), FILE_CYCLES_INSIDE);
+    let found = circles(&root().join("src"));
     assert!(found.is_empty(), "{}", found.join("\n"));
 }
 
@@ -557,7 +556,7 @@ fn the_file_graph_reads_use_trees_and_fails_on_a_planted_circle() {
     );
     write("b.rs", "pub fn g() { crate::Thing::new(); }\n");
     write("c.rs", "pub struct Thing;\n");
-    assert!(circles(src, &[]).is_empty(), "{:?}", circles(src, &[]));
+    assert!(circles(src).is_empty(), "{:?}", circles(src));
     let (_, e) = file_graph(src);
     assert!(e.contains_key(&("src/a/inner.rs".into(), "src/b.rs".into())));
     assert!(e.contains_key(&("src/b.rs".into(), "src/c.rs".into())));
@@ -568,7 +567,7 @@ fn the_file_graph_reads_use_trees_and_fails_on_a_planted_circle() {
     // A circle planted between two modules through different files fails,
     // naming the modules and the line of each edge.
     write("c.rs", "pub struct Thing;\nfn h() { super::a::f() }\n");
-    let found = circles(src, &[]);
+    let found = circles(src);
     assert_eq!(found.len(), 1, "{found:?}");
     assert!(
         found[0].contains("modules in a circle: a, b, c"),
@@ -580,17 +579,16 @@ fn the_file_graph_reads_use_trees_and_fails_on_a_planted_circle() {
         "{}",
         found[0]
     );
-    // A circle of files inside one module fails unless tolerated there.
+    // A circle of files inside one module fails too.
     write("c.rs", "pub struct Thing;\n");
     write("a/inner.rs", "pub fn f() { super::helper() }\n");
     write(
         "a/mod.rs",
         "mod inner;\npub use inner::f;\npub fn helper() {}\n",
     );
-    let found = circles(src, &[]);
+    let found = circles(src);
     assert_eq!(found.len(), 1, "{found:?}");
     assert!(found[0].contains("files in a circle: src/a/inner.rs, src/a/mod.rs"));
-    assert!(circles(src, &["a"]).is_empty());
 }
 
 /// Only `src/registry*` names an engine crate (comments included): the

@@ -1,0 +1,613 @@
+//! A model's study, ready to run ([`Plan`]): its setups, its fixed list of
+//! tasks ([`Task`]) and the row of numbers each task reduces to (an engine
+//! run against Coulomb's ω* and the engine's own law, or a Coulomb fit).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::bail;
+use pushval_engine::{tail_loads, tail_mean_omega, Engine, EngineOptions, LawClass};
+use pushval_model::{Problem, Push, SegmentDynamics, Trajectory};
+
+use super::fit;
+use super::plate::{frs, paper_plate, phis, speed_of, PHI_TABLE, TABLE_SPEEDS};
+use super::spec::{self, Spec};
+
+/// One setup of a study: the study's own options or a variant's.
+pub struct Setup {
+    /// `""` for the study's own setup, else the variant's name.
+    pub name: String,
+    pub engine: Box<dyn Engine>,
+    pub options: EngineOptions,
+    pub supports_half: Option<f64>,
+    /// Direction of its table (rad).
+    pub phi: f64,
+    /// Its step (s).
+    pub dt: f64,
+    pub map: bool,
+}
+
+/// One task: an engine run or a fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Task {
+    /// Setup `s` at `TABLE_SPEEDS[v]` in its table direction.
+    Table { s: usize, v: usize },
+    /// The step ladder: `ladder[k]` at 0.5 m/s, φ = π/4 + 0.3.
+    Ladder { k: usize },
+    /// The creep ladder: `ladder[k]` at `TABLE_SPEEDS[v]`.
+    Creep { v: usize, k: usize },
+    /// Setup `s`'s map at `frs[i]`, `phis[j]`.
+    Map { s: usize, i: usize, j: usize },
+    /// The Coulomb fit on schedule `k`.
+    Fit { k: usize },
+    /// Sweep `w` at its `values[i]` and `speeds[v]`.
+    Sweep { w: usize, i: usize, v: usize },
+}
+
+/// Supports whose loads a row carries (the plate's four).
+pub const LOADS: usize = 4;
+
+/// Values of a run's row: ω of the engine, of Coulomb and of the law
+/// (rad/s), the law's class code ([`class_code`]) and its rest moments,
+/// then [`LOADS`] support loads measured by the engine and as many
+/// predicted by the law (N; NaN where unknown), the engine's angle at the
+/// end of the run (rad), then what the run's own loads give
+/// ([`LAW_RUN`]): the law's ω on them (tail mean, rad/s), the RMS of the
+/// engine's ω against it over the tail (rad/s), the largest rise (m) and the
+/// share of steps with a support out of contact, and the smallest and
+/// largest per-step load of any support (N).
+pub const RUN_WIDTH: usize = 14 + 2 * LOADS;
+
+/// Index in a run's row of `omega_law_run`; `law_run_rms`, `max_rise_m`,
+/// `contact_lost_share`, `load_min` and `load_max` follow it.
+pub const LAW_RUN: usize = 8 + 2 * LOADS;
+
+/// A sweep of the study file, ready to run.
+pub struct SweepPlan {
+    pub spec: spec::Sweep,
+    /// One engine per value for an `[engine]` key sweep, else one.
+    pub engines: Vec<Box<dyn Engine>>,
+    /// Pusher speeds (m/s).
+    pub speeds: Vec<f64>,
+    pub phi: f64,
+    pub dt: f64,
+    pub t_run: f64,
+    pub tail: f64,
+}
+
+impl SweepPlan {
+    /// Speed (m/s), direction (rad), step (s), start θ (rad) and engine of
+    /// value `i` at speed `v`.
+    pub(super) fn push(&self, i: usize, v: usize) -> (f64, f64, f64, f64, &dyn Engine) {
+        let x = self.spec.values[i];
+        let mut p = (self.speeds[v], self.phi, self.dt, 0.0);
+        match self.spec.over.as_str() {
+            "speed" => p.0 = x,
+            "phi" => p.1 = x,
+            "dt" => p.2 = x,
+            "theta0" => p.3 = x,
+            _ => {}
+        }
+        let e = &self.engines[if self.engines.len() > 1 { i } else { 0 }];
+        (p.0, p.1, p.2, p.3, e.as_ref())
+    }
+}
+
+/// The code of a class in a row: 0 turns, 1 locked, 2 semi-stable; NaN none.
+pub fn class_code(c: Option<LawClass>) -> [f64; 4] {
+    match c {
+        None => [f64::NAN; 4],
+        Some(LawClass::Turns) => [0.0, f64::NAN, f64::NAN, f64::NAN],
+        Some(LawClass::Locked) => [1.0, f64::NAN, f64::NAN, f64::NAN],
+        Some(LawClass::SemiStable { moment, lock, hold }) => [2.0, moment, lock, hold],
+    }
+}
+
+/// The class name of a code (empty for none).
+pub fn class_name(code: f64) -> &'static str {
+    ["turns", "locked", "semi_stable"]
+        .into_iter()
+        .enumerate()
+        .find(|(i, _)| *i as f64 == code)
+        .map_or("", |(_, n)| n)
+}
+
+/// A model's study: its setups, steps and task list.
+pub struct Plan {
+    pub model: String,
+    /// Engine runs that failed in this process: how many, and the first
+    /// error (said on stderr at the end, never swallowed).
+    failures: std::sync::Mutex<(usize, Option<String>)>,
+    pub spec: Spec,
+    pub setups: Vec<Setup>,
+    pub quick: bool,
+    /// Step of the tables and maps (s).
+    pub dt: f64,
+    pub ladder: Vec<f64>,
+    pub t_run: f64,
+    pub tail: f64,
+    /// Table speeds (indices) at which the law locks: the creep ladder's.
+    pub creep: Vec<usize>,
+    pub fit: bool,
+    pub sweeps: Vec<SweepPlan>,
+}
+
+fn build(model: &str, options: &EngineOptions) -> anyhow::Result<Box<dyn Engine>> {
+    let e = crate::registry::entry(model).ok_or_else(|| {
+        anyhow::anyhow!("unknown model `{model}`; known: {}", models().join(", "))
+    })?;
+    e.build(options)
+        .map_err(|o| anyhow::anyhow!("{model}: {o}"))
+}
+
+/// Every engine model of the registry, in its order.
+pub fn models() -> Vec<String> {
+    crate::registry::entries()
+        .iter()
+        .map(|e| e.name.to_string())
+        .collect()
+}
+
+impl Plan {
+    /// The plan of `model` from its study file in `studies`.
+    pub fn new(model: &str, studies: &Path, quick: bool) -> anyhow::Result<Self> {
+        let spec = Spec::load(studies, model)?;
+        let options = spec.options(&BTreeMap::new());
+        let engine = build(model, &options)?;
+        if let Err(why) = engine.availability() {
+            bail!("the model `{model}` is not in this build: {why}");
+        }
+        // Every `[engine]` key of the file must be one the model reads:
+        // (where the file names it, the key).
+        let mut keys: Vec<(String, &str)> = spec
+            .engine
+            .keys()
+            .map(|k| (format!("engine.{k}"), k.as_str()))
+            .collect();
+        for (i, v) in spec.variant.iter().enumerate() {
+            keys.extend(
+                v.engine
+                    .keys()
+                    .map(|k| (format!("variant[{i}].engine.{k}"), k.as_str())),
+            );
+        }
+        for (i, w) in spec.sweep.iter().enumerate() {
+            keys.extend(
+                w.engine
+                    .keys()
+                    .map(|k| (format!("sweep[{i}].engine.{k}"), k.as_str())),
+            );
+            keys.extend(w.key().map(|k| (format!("sweep[{i}].over"), k)));
+        }
+        if let Some((at, k)) = keys.iter().find(|(_, k)| !engine.accepts_option(k)) {
+            bail!(
+                "{}: key `{at}`: the model `{model}` reads no [engine] key `{k}` (it reads: {})",
+                studies.join(format!("{model}.toml")).display(),
+                engine.option_keys().join(", ")
+            );
+        }
+        let dt = spec.dt.unwrap_or(engine.default_dt());
+        let mut setups = vec![Setup {
+            name: String::new(),
+            engine,
+            options,
+            supports_half: None,
+            phi: PHI_TABLE,
+            dt,
+            map: true,
+        }];
+        // A model the file's options refuse, named by the file and key.
+        let file = studies.join(format!("{model}.toml"));
+        let built = |o: &EngineOptions, at: String| {
+            build(model, o).map_err(|e| anyhow::anyhow!("{}: key `{at}`: {e}", file.display()))
+        };
+        for (i, v) in spec.variant.iter().enumerate() {
+            let options = spec.options(&v.engine);
+            setups.push(Setup {
+                name: v.name.clone(),
+                engine: built(&options, format!("variant[{i}].engine"))?,
+                options,
+                supports_half: v.supports_half,
+                phi: v.phi.unwrap_or(PHI_TABLE),
+                dt: v.dt.unwrap_or(dt),
+                map: v.map,
+            });
+        }
+        let t_run = spec.t_run.unwrap_or(6.0);
+        let law_locks = |v: usize| {
+            let p = paper_plate(TABLE_SPEEDS[v], PHI_TABLE, t_run, None);
+            setups[0]
+                .engine
+                .law()
+                .and_then(|l| l.steady(&p, 0, dt))
+                .is_some_and(|s| s.class != LawClass::Turns)
+        };
+        let creep = (0..TABLE_SPEEDS.len()).filter(|&v| law_locks(v)).collect();
+        let tail = spec.tail.unwrap_or(0.2);
+        let mut sweeps = Vec::new();
+        for (n, w) in spec.sweep.iter().enumerate() {
+            let engines = match w.key() {
+                Some(key) => {
+                    let mut e = Vec::new();
+                    for (k, &x) in w.values.iter().enumerate() {
+                        let mut o = w.engine.clone();
+                        // A whole number as TOML's integer: counts are options too.
+                        let v = if x.fract() == 0.0 && x.abs() < 9e15 {
+                            (x as i64).into()
+                        } else {
+                            x.into()
+                        };
+                        o.insert(key.to_string(), v);
+                        e.push(built(&spec.options(&o), format!("sweep[{n}].values[{k}]"))?);
+                    }
+                    e
+                }
+                None => vec![built(
+                    &spec.options(&w.engine),
+                    format!("sweep[{n}].engine"),
+                )?],
+            };
+            sweeps.push(SweepPlan {
+                engines,
+                speeds: w.speeds.clone().unwrap_or(vec![0.5]),
+                phi: w.phi.unwrap_or(PHI_TABLE),
+                dt: w.dt.unwrap_or(dt),
+                t_run: w.t_run.unwrap_or(t_run),
+                tail: w.tail.unwrap_or(tail),
+                spec: w.clone(),
+            });
+        }
+        Ok(Self {
+            model: model.to_string(),
+            failures: std::sync::Mutex::new((0, None)),
+            ladder: spec.ladder(dt, quick),
+            tail,
+            sweeps,
+            fit: spec.fit.unwrap_or(true),
+            spec,
+            setups,
+            quick,
+            dt,
+            t_run,
+            creep,
+        })
+    }
+
+    /// The task list (fixed by the grid and the study file).
+    pub fn tasks(&self) -> Vec<Task> {
+        let mut t = Vec::new();
+        for s in 0..self.setups.len() {
+            t.extend((0..TABLE_SPEEDS.len()).map(|v| Task::Table { s, v }));
+        }
+        t.extend((0..self.ladder.len()).map(|k| Task::Ladder { k }));
+        for &v in &self.creep {
+            t.extend((0..self.ladder.len()).map(|k| Task::Creep { v, k }));
+        }
+        for (s, setup) in self.setups.iter().enumerate() {
+            if setup.map {
+                for i in 0..frs(self.quick).len() {
+                    t.extend((0..phis(self.quick).len()).map(|j| Task::Map { s, i, j }));
+                }
+            }
+        }
+        if self.fit {
+            let n = if self.quick { 1 } else { fit::SCHEDULES.len() };
+            t.extend((0..n).map(|k| Task::Fit { k }));
+        }
+        for (w, sw) in self.sweeps.iter().enumerate() {
+            // A speed sweep sets the speed itself: one column of speeds.
+            let nv = if sw.spec.over == "speed" {
+                1
+            } else {
+                sw.speeds.len()
+            };
+            for i in 0..sw.spec.values.len() {
+                t.extend((0..nv).map(|v| Task::Sweep { w, i, v }));
+            }
+        }
+        t
+    }
+
+    /// The task's key: what it computes, so its hash shard never moves.
+    pub fn key(&self, t: &Task) -> String {
+        let m = &self.model;
+        if let Task::Sweep { w, i, v } = *t {
+            let sw = &self.sweeps[w];
+            let (speed, phi, dt, theta0, _) = sw.push(i, v);
+            return format!(
+                "{m}/sweep/{}/{}={}/{:?}/v={speed}/phi={phi}/dt={dt}/theta0={theta0}/t={}/tail={}",
+                sw.spec.name, sw.spec.over, sw.spec.values[i], sw.spec.engine, sw.t_run, sw.tail
+            ) + &sw.spec.stop.map_or(String::new(), |s| format!("/stop={s}"));
+        }
+        let (speed, phi, dt, s) = self.push(t);
+        match t {
+            Task::Fit { k } => format!("{m}/fit/{}/{}", fit::SCHEDULES[*k], self.dt),
+            _ => format!(
+                "{m}/{}/{}/v={speed}/phi={phi}/dt={dt}/t={}/tail={}",
+                self.setups[s].name,
+                match t {
+                    Task::Creep { .. } => "creep",
+                    Task::Ladder { .. } => "ladder",
+                    _ => "run",
+                },
+                self.t_run,
+                self.tail
+            ),
+        }
+    }
+
+    /// Speed (m/s), direction (rad), step (s) and setup of a run task.
+    fn push(&self, t: &Task) -> (f64, f64, f64, usize) {
+        match *t {
+            Task::Table { s, v } => (TABLE_SPEEDS[v], self.setups[s].phi, self.setups[s].dt, s),
+            Task::Ladder { k } => (0.5, PHI_TABLE, self.ladder[k], 0),
+            Task::Creep { v, k } => (TABLE_SPEEDS[v], PHI_TABLE, self.ladder[k], 0),
+            Task::Map { s, i, j } => {
+                let (fr, phi) = (frs(self.quick)[i], phis(self.quick)[j]);
+                (speed_of(fr), phi, self.setups[s].dt, s)
+            }
+            Task::Fit { .. } | Task::Sweep { .. } => (f64::NAN, f64::NAN, self.dt, 0),
+        }
+    }
+
+    /// Runs a task: a run's row is [`RUN_WIDTH`] values, a fit's
+    /// [`fit::WIDTH`] (NaN where the engine or the fit fails).
+    pub fn eval(&self, t: &Task) -> Vec<f64> {
+        if let Task::Fit { k } = *t {
+            return fit::fit_engine(self.setups[0].engine.as_ref(), k, self.dt).unwrap_or_else(
+                |(stage, e)| {
+                    // The row keeps the stage (its reason column); the
+                    // error itself is said here.
+                    eprintln!(
+                        "study {}: coulomb fit of {}: {}: {e:#}",
+                        self.model,
+                        fit::SCHEDULES[k],
+                        stage.reason()
+                    );
+                    fit::failed_row(stage)
+                },
+            );
+        }
+        if let Task::Sweep { w, i, v } = *t {
+            let sw = &self.sweeps[w];
+            let (speed, phi, dt, theta0, engine) = sw.push(i, v);
+            let mut p = paper_plate(speed, phi, sw.t_run, None);
+            p.initial.theta = theta0;
+            if let Some(duration) = sw.spec.stop {
+                p.pushes.push(Push {
+                    duration,
+                    speed: 0.0,
+                    phi,
+                });
+            }
+            return run_row(engine, &p, dt, sw.tail, &self.failures);
+        }
+        let (speed, phi, dt, s) = self.push(t);
+        let setup = &self.setups[s];
+        let p = paper_plate(speed, phi, self.t_run, setup.supports_half);
+        run_row(setup.engine.as_ref(), &p, dt, self.tail, &self.failures)
+    }
+
+    /// The note on the engine runs that failed (their rows are blank), if
+    /// any: how many and the first error.
+    pub fn failure_note(&self) -> Option<String> {
+        let f = self.failures.lock().expect("not poisoned");
+        (f.0 > 0).then(|| {
+            format!(
+                "study {}: {} engine run(s) failed, their cells left blank; the first: {}",
+                self.model,
+                f.0,
+                f.1.as_deref().unwrap_or("-")
+            )
+        })
+    }
+
+    pub(super) fn width(&self, t: &Task) -> usize {
+        match t {
+            Task::Fit { .. } => fit::WIDTH,
+            _ => RUN_WIDTH,
+        }
+    }
+}
+
+/// A run's row ([`RUN_WIDTH`] values): the engine's tail-mean ω and loads,
+/// Coulomb's ω*, the law's ω, class and loads.
+fn run_row(
+    engine: &dyn Engine,
+    p: &Problem,
+    dt: f64,
+    tail: f64,
+    failures: &std::sync::Mutex<(usize, Option<String>)>,
+) -> Vec<f64> {
+    let run = engine
+        .run(p, dt)
+        .inspect_err(|e| {
+            let mut f = failures.lock().expect("not poisoned");
+            f.0 += 1;
+            f.1.get_or_insert_with(|| format!("v_c {} m/s, dt {dt} s: {e}", p.pushes[0].speed));
+        })
+        .ok();
+    // The last segment: the push, or the rest after a stop, where ω is the
+    // mean |ω| over the tail (a signed mean hides a chattering stop).
+    let seg = p.pushes.len() - 1;
+    let law = engine.law();
+    let period = law.and_then(|l| l.angle_period(p));
+    let omega = run
+        .as_ref()
+        .and_then(|r| {
+            if seg == 0 {
+                let whole = period.and_then(|a| whole_period_omega(p, &r.trajectory, tail, a));
+                return whole.or_else(|| tail_mean_omega(p, &r.trajectory, tail)[0]);
+            }
+            let t1 = p.segment_times()[seg].1;
+            let w: Vec<f64> = r
+                .trajectory
+                .samples
+                .iter()
+                .filter(|s| s.t >= t1 - tail * p.pushes[seg].duration)
+                .map(|s| s.omega.abs())
+                .collect();
+            Some(w.iter().sum::<f64>() / w.len() as f64)
+        })
+        .unwrap_or(f64::NAN);
+    let coulomb = pushval_engine::coulomb_steady(p, seg).unwrap_or(f64::NAN);
+    let steady = law.and_then(|l| l.steady(p, seg, dt));
+    let mut row = vec![omega, coulomb, steady.map_or(f64::NAN, |l| l.omega)];
+    row.extend(class_code(steady.map(|l| l.class)));
+    for loads in [
+        run.as_ref().and_then(tail_loads),
+        law.and_then(|l| l.loads(p, seg, dt)),
+    ] {
+        let loads = loads.unwrap_or_default();
+        row.extend((0..LOADS).map(|k| loads.get(k).copied().unwrap_or(f64::NAN)));
+    }
+    let end = run.as_ref().and_then(|r| r.trajectory.samples.last());
+    row.push(end.map_or(f64::NAN, |s| s.theta));
+    let contact = run.as_ref().and_then(|r| Some((r, r.contact.as_ref()?)));
+    let (law_run, rms) = match (contact, law) {
+        (Some((r, c)), Some(law)) => law_on_run_loads(law, p, seg, dt, tail, r, c),
+        _ => (f64::NAN, f64::NAN),
+    };
+    row.extend([
+        law_run,
+        rms,
+        contact.map_or(f64::NAN, |(_, c)| c.max_rise_m),
+        contact.map_or(f64::NAN, |(_, c)| c.contact_lost_share),
+        contact.map_or(f64::NAN, |(_, c)| c.load_range[0]),
+        contact.map_or(f64::NAN, |(_, c)| c.load_range[1]),
+    ]);
+    row
+}
+
+/// The mean ω (rad/s) of the first segment over the longest part of its
+/// tail (its last `tail` share) that ends at the segment's end and turns the
+/// object by a whole number of `period`s (rad): the mean a law that depends
+/// on the angle predicts (`FrictionLaw::angle_period`), which a tail cut
+/// mid-period misses by up to a few per cent. The start is interpolated
+/// linearly between samples. None where the tail turns less than a period.
+pub fn whole_period_omega(p: &Problem, traj: &Trajectory, tail: f64, period: f64) -> Option<f64> {
+    let (t0, t1) = p.segment_times()[0];
+    let from = t1 - tail * (t1 - t0);
+    let s: Vec<_> = traj
+        .samples
+        .iter()
+        .filter(|s| s.t >= from - 1e-12 && s.t <= t1 + 1e-12)
+        .collect();
+    let (first, last) = (s.first()?, s.last()?);
+    let turn = last.theta - first.theta;
+    let n = (turn.abs() / period).floor();
+    if n < 1.0 || !turn.is_finite() {
+        return None;
+    }
+    let target = n * period;
+    // The latest sample that has turned the target by the end, walking back.
+    let k = (0..s.len())
+        .rev()
+        .find(|&k| (last.theta - s[k].theta).abs() >= target)?;
+    let (a, b) = (s[k], s[(k + 1).min(s.len() - 1)]);
+    let (da, db) = ((last.theta - a.theta).abs(), (last.theta - b.theta).abs());
+    let start = if da > db {
+        a.t + (b.t - a.t) * (da - target) / (da - db)
+    } else {
+        a.t
+    };
+    (last.t > start).then(|| turn.signum() * target / (last.t - start))
+}
+
+/// The most tail samples [`law_on_run_loads`] evaluates a law without
+/// dynamics at (quasi-statically).
+pub const LAW_RUN_SAMPLES: usize = 40;
+
+/// The law on the run's own loads over the tail of segment `seg` (its
+/// last `tail` share): the mean of the law's ω over the tail samples
+/// (`omega_law_run`, rad/s) and the RMS of the engine's ω against it
+/// (`law_run_rms`, rad/s). NaN where the engine's loads do not cover the
+/// supports or the law has no value on them.
+///
+/// A law with dynamics ([`pushval_engine::FrictionLaw::dynamics_on_loads`],
+/// Coulomb on the loads) is integrated in time: from the engine's ω at the
+/// tail's first sample, each interval between samples under the loads the
+/// engine carried over it (the recorder's interval means), so loads that
+/// change faster than the law settles act through its transient. Any other
+/// law is taken quasi-statically, at most [`LAW_RUN_SAMPLES`] samples evenly
+/// spaced: at each, the steady ω its friction rule gives with that sample's
+/// loads (an angle-dependent law's steady ω is a period mean that costs
+/// hundreds of roots).
+pub fn law_on_run_loads(
+    law: &dyn pushval_engine::FrictionLaw,
+    p: &Problem,
+    seg: usize,
+    dt: f64,
+    tail: f64,
+    run: &pushval_engine::EngineRun,
+    contact: &pushval_engine::ContactRecord,
+) -> (f64, f64) {
+    let (t0, t1) = p.segment_times()[seg];
+    let from = t1 - tail * (t1 - t0);
+    let tail: Vec<_> = run
+        .trajectory
+        .samples
+        .iter()
+        .zip(&contact.loads)
+        .filter(|(s, _)| s.t >= from - 1e-12 && s.t <= t1 + 1e-12)
+        .collect();
+    let Some(&(first, _)) = tail.first() else {
+        return (f64::NAN, f64::NAN);
+    };
+    let mut pairs = Vec::with_capacity(tail.len());
+    if law_integrates(law, p, seg, dt) {
+        // Without load the law applies no friction: ω̇ = k ω / I_P, the
+        // inertial term alone, exactly e^(k t / I_P).
+        let free = SegmentDynamics::new(&p.body, &p.pushes[seg]);
+        let rate = free.inertial_slope() / free.inertia_contact();
+        let mut w = first.omega;
+        pairs.push((first.omega, w));
+        for pair in tail.windows(2) {
+            let ((a, _), (b, loads)) = (pair[0], pair[1]);
+            let span = b.t - a.t;
+            let next = if loads.len() == p.body.len() && loads.iter().all(|&l| l == 0.0) {
+                Some(w * (rate * span).exp())
+            } else {
+                law.dynamics_on_loads(p, seg, dt, loads)
+                    .and_then(|d| d.advance(w, span))
+            };
+            let Some(next) = next else {
+                return (f64::NAN, f64::NAN);
+            };
+            w = next;
+            pairs.push((b.omega, w));
+        }
+    } else {
+        let m = tail.len().min(LAW_RUN_SAMPLES);
+        for j in 0..m {
+            let k = if m < 2 {
+                tail.len() - 1
+            } else {
+                j * (tail.len() - 1) / (m - 1)
+            };
+            let (s, loads) = tail[k];
+            let Some(w) = law.steady_on_loads(p, seg, dt, loads) else {
+                return (f64::NAN, f64::NAN);
+            };
+            pairs.push((s.omega, w.omega));
+        }
+    }
+    let n = pairs.len() as f64;
+    let mean = pairs.iter().map(|(_, w)| w).sum::<f64>() / n;
+    let rms = (pairs.iter().map(|(e, w)| (e - w).powi(2)).sum::<f64>() / n).sqrt();
+    (mean, rms)
+}
+
+/// Whether `law` has dynamics a study integrates along a run's loads
+/// ([`pushval_engine::FrictionLaw::dynamics_on_loads`] on the problem's
+/// rest loads, the statics of its weight).
+pub(crate) fn law_integrates(
+    law: &dyn pushval_engine::FrictionLaw,
+    p: &Problem,
+    seg: usize,
+    dt: f64,
+) -> bool {
+    let body = &p.body;
+    pushval_laws::mujoco::rest_loads(body, body.mass() * pushval_engine::GRAVITY)
+        .is_some_and(|rest| law.dynamics_on_loads(p, seg, dt, &rest).is_some())
+}
