@@ -11,7 +11,7 @@
 //!
 //! `cargo bench --bench control`
 
-use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
+use criterion::{criterion_group, BatchSize, BenchmarkId, Criterion};
 use pushval::control::mpc::PlantScale;
 use pushval::control::plan::{straight_time, Motion, PlanSpec, Planner, Start};
 use pushval::control::study::{goals, scene};

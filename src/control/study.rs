@@ -140,7 +140,7 @@ impl Lcg {
 /// corner push moves the plate into (bearing −30° to 120°), turned by up to
 /// ±90°, and kept when the dynamic model's plan reaches each at every speed.
 pub fn goals(problem: &Problem, speeds: &[f64], count: usize) -> Vec<Goal> {
-    let mut rng = Lcg(0x5eed_0f_c0_47_201);
+    let mut rng = Lcg(0x5_eed0_fc04_7201);
     let mut out = Vec::new();
     let start = Start::of_problem(problem);
     let reach = Reach::default();

@@ -257,8 +257,7 @@ fn plan_writes_a_scenario_every_command_takes_and_its_checks() {
     let csv = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
     let last = csv
         .lines()
-        .filter(|l| l.starts_with("rapier2d,"))
-        .last()
+        .rfind(|l| l.starts_with("rapier2d,"))
         .unwrap()
         .split(',')
         .map(|f| f.parse::<f64>().unwrap_or(f64::NAN))
