@@ -355,11 +355,12 @@ fn main() {
             let session = OutsideEngine::new(session_spec(python, extra, &log), &options);
             let warm = session.run(&problem, DT).unwrap();
             assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
-            let mut walls = Vec::with_capacity(runs);
+            let (mut walls, mut reads) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
             for _ in 0..runs {
                 let s = Instant::now();
-                std::hint::black_box(session.run(&problem, DT).unwrap());
+                let run = std::hint::black_box(session.run(&problem, DT).unwrap());
                 walls.push(s.elapsed().as_secs_f64());
+                reads.push(run.diagnostics["parse_resample_time_s"].as_f64().unwrap());
             }
             let last = session.run(&problem, DT).unwrap();
             assert_eq!(
@@ -387,7 +388,7 @@ fn main() {
                 &mut rows,
                 &format!("adapter_stepping_{kind}_{label}"),
                 median(steps.to_vec()),
-                "the adapter's own stepping in those runs (--timing: reset and the step loop)"
+                "the adapter's own stepping in those runs (--timing: reset, the switches and the step loop)"
                     .into(),
             );
             put(
@@ -395,6 +396,12 @@ fn main() {
                 &format!("overhead_{kind}_{label}"),
                 median(over),
                 "engine_run − adapter_stepping, run by run: the protocol's cost per run".into(),
+            );
+            put(
+                &mut rows,
+                &format!("pushval_read_{kind}_{label}"),
+                median(reads),
+                "pushval's own side of the answers in those runs (reading and checking the rows, resampling: the run's parse_resample_time_s)".into(),
             );
             let (med, min) = median(share);
             rows.push((
@@ -483,7 +490,7 @@ fn main() {
             &mut rows,
             &format!("adapter_stepping_mpc_{label}"),
             per(steps.to_vec()),
-            "per advance: the adapter's own stepping in those runs (--timing at finish: reset and the step loop, / the advances)".into(),
+            "per advance: the adapter's own stepping in those runs (--timing at finish: reset, the switches and the step loop, / the advances)".into(),
         );
         put(
             &mut rows,
@@ -596,7 +603,8 @@ fn main() {
             &mut rows,
             "overhead_loop_resolved",
             median(over),
-            "requests_loop − adapter_stepping, run by run: the protocol's cost in a whole loop".into(),
+            "requests_loop − adapter_stepping, run by run: the protocol's cost in a whole loop"
+                .into(),
         );
         put(
             &mut rows,

@@ -106,7 +106,8 @@ What the kit does for every problem
 
 Options every adapter built with `main` accepts: ``--session`` (above) and
 ``--timing`` (after each answer, ``step_time_s=S steps=N`` on standard error:
-the time spent in `Engine.reset` and the steps). The engine adds its own with
+the time spent in `Engine.reset`, `Engine.switch` and the steps; in protocol 3
+after ``finish``, for the whole problem). The engine adds its own with
 `Engine.add_arguments`.
 
 Standard library only; Python 3.9 or newer.
@@ -649,7 +650,7 @@ class Run:
     steps: int
     """The number of steps."""
     step_time_s: float
-    """Wall time in `Engine.reset` and the steps (s)."""
+    """Wall time in `Engine.reset`, `Engine.switch` and the steps (s)."""
     columns: tuple[str, ...] = ()
     """The engine's extra columns (`Engine.extra_columns`), after omega."""
 
@@ -1103,10 +1104,6 @@ class _Server:
     def session(self, stdin: IO[str]) -> int:
         number = 0
         self.stepper: Stepper | None = None
-        # Whether the next document is already read (pushval wrote several
-        # at once): then this answer goes out with the next one's, in one
-        # write; an answer is always flushed before the kit waits for input.
-        waiting = getattr(stdin, "pending", None)
         try:
             while True:
                 line = stdin.readline()
@@ -1116,11 +1113,10 @@ class _Server:
                     continue
                 number += 1
                 text = self.request(line, number)
+                # One write a request: the answer and its closing line.
                 self.out.write(text)
-                if waiting is None or not waiting():
-                    self.out.flush()
+                self.out.flush()
         finally:
-            self.out.flush()
             self.drop_stepper()
 
     def drop_stepper(self) -> None:
@@ -1229,44 +1225,6 @@ def serve(
     return server.session(stdin) if session else server.one_shot(stdin)
 
 
-class _Input:
-    """Standard input read from its file descriptor in large reads, line by
-    line, knowing whether a whole further line is already read
-    (`pending`)."""
-
-    def __init__(self, fd: int):
-        self.fd = fd
-        self.buf = b""
-        self.at = 0
-
-    def pending(self) -> bool:
-        return self.buf.find(b"\n", self.at) >= 0
-
-    def readline(self) -> str:
-        while True:
-            i = self.buf.find(b"\n", self.at)
-            if i >= 0:
-                line = self.buf[self.at : i + 1]
-                self.at = i + 1
-                return line.decode("utf-8")
-            chunk = os.read(self.fd, 1 << 16)
-            rest = self.buf[self.at :]
-            self.at = 0
-            if not chunk:
-                self.buf = b""
-                return rest.decode("utf-8")
-            self.buf = rest + chunk
-
-    def read(self) -> str:
-        parts = [self.buf[self.at :]]
-        self.buf, self.at = b"", 0
-        while True:
-            chunk = os.read(self.fd, 1 << 16)
-            if not chunk:
-                return b"".join(parts).decode("utf-8")
-            parts.append(chunk)
-
-
 def _protocol_stdout() -> IO[str]:
     """The real standard output for the protocol alone; file descriptor 1
     (and so anything else that prints) goes to standard error from now on."""
@@ -1304,10 +1262,7 @@ def main(engine: Callable[[argparse.Namespace], Engine], argv: Sequence[str] | N
         add(parser)
     args = parser.parse_args(argv)
     out = _protocol_stdout()
-    try:
-        stdin: Any = _Input(sys.stdin.fileno())
-    except (OSError, ValueError, AttributeError):
-        stdin = sys.stdin  # not a real file (an embedding host): keep it
+    stdin = open(sys.stdin.fileno(), encoding="utf-8", closefd=False)
     try:
         instance = engine(args)
     except AdapterError as e:
