@@ -118,10 +118,18 @@ fn session_spec(python: &str, extra: &str, log: &Path) -> Arc<Spec> {
 
 /// The stepping times (s) an adapter run with `--timing` logged, in order.
 fn step_times(log: &Path) -> Vec<f64> {
+    logged(log, "step_time_s=")
+}
+
+/// The numbers after `key` in an adapter's `--timing` lines, in order
+/// (`answer_time_s=`: the time a protocol 3 problem's requests took the
+/// kit to answer, from reading each line to the answer ready to write,
+/// the stepping included).
+fn logged(log: &Path, key: &str) -> Vec<f64> {
     std::fs::read_to_string(log)
         .unwrap_or_default()
         .split_whitespace()
-        .filter_map(|w| w.strip_prefix("step_time_s=").and_then(|n| n.parse().ok()))
+        .filter_map(|w| w.strip_prefix(key).and_then(|n| n.parse().ok()))
         .collect()
 }
 
@@ -371,6 +379,14 @@ fn main() {
             let steps = step_times(&log);
             assert_eq!(steps.len(), runs + 2, "a stepping time per run: {steps:?}");
             let steps = &steps[1..=runs];
+            let answers = logged(&log, "answer_time_s=");
+            let kit: Option<Vec<f64>> = (answers.len() == runs + 2).then(|| {
+                answers[1..=runs]
+                    .iter()
+                    .zip(steps)
+                    .map(|(a, s)| a - s)
+                    .collect()
+            });
             let over: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| w - s).collect();
             let share: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| (w - s) / w).collect();
             let about = format!(
@@ -394,15 +410,30 @@ fn main() {
             put(
                 &mut rows,
                 &format!("overhead_{kind}_{label}"),
-                median(over),
+                median(over.clone()),
                 "engine_run − adapter_stepping, run by run: the protocol's cost per run".into(),
             );
             put(
                 &mut rows,
                 &format!("pushval_read_{kind}_{label}"),
-                median(reads),
+                median(reads.clone()),
                 "pushval's own side of the answers in those runs (reading and checking the rows, resampling: the run's parse_resample_time_s)".into(),
             );
+            if let Some(kit) = kit {
+                let handoff: Vec<f64> = (0..runs).map(|i| over[i] - kit[i] - reads[i]).collect();
+                put(
+                    &mut rows,
+                    &format!("kit_{kind}_{label}"),
+                    median(kit),
+                    "the adapter kit's own work in those runs (--timing: answer_time_s − step_time_s, run by run: parsing the documents, taking and encoding the rows)".into(),
+                );
+                put(
+                    &mut rows,
+                    &format!("handoff_{kind}_{label}"),
+                    median(handoff),
+                    "overhead − kit − pushval_read, run by run: writing and reading the pipes, and the waits for a core at each handoff between pushval and the adapter".into(),
+                );
+            }
             let (med, min) = median(share);
             rows.push((
                 format!("overhead_share_{kind}_{label}"),
@@ -425,11 +456,13 @@ fn main() {
         .iter()
         .flat_map(|p| {
             let n = (p.duration / PERIOD).round().max(1.0) as usize;
-            std::iter::repeat(Push {
-                duration: p.duration / n as f64,
-                ..*p
-            })
-            .take(n)
+            std::iter::repeat_n(
+                Push {
+                    duration: p.duration / n as f64,
+                    ..*p
+                },
+                n,
+            )
         })
         .collect();
     for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
@@ -467,6 +500,17 @@ fn main() {
         let steps = step_times(&log);
         assert_eq!(steps.len(), runs + 2, "a stepping time per run: {steps:?}");
         let steps = &steps[1..=runs];
+        let answers = logged(&log, "answer_time_s=");
+        assert_eq!(
+            answers.len(),
+            runs + 2,
+            "an answering time per run: {answers:?}"
+        );
+        let kit: Vec<f64> = answers[1..=runs]
+            .iter()
+            .zip(steps)
+            .map(|(a, s)| a - s)
+            .collect();
         let k = periods.len() as f64;
         let per = |v: Vec<f64>| {
             let (med, min) = median(v);
@@ -474,6 +518,7 @@ fn main() {
         };
         let over: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| w - s).collect();
         let share: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| (w - s) / w).collect();
+        let handoff: Vec<f64> = (0..runs).map(|i| over[i] - kit[i] - reads[i]).collect();
         put(
             &mut rows,
             &format!("engine_run_mpc_{label}"),
@@ -497,6 +542,18 @@ fn main() {
             &format!("overhead_mpc_{label}"),
             per(over),
             "per advance: engine_run − adapter_stepping, run by run: the protocol's cost of one control period".into(),
+        );
+        put(
+            &mut rows,
+            &format!("kit_mpc_{label}"),
+            per(kit),
+            "per advance: the adapter kit's own work in those runs (--timing: answer_time_s − step_time_s, / the advances: parsing the request, cutting the push into steps, taking and encoding the rows)".into(),
+        );
+        put(
+            &mut rows,
+            &format!("handoff_mpc_{label}"),
+            per(handoff),
+            "per advance: overhead − kit − pushval_read, run by run: writing and reading the pipes, and the two waits for a core at each round trip between pushval and the adapter".into(),
         );
         put(
             &mut rows,

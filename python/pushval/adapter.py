@@ -107,7 +107,9 @@ What the kit does for every problem
 Options every adapter built with `main` accepts: ``--session`` (above) and
 ``--timing`` (after each answer, ``step_time_s=S steps=N`` on standard error:
 the time spent in `Engine.reset`, `Engine.switch` and the steps; in protocol 3
-after ``finish``, for the whole problem). The engine adds its own with
+after ``finish``, for the whole problem, with ``answer_time_s=A``: the time
+spent answering its requests, from reading each line to the answer ready to
+write, the steps included). The engine adds its own with
 `Engine.add_arguments`.
 
 Standard library only; Python 3.9 or newer.
@@ -1049,6 +1051,10 @@ class _Server:
         self.out = out
         self.err = err
         self.timing = timing
+        #: Wall time answering the current protocol 3 problem's requests
+        #: (from reading each line to its answer ready to write), for
+        #: --timing.
+        self.answer_time_s = 0.0
         self.name = _engine_name(engine)
 
     def say(self, text: str) -> None:
@@ -1112,7 +1118,9 @@ class _Server:
                 if not line.strip():
                     continue
                 number += 1
+                started = time.perf_counter()
                 text = self.request(line, number)
+                self.answer_time_s += time.perf_counter() - started
                 # One write a request: the answer and its closing line.
                 self.out.write(text)
                 self.out.flush()
@@ -1176,6 +1184,7 @@ class _Server:
         r = _Reader(doc, "")
         if op == "start":
             self.drop_stepper()
+            self.answer_time_s = 0.0
             rows = r.string("rows") if r.has("rows") else "steps"
             if rows not in ("steps", "samples"):
                 raise ProblemError(f"`rows` is {rows!r}; known: steps, samples")
@@ -1191,7 +1200,10 @@ class _Server:
         if op == "finish":
             self.drop_stepper()
             if self.timing:
-                self.err.write(f"step_time_s={stepper.step_time_s!r} steps={stepper.steps}\n")
+                self.err.write(
+                    f"step_time_s={stepper.step_time_s!r} steps={stepper.steps} "
+                    f"answer_time_s={self.answer_time_s!r}\n"
+                )
                 self.err.flush()
             return f"#end{tag}\n"
         rows = stepper.advance(
