@@ -54,7 +54,7 @@ use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 use pushval_engine::{trajectory_from_steps, Engine, EngineOptions};
-use pushval_model::Problem;
+use pushval_model::{Problem, Push};
 use pushval_outside::{
     csv, history_from_rows, problem_document, run_process, shutdown_sessions, Config, Limits,
     OutsideEngine, Spec,
@@ -62,6 +62,12 @@ use pushval_outside::{
 use pushval_scenario::Scenario;
 
 const DT: f64 = 1e-3;
+/// The control period of `pushval loop` (its default).
+const PERIOD: f64 = 0.02;
+/// The scenario every measurement runs.
+const SCENARIO: &str = "scenarios/paper-square-v1.0.toml";
+/// The goal of the whole-loop measurement (x m, y m, theta rad).
+const GOAL: &str = "0.8,0.2,-0.5";
 const TIMEOUT: Duration = Duration::from_secs(300);
 
 fn root() -> PathBuf {
@@ -112,10 +118,18 @@ fn session_spec(python: &str, extra: &str, log: &Path) -> Arc<Spec> {
 
 /// The stepping times (s) an adapter run with `--timing` logged, in order.
 fn step_times(log: &Path) -> Vec<f64> {
+    logged(log, "step_time_s=")
+}
+
+/// The numbers after `key` in an adapter's `--timing` lines, in order
+/// (`answer_time_s=`: the time a protocol 3 problem's requests took the
+/// kit to answer, from reading each line to the answer ready to write,
+/// the stepping included).
+fn logged(log: &Path, key: &str) -> Vec<f64> {
     std::fs::read_to_string(log)
         .unwrap_or_default()
         .split_whitespace()
-        .filter_map(|w| w.strip_prefix("step_time_s=").and_then(|n| n.parse().ok()))
+        .filter_map(|w| w.strip_prefix(key).and_then(|n| n.parse().ok()))
         .collect()
 }
 
@@ -187,7 +201,7 @@ fn put(rows: &mut Vec<Row>, name: &str, (med, min): (f64, f64), note: String) {
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let runs = if quick { 3 } else { 11 };
-    let sc = Scenario::from_path(root().join("scenarios/paper-square-v1.0.toml")).unwrap();
+    let sc = Scenario::from_path(root().join(SCENARIO)).unwrap();
     let problem: Problem = sc.problem();
     let options: EngineOptions = pushval::registry::engine_options(&sc);
     let py = resolved_python();
@@ -349,11 +363,12 @@ fn main() {
             let session = OutsideEngine::new(session_spec(python, extra, &log), &options);
             let warm = session.run(&problem, DT).unwrap();
             assert_eq!(warm.diagnostics["session"]["answered_before"], 0);
-            let mut walls = Vec::with_capacity(runs);
+            let (mut walls, mut reads) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
             for _ in 0..runs {
                 let s = Instant::now();
-                std::hint::black_box(session.run(&problem, DT).unwrap());
+                let run = std::hint::black_box(session.run(&problem, DT).unwrap());
                 walls.push(s.elapsed().as_secs_f64());
+                reads.push(run.diagnostics["parse_resample_time_s"].as_f64().unwrap());
             }
             let last = session.run(&problem, DT).unwrap();
             assert_eq!(
@@ -364,6 +379,14 @@ fn main() {
             let steps = step_times(&log);
             assert_eq!(steps.len(), runs + 2, "a stepping time per run: {steps:?}");
             let steps = &steps[1..=runs];
+            let answers = logged(&log, "answer_time_s=");
+            let kit: Option<Vec<f64>> = (answers.len() == runs + 2).then(|| {
+                answers[1..=runs]
+                    .iter()
+                    .zip(steps)
+                    .map(|(a, s)| a - s)
+                    .collect()
+            });
             let over: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| w - s).collect();
             let share: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| (w - s) / w).collect();
             let about = format!(
@@ -381,15 +404,36 @@ fn main() {
                 &mut rows,
                 &format!("adapter_stepping_{kind}_{label}"),
                 median(steps.to_vec()),
-                "the adapter's own stepping in those runs (--timing: reset and the step loop)"
+                "the adapter's own stepping in those runs (--timing: reset, the switches and the step loop)"
                     .into(),
             );
             put(
                 &mut rows,
                 &format!("overhead_{kind}_{label}"),
-                median(over),
+                median(over.clone()),
                 "engine_run − adapter_stepping, run by run: the protocol's cost per run".into(),
             );
+            put(
+                &mut rows,
+                &format!("pushval_read_{kind}_{label}"),
+                median(reads.clone()),
+                "pushval's own side of the answers in those runs (reading and checking the rows, resampling: the run's parse_resample_time_s)".into(),
+            );
+            if let Some(kit) = kit {
+                let handoff: Vec<f64> = (0..runs).map(|i| over[i] - kit[i] - reads[i]).collect();
+                put(
+                    &mut rows,
+                    &format!("kit_{kind}_{label}"),
+                    median(kit),
+                    "the adapter kit's own work in those runs (--timing: answer_time_s − step_time_s, run by run: parsing the documents, taking and encoding the rows)".into(),
+                );
+                put(
+                    &mut rows,
+                    &format!("handoff_{kind}_{label}"),
+                    median(handoff),
+                    "overhead − kit − pushval_read, run by run: writing and reading the pipes, and the waits for a core at each handoff between pushval and the adapter".into(),
+                );
+            }
             let (med, min) = median(share);
             rows.push((
                 format!("overhead_share_{kind}_{label}"),
@@ -400,6 +444,241 @@ fn main() {
             ));
         }
     }
+    // The MPC case: the caller owns the loop and steps one control period at
+    // a time (`pushval loop`: one protocol 3 `advance` a period, each
+    // answer awaited before the next request). The 10 s paper push cut
+    // into 500 periods of 0.02 s (20 steps each), through start, advance
+    // and finish directly; per run the adapter reports its stepping at
+    // `finish` (--timing), so the rows are per advance: a run's wall time
+    // and stepping divided by its 500 advances.
+    let periods: Vec<Push> = problem
+        .pushes
+        .iter()
+        .flat_map(|p| {
+            let n = (p.duration / PERIOD).round().max(1.0) as usize;
+            std::iter::repeat_n(
+                Push {
+                    duration: p.duration / n as f64,
+                    ..*p
+                },
+                n,
+            )
+        })
+        .collect();
+    for (label, python) in [("resolved", py.as_str()), ("python3_on_path", "python3")] {
+        let log = logs.path().join(format!("mpc_{label}"));
+        let session = OutsideEngine::new(session_spec(python, "", &log), &options);
+        let warm = session.run(&problem, DT).unwrap();
+        let stepped = |s: &OutsideEngine| {
+            let e: &dyn Engine = s;
+            let mut sess = e.start(&problem, DT).unwrap();
+            for p in &periods {
+                sess.advance(p).unwrap();
+            }
+            sess.finish().unwrap()
+        };
+        let (mut walls, mut reads) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
+        for _ in 0..runs {
+            let s = Instant::now();
+            let run = std::hint::black_box(stepped(&session));
+            walls.push(s.elapsed().as_secs_f64());
+            reads.push(run.diagnostics["parse_resample_time_s"].as_f64().unwrap());
+        }
+        let last = stepped(&session);
+        assert_eq!(
+            last.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
+            "one process served every run"
+        );
+        assert_eq!(
+            last.diagnostics["session"]["requests"]
+                .as_array()
+                .map(Vec::len),
+            Some(periods.len() + 2),
+            "a request per period, a start and a finish"
+        );
+        shutdown_sessions();
+        let steps = step_times(&log);
+        assert_eq!(steps.len(), runs + 2, "a stepping time per run: {steps:?}");
+        let steps = &steps[1..=runs];
+        let answers = logged(&log, "answer_time_s=");
+        assert_eq!(
+            answers.len(),
+            runs + 2,
+            "an answering time per run: {answers:?}"
+        );
+        let kit: Vec<f64> = answers[1..=runs]
+            .iter()
+            .zip(steps)
+            .map(|(a, s)| a - s)
+            .collect();
+        let k = periods.len() as f64;
+        let per = |v: Vec<f64>| {
+            let (med, min) = median(v);
+            (med / k, min / k)
+        };
+        let over: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| w - s).collect();
+        let share: Vec<f64> = walls.iter().zip(steps).map(|(w, s)| (w - s) / w).collect();
+        let handoff: Vec<f64> = (0..runs).map(|i| over[i] - kit[i] - reads[i]).collect();
+        put(
+            &mut rows,
+            &format!("engine_run_mpc_{label}"),
+            per(walls.clone()),
+            format!(
+                "per advance: pure_python.py as a session (protocol 3, rows at the sample times), {}; the 10 s paper push as {} advances of {PERIOD} s ({} steps each), start/advance/finish one request at a time, each answer awaited; {runs} runs (a run's wall time / {})",
+                interpreter(label),
+                periods.len(),
+                (PERIOD / DT).round(),
+                periods.len()
+            ),
+        );
+        put(
+            &mut rows,
+            &format!("adapter_stepping_mpc_{label}"),
+            per(steps.to_vec()),
+            "per advance: the adapter's own stepping in those runs (--timing at finish: reset, the switches and the step loop, / the advances)".into(),
+        );
+        put(
+            &mut rows,
+            &format!("overhead_mpc_{label}"),
+            per(over),
+            "per advance: engine_run − adapter_stepping, run by run: the protocol's cost of one control period".into(),
+        );
+        put(
+            &mut rows,
+            &format!("kit_mpc_{label}"),
+            per(kit),
+            "per advance: the adapter kit's own work in those runs (--timing: answer_time_s − step_time_s, / the advances: parsing the request, cutting the push into steps, taking and encoding the rows)".into(),
+        );
+        put(
+            &mut rows,
+            &format!("handoff_mpc_{label}"),
+            per(handoff),
+            "per advance: overhead − kit − pushval_read, run by run: writing and reading the pipes, and the two waits for a core at each round trip between pushval and the adapter".into(),
+        );
+        put(
+            &mut rows,
+            &format!("pushval_read_mpc_{label}"),
+            per(reads),
+            "per advance: pushval's own side of the answers in those runs (reading and checking each answer's rows, and the resampling at finish: the run's parse_resample_time_s / the advances)".into(),
+        );
+        let (med, min) = median(share);
+        rows.push((
+            format!("overhead_share_mpc_{label}"),
+            med,
+            min,
+            "fraction",
+            "overhead / engine_run, run by run (median, min)".into(),
+        ));
+    }
+
+    // A whole `pushval loop` (model-predictive control, src/control/mpc.rs)
+    // in process, on a warm session: the goal (0.8 m, 0.2 m, -0.5 rad) at
+    // 1 m/s from the paper square at rest. Its wall time holds the plan
+    // from rest, the re-plans (the predictor), the adapter's stepping and
+    // the protocol: the session's requests as pushval sees them (from
+    // writing each document to its closing line, and reading the answers)
+    // less the adapter's stepping in them.
+    {
+        use pushval::control::mpc::{plan_from_rest, run_loop, LoopSpec, PlantScale};
+        use pushval::control::plan::PlanSpec;
+        use pushval::control::{Goal, Predictor, Reach};
+        let text = std::fs::read_to_string(root().join(SCENARIO)).unwrap();
+        let loop_problem = pushval::control::cli::problem_from_rest(&sc, &text);
+        let goal = Goal::parse(GOAL).unwrap();
+        let spec = LoopSpec {
+            plan: PlanSpec {
+                segments: 6,
+                speed: 1.0,
+                predictor: Predictor::Dynamic,
+            },
+            period: PERIOD,
+            plant: PlantScale::default(),
+            reach: Reach::default(),
+        };
+        let plan_time = time(runs, || {
+            plan_from_rest(&loop_problem, goal, spec.plan, spec.reach).is_some()
+        });
+        let log = logs.path().join("loop");
+        let session = OutsideEngine::new(session_spec(&py, "", &log), &options);
+        let warm = session.run(&problem, DT).unwrap();
+        let (mut walls, mut planning, mut requests) = (Vec::new(), Vec::new(), Vec::new());
+        let mut periods_run = 0;
+        for _ in 0..runs {
+            let s = Instant::now();
+            let out = run_loop(&loop_problem, &session, DT, goal, spec).unwrap();
+            walls.push(s.elapsed().as_secs_f64());
+            assert!(out.success, "the loop reaches its goal");
+            assert!(!out.replayed, "the session steps");
+            assert_eq!(
+                out.run.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
+                "one process served every run"
+            );
+            planning.push(plan_time.0 + out.predictor_us.iter().sum::<f64>() * 1e-6);
+            let d = &out.run.diagnostics;
+            requests.push(
+                d["process_wall_time_s"].as_f64().unwrap()
+                    + d["parse_resample_time_s"].as_f64().unwrap(),
+            );
+            periods_run = out.steps;
+        }
+        shutdown_sessions();
+        let steps = step_times(&log);
+        assert_eq!(steps.len(), runs + 1, "a stepping time per run: {steps:?}");
+        let steps = &steps[1..];
+        let over: Vec<f64> = (0..runs).map(|i| requests[i] - steps[i]).collect();
+        let rest: Vec<f64> = (0..runs)
+            .map(|i| walls[i] - requests[i] - planning[i])
+            .collect();
+        let share: Vec<f64> = (0..runs).map(|i| over[i] / walls[i]).collect();
+        put(
+            &mut rows,
+            "loop_run_resolved",
+            median(walls.clone()),
+            format!(
+                "pushval's MPC loop (control::mpc::run_loop, as `pushval loop {SCENARIO} --goal {GOAL} --speed 1.0 --engine pure_python` runs it) in process on a warm session of pure_python.py (the resolved interpreter): {periods_run} periods of {PERIOD} s and the rest of the plan; {runs} runs"
+            ),
+        );
+        put(
+            &mut rows,
+            "adapter_stepping_loop_resolved",
+            median(steps.to_vec()),
+            "the adapter's own stepping in those runs (--timing at finish)".into(),
+        );
+        put(
+            &mut rows,
+            "planning_loop_resolved",
+            median(planning),
+            "the plan from rest (timed alone, median) + the loop's re-plans (its predictor_us, summed), run by run".into(),
+        );
+        put(
+            &mut rows,
+            "requests_loop_resolved",
+            median(requests.clone()),
+            "the session's requests in those runs as pushval sees them: from writing each document to its closing line (process_wall_time_s), and reading the answers with the resampling at finish (parse_resample_time_s)".into(),
+        );
+        put(
+            &mut rows,
+            "overhead_loop_resolved",
+            median(over),
+            "requests_loop − adapter_stepping, run by run: the protocol's cost in a whole loop"
+                .into(),
+        );
+        put(
+            &mut rows,
+            "rest_loop_resolved",
+            median(rest),
+            "loop_run − requests_loop − planning, run by run: the loop's own bookkeeping and what the planning estimate misses".into(),
+        );
+        let (med, min) = median(share);
+        rows.push((
+            "overhead_share_loop_resolved".into(),
+            med,
+            min,
+            "fraction",
+            "overhead_loop / loop_run, run by run (median, min)".into(),
+        ));
+    }
+
     // The adapter's own input and output (imports, json.load, writing the
     // rows), by difference.
     let med = |name: &str| {
@@ -464,8 +743,32 @@ fn main() {
                 std::thread::available_parallelism().map_or(1, |n| n.get())
             ),
         );
+        // `pushval loop` as a user runs it: the whole process, the engine
+        // declared in the repository's pushval.toml (python3 from PATH), the
+        // interpreter's start included.
+        let out = tempfile::tempdir().expect("a temporary folder");
+        let mut runs_ok = true;
+        let wall = time(if quick { 2 } else { 5 }, || {
+            let st = Command::new(&bin)
+                .current_dir(root())
+                .args(["loop", SCENARIO, "--goal", GOAL, "--speed", "1.0"])
+                .args(["--engine", "pure_python", "--out"])
+                .arg(out.path())
+                .output()
+                .expect("the pushval binary runs");
+            runs_ok &= st.status.success();
+        });
+        assert!(runs_ok, "pushval loop failed while timed");
+        put(
+            &mut rows,
+            "loop_cli_wall",
+            wall,
+            format!(
+                "target/release/pushval loop {SCENARIO} --goal {GOAL} --speed 1.0 --engine pure_python (pushval.toml: python3 from PATH, a session), whole process: the interpreter's start, the plan, the loop, the outputs"
+            ),
+        );
     } else {
-        eprintln!("outside_overhead: no target/release/pushval; main_job_wall not measured (cargo build --release first)");
+        eprintln!("outside_overhead: no target/release/pushval; main_job_wall and loop_cli_wall not measured (cargo build --release first)");
     }
 
     // How busy the machine was: the protocol's share grows with the wait

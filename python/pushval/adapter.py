@@ -106,7 +106,10 @@ What the kit does for every problem
 
 Options every adapter built with `main` accepts: ``--session`` (above) and
 ``--timing`` (after each answer, ``step_time_s=S steps=N`` on standard error:
-the time spent in `Engine.reset` and the steps). The engine adds its own with
+the time spent in `Engine.reset`, `Engine.switch` and the steps; in protocol 3
+after ``finish``, for the whole problem, with ``answer_time_s=A``: the time
+spent answering its requests, from reading each line to the answer ready to
+write, the steps included). The engine adds its own with
 `Engine.add_arguments`.
 
 Standard library only; Python 3.9 or newer.
@@ -121,6 +124,7 @@ import dataclasses
 import itertools
 import json
 import math
+import operator
 import os
 import sys
 import time
@@ -160,6 +164,8 @@ SWITCHING_RULES = ("impulsive", "continuous")
 
 #: Seconds of stepping before the first progress line, and between lines.
 PROGRESS_EVERY_S = 5.0
+
+_INF = math.inf
 
 
 class ProblemError(ValueError):
@@ -646,7 +652,7 @@ class Run:
     steps: int
     """The number of steps."""
     step_time_s: float
-    """Wall time in `Engine.reset` and the steps (s)."""
+    """Wall time in `Engine.reset`, `Engine.switch` and the steps (s)."""
     columns: tuple[str, ...] = ()
     """The engine's extra columns (`Engine.extra_columns`), after omega."""
 
@@ -689,6 +695,21 @@ def _extras(value: Any, columns: Sequence[str], t: float) -> tuple[float, ...]:
         if not math.isfinite(v):
             raise AdapterError(f"the engine's {name} at t = {t!r} s is not finite: {v!r}")
     return vals
+
+
+#: The pose and ω of a row (columns 1 to 4).
+_POSE = operator.itemgetter(1, 2, 3, 4)
+
+
+def _fine(rows: Sequence[tuple[Any, ...]]) -> bool:
+    """Whether columns 1 to 4 (x, y, theta, omega) of every row are finite
+    floats: passes in C over the rows, no Python loop (a sum that overflows
+    says no, and the caller's exact check row by row decides)."""
+    try:
+        flat = list(itertools.chain.from_iterable(map(_POSE, rows)))
+        return set(map(type, flat)) == {float} and math.isfinite(sum(flat))
+    except (TypeError, IndexError):
+        return False
 
 
 class Stepper:
@@ -766,7 +787,10 @@ class Stepper:
         if not self.applied:
             out += self._reset(push)
         else:
+            # The switch is the engine's own work: timed as its steps are.
+            started = time.perf_counter()
             self.engine.switch(self.applied[-1], push)
+            self.step_time_s += time.perf_counter() - started
         out += self._segment(push, progress, total)
         self.applied.append(push)
         # Summed in order, as pushval sums it.
@@ -778,6 +802,8 @@ class Stepper:
         object frame, duration s) starting where the pushes applied end;
         the first call applies the start's own schedule first. Returns the
         rows (see `apply`)."""
+        if not self.pending:
+            return self.apply(Push(len(self.applied), self.end, duration, speed, phi))
         todo = [(p.speed, p.phi, p.duration) for p in self.pending] + [(speed, phi, duration)]
         self.pending = []
         out: list[tuple[float, ...]] = []
@@ -812,10 +838,17 @@ class Stepper:
         t_end = t0 + push.duration
         if self.mode == "steps":
             times = [t0 + j * h for j in range(1, n)] + [t_end]
-            rows = [
-                (t, *_state(s, t), *(_extras(e, columns, t) if columns else ()))
-                for t, s, e in zip(times, states, more if columns else itertools.repeat(()))
-            ]
+            if columns:
+                rows = [(t, *s, *_extras(e, columns, t)) for t, s, e in zip(times, states, more)]
+            else:
+                rows = [(t, *s) for t, s in zip(times, states)]
+            if not (_fine(rows) and set(map(len, rows)) == {5 + len(columns)}):
+                # Not four finite floats somewhere: checked row by row (the
+                # first bad one named), numbers made floats.
+                rows = [
+                    (t, *_state(s, t), *(_extras(e, columns, t) if columns else ()))
+                    for t, s, e in zip(times, states, more if columns else itertools.repeat(()))
+                ]
         else:
             rows = self._samples(push, states, more, n, h, t_end)
         self.last = rows[-1]
@@ -835,7 +868,8 @@ class Stepper:
         prev = self.last
         assert prev is not None
         x0, y0, th0 = prev[1], prev[2], prev[3]
-        rows = []
+        rows: list[tuple[Any, ...]] = []
+        append = rows.append
         t_prev = t0 if prev[0] < t0 else prev[0]
         columns = self.columns
         j_prev = 0
@@ -856,19 +890,21 @@ class Stepper:
                 s = u - (j - 1)
                 x, y, th = a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])
             # ω held over (t_prev, t], read at its middle.
-            i = min(n, max(1, ceil(((t_prev + t) / 2 - t0) / h)))
-            row = (t, x, y, th, states[i - 1][3])
+            i = ceil(((t_prev + t) / 2 - t0) / h)
+            if i > n:
+                i = n
+            elif i < 1:
+                i = 1
+            # The last number: the engine steps the row's interval took
+            # (pushval's count).
             if columns:
-                row += _extras(more[i - 1], columns, t)
-            # The engine steps the row's interval took (pushval's count).
-            rows.append(row + (j - j_prev,))
+                append((t, x, y, th, states[i - 1][3], *_extras(more[i - 1], columns, t), j - j_prev))
+            else:
+                append((t, x, y, th, states[i - 1][3], j - j_prev))
             t_prev, j_prev = t, j
-        # Four finite floats each (checked at once; the first bad row named).
-        try:
-            fine = all(map(math.isfinite, itertools.chain.from_iterable(r[1:5] for r in rows)))
-        except TypeError:
-            fine = False
-        if not fine or any(type(v) is not float for r in rows for v in r[1:5]):
+        # Four finite floats each (checked at once; else row by row, the
+        # first bad row named).
+        if not _fine(rows):
             rows = [(r[0], *_state(r[1:5], r[0]), *r[5:]) for r in rows]
         return rows
 
@@ -1015,6 +1051,10 @@ class _Server:
         self.out = out
         self.err = err
         self.timing = timing
+        #: Wall time answering the current protocol 3 problem's requests
+        #: (from reading each line to its answer ready to write), for
+        #: --timing.
+        self.answer_time_s = 0.0
         self.name = _engine_name(engine)
 
     def say(self, text: str) -> None:
@@ -1078,7 +1118,10 @@ class _Server:
                 if not line.strip():
                     continue
                 number += 1
+                started = time.perf_counter()
                 text = self.request(line, number)
+                self.answer_time_s += time.perf_counter() - started
+                # One write a request: the answer and its closing line.
                 self.out.write(text)
                 self.out.flush()
         finally:
@@ -1124,9 +1167,24 @@ class _Server:
 
     def step(self, doc: dict[str, Any], op: Any, tag: str) -> str:
         """Protocol 3: ``start``, ``advance`` or ``finish``."""
+        if op == "advance" and self.stepper is not None:
+            # The usual advance (three finite floats, as pushval writes
+            # them) without the reader's checks; anything else takes the
+            # checked path below, whose errors name the key.
+            speed, phi, duration = doc.get("speed"), doc.get("phi"), doc.get("duration")
+            if (
+                type(speed) is float
+                and type(phi) is float
+                and type(duration) is float
+                and 0.0 <= speed < _INF
+                and -_INF < phi < _INF
+                and 0.0 < duration < _INF
+            ):
+                return self.rows(self.stepper, self.stepper.advance(speed, phi, duration), tag)
         r = _Reader(doc, "")
         if op == "start":
             self.drop_stepper()
+            self.answer_time_s = 0.0
             rows = r.string("rows") if r.has("rows") else "steps"
             if rows not in ("steps", "samples"):
                 raise ProblemError(f"`rows` is {rows!r}; known: steps, samples")
@@ -1142,12 +1200,20 @@ class _Server:
         if op == "finish":
             self.drop_stepper()
             if self.timing:
-                self.err.write(f"step_time_s={stepper.step_time_s!r} steps={stepper.steps}\n")
+                self.err.write(
+                    f"step_time_s={stepper.step_time_s!r} steps={stepper.steps} "
+                    f"answer_time_s={self.answer_time_s!r}\n"
+                )
                 self.err.flush()
             return f"#end{tag}\n"
         rows = stepper.advance(
             r.number("speed", 0.0), r.number("phi"), r.number("duration", 0.0, strict=True)
         )
+        return self.rows(stepper, rows, tag)
+
+    def rows(self, stepper: Stepper, rows: Sequence[tuple[float, ...]], tag: str) -> str:
+        """An advance's answer: the header (after ``start``, once), the
+        rows (one compact line, or text) and ``#end N``."""
         head = ""
         if not stepper.header_sent:
             stepper.header_sent = True

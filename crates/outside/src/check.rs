@@ -32,6 +32,10 @@ pub(crate) struct Bound {
     reach: f64,
     /// The fastest turn (rad/s).
     omega: f64,
+    /// |ω₀| (rad/s): 0 from rest.
+    omega0: f64,
+    /// The radius of gyration √(I_cm / m) (m).
+    gyration: f64,
 }
 
 impl Bound {
@@ -57,28 +61,50 @@ impl Bound {
             speed,
             reach,
             omega: omega0 + speed / gyration,
+            omega0,
+            gyration,
         }
+    }
+
+    /// The bound once `speed` (m/s) is pushed too: as [`Bound::of`] the
+    /// problem with that push added to its schedule.
+    pub(crate) fn widen(&mut self, speed: f64) {
+        self.speed = self.speed.max(speed.abs());
+        self.omega = self.omega0 + self.speed / self.gyration;
     }
 
     /// Whether the step from row `a` to row `b` is within the bound; else
     /// the sentence saying which jump is not (naming `b`'s line as `where_`
     /// tells).
-    pub(crate) fn step(&self, a: &Record, b: &Record, where_: &str) -> Result<(), String> {
+    pub(crate) fn step(
+        &self,
+        a: &Record,
+        b: &Record,
+        where_: impl Fn() -> String,
+    ) -> Result<(), String> {
         let dt = b.numbers[0] - a.numbers[0];
         let moved = (b.numbers[1] - a.numbers[1]).hypot(b.numbers[2] - a.numbers[2]);
         let allowed = MARGIN * (self.speed + self.omega * self.reach) * dt + SLACK * self.reach;
         if !(moved <= allowed) {
             return Err(format!(
-                "{where_}: the centre of mass jumps {moved:.6e} m from the row before ({} s to {} s), more than the push allows ({allowed:.3e} m: {MARGIN} × (push speed {} m/s + {:.4} rad/s × reach {:.4} m) × {dt:.3e} s, + {SLACK} × reach)",
-                a.numbers[0], b.numbers[0], self.speed, self.omega, self.reach
+                "{}: the centre of mass jumps {moved:.6e} m from the row before ({} s to {} s), more than the push allows ({allowed:.3e} m: {MARGIN} × (push speed {} m/s + {:.4} rad/s × reach {:.4} m) × {dt:.3e} s, + {SLACK} × reach)",
+                where_(),
+                a.numbers[0],
+                b.numbers[0],
+                self.speed,
+                self.omega,
+                self.reach
             ));
         }
         let turned = (b.numbers[3] - a.numbers[3]).abs();
         let allowed = MARGIN * self.omega * dt + SLACK;
         if !(turned <= allowed) {
             return Err(format!(
-                "{where_}: theta jumps {turned:.6e} rad from the row before ({} s to {} s), more than the push allows ({allowed:.3e} rad: {MARGIN} × {:.4} rad/s × {dt:.3e} s, + {SLACK} rad; theta must be unwrapped)",
-                a.numbers[0], b.numbers[0], self.omega
+                "{}: theta jumps {turned:.6e} rad from the row before ({} s to {} s), more than the push allows ({allowed:.3e} rad: {MARGIN} × {:.4} rad/s × {dt:.3e} s, + {SLACK} rad; theta must be unwrapped)",
+                where_(),
+                a.numbers[0],
+                b.numbers[0],
+                self.omega
             ));
         }
         Ok(())
@@ -105,7 +131,7 @@ pub(crate) fn rows(
                     a.numbers[0]
                 ));
             }
-            bound.step(a, r, &line(r))?;
+            bound.step(a, r, || line(r))?;
         }
         prev = Some(r);
     }

@@ -155,7 +155,8 @@ impl Engine for OutsideEngine {
                 "answered_before": a.answered_before,
                 "request": a.request,
             });
-            (a.stdout, a.stderr, a.elapsed, None, Some(about))
+            let stderr = a.stderr();
+            (a.stdout, stderr, a.elapsed, None, Some(about))
         } else {
             let input = serde_json::to_vec(&doc).expect("a JSON value serialises");
             let out = run_process(
@@ -277,6 +278,13 @@ struct Stepping<'a> {
     applied: Vec<Push>,
     /// The header line, once the first advance has given it.
     header: Option<String>,
+    /// Where compact rows put their numbers (from `header`), once read.
+    columns: Option<csv::Columns>,
+    /// The end of the pushes applied (s), summed in order as
+    /// [`Problem::segment_times`] sums it.
+    end: f64,
+    /// The largest motion between two rows the pushes applied allow.
+    bound: Bound,
     rows: Vec<csv::Record>,
     state: EngineState,
     started: Instant,
@@ -326,13 +334,12 @@ impl<'a> Stepping<'a> {
         dt: f64,
         push: &Push,
     ) -> (serde_json::Map<String, serde_json::Value>, Limits) {
-        let one = with_pushes(problem, vec![*push]);
         let mut request = serde_json::Map::new();
         request.insert("op".into(), "advance".into());
         request.insert("speed".into(), push.speed.into());
         request.insert("phi".into(), push.phi.into());
         request.insert("duration".into(), push.duration.into());
-        (request, Limits::for_problem(&one, dt))
+        (request, Limits::for_push(problem, push.duration, dt))
     }
 
     fn finish_doc() -> serde_json::Map<String, serde_json::Value> {
@@ -376,6 +383,9 @@ impl<'a> Stepping<'a> {
             lease,
             applied: Vec::new(),
             header: None,
+            columns: None,
+            end: 0.0,
+            bound: Bound::of(&with_pushes(problem, Vec::new())),
             rows: Vec::new(),
             state: EngineState::initial(problem),
             started,
@@ -431,21 +441,21 @@ impl<'a> Stepping<'a> {
     /// The rows of one advance's answer (`text`: the header first in the
     /// first answer), checked against the rows before.
     fn read(&mut self, text: &str, request: u64, push: &Push) -> Result<(), String> {
-        let problem = with_pushes(&self.problem, self.applied.clone());
+        let supports = self.problem.body.len();
         let first = self.header.is_none();
         if text
             .lines()
             .any(|l| l.trim_start().starts_with(csv::COMPACT))
         {
-            return self.read_compact(text, request, push, problem);
+            return self.read_compact(text, request, push);
         }
         let (rows, offset) = if first {
             let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
             self.header = Some(header.trim().to_string());
-            (csv::read(text, problem.body.len()), 0)
+            (csv::read(text, supports), 0)
         } else {
             let full = format!("{}\n{text}", self.header.as_deref().unwrap_or(""));
-            (csv::read(&full, problem.body.len()), 1)
+            (csv::read(&full, supports), 1)
         };
         let where_ =
             |line: usize| format!("line {} of its answer to request {request}", line - offset);
@@ -461,17 +471,11 @@ impl<'a> Stepping<'a> {
             // Lines counted in the answer.
             r.line -= offset;
         }
-        self.take(rows, first, request, push, problem)
+        self.take(rows, first, request, push)
     }
 
     /// An answer of compact lines (the header first, in the first answer).
-    fn read_compact(
-        &mut self,
-        text: &str,
-        request: u64,
-        push: &Push,
-        problem: Problem,
-    ) -> Result<(), String> {
+    fn read_compact(&mut self, text: &str, request: u64, push: &Push) -> Result<(), String> {
         let first = self.header.is_none();
         let mut lines = text
             .lines()
@@ -481,10 +485,14 @@ impl<'a> Stepping<'a> {
             let (_, header) = lines.next().unwrap_or((0, ""));
             self.header = Some(header.trim().to_string());
         }
-        let header = self.header.as_deref().unwrap_or("");
-        let columns = csv::Columns::of(header, problem.body.len()).map_err(|e| {
-            format!("wrote a header its compact rows cannot use (request {request}): {e}")
-        })?;
+        if self.columns.is_none() {
+            let header = self.header.as_deref().unwrap_or("");
+            let columns = csv::Columns::of(header, self.problem.body.len()).map_err(|e| {
+                format!("wrote a header its compact rows cannot use (request {request}): {e}")
+            })?;
+            self.columns = Some(columns);
+        }
+        let columns = self.columns.as_ref().expect("just read");
         let mut rows = Vec::new();
         for (i, l) in lines {
             let Some(hex) = l.trim().strip_prefix(csv::COMPACT) else {
@@ -493,25 +501,27 @@ impl<'a> Stepping<'a> {
                     i + 1
                 ));
             };
-            rows.extend(csv::read_compact(hex, &columns, i + 1).map_err(|e| {
+            rows.extend(csv::read_compact(hex, columns, i + 1).map_err(|e| {
                 format!("wrote a malformed compact row (answer to request {request}): {e}")
             })?);
         }
-        self.take(rows, first, request, push, problem)
+        self.take(rows, first, request, push)
     }
 
-    /// Checks an advance's rows against the push and the rows before, and
-    /// keeps them.
+    /// Checks an advance's rows against the push (the last of `applied`)
+    /// and the rows before, and keeps them.
     fn take(
         &mut self,
         rows: Vec<csv::Record>,
         first: bool,
         request: u64,
         push: &Push,
-        problem: Problem,
     ) -> Result<(), String> {
         let where_ = |line: usize| format!("line {line} of its answer to request {request}");
-        let (t0, t1) = *problem.segment_times().last().expect("a push applied");
+        let t0 = self.end;
+        let t1 = t0 + push.duration;
+        let mut bound = self.bound;
+        bound.widen(push.speed);
         let tol = 1e-9 * t1.max(1.0);
         if rows.is_empty() {
             return Err(format!(
@@ -534,10 +544,8 @@ impl<'a> Stepping<'a> {
                 last.numbers[0]
             ));
         }
-        check::rows(&Bound::of(&problem), self.rows.last(), &rows, |r| {
-            where_(r.line)
-        })
-        .map_err(|e| format!("wrote a row that is not a motion of the push: {e}"))?;
+        check::rows(&bound, self.rows.last(), &rows, |r| where_(r.line))
+            .map_err(|e| format!("wrote a row that is not a motion of the push: {e}"))?;
         let s = rows.last().expect("not empty").numbers;
         self.state = EngineState {
             t: s[0],
@@ -545,8 +553,10 @@ impl<'a> Stepping<'a> {
             y: s[2],
             theta: s[3],
             omega: s[4],
-            v_cm: rigid_cm_velocity(&problem, Some(push), s[3], s[4]),
+            v_cm: rigid_cm_velocity(&self.problem, Some(push), s[3], s[4]),
         };
+        self.end = t1;
+        self.bound = bound;
         self.rows.extend(rows);
         Ok(())
     }
@@ -567,11 +577,11 @@ impl Stepping<'_> {
                     "wrote an answer to request {} that is not UTF-8 ({e})",
                     a.request
                 ),
-                &a.stderr,
+                &a.stderr(),
             )
         })?;
         self.read(text, a.request, push)
-            .map_err(|e| engine.fail(e, &a.stderr))?;
+            .map_err(|e| engine.fail(e, &a.stderr()))?;
         self.parse_time += parse.elapsed();
         self.failed = false;
         Ok(())
@@ -588,7 +598,7 @@ impl Stepping<'_> {
                     a.request,
                     a.request
                 ),
-                &a.stderr,
+                &a.stderr(),
             ));
         }
         self.process_time += a.elapsed;
@@ -601,7 +611,7 @@ impl Stepping<'_> {
             .map_err(|e| {
                 engine.fail(
                     format!("wrote rows that do not cover the run: {e}"),
-                    &a.stderr,
+                    &a.stderr(),
                 )
             })?;
         self.parse_time += parse.elapsed();

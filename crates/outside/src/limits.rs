@@ -32,17 +32,33 @@ pub struct Limits {
 impl Limits {
     /// The cap of a run of `problem` at step `dt` (s).
     pub fn for_problem(problem: &Problem, dt: f64) -> Self {
+        Self::of(
+            problem.duration(),
+            problem.pushes.len(),
+            problem.sample_dt,
+            dt,
+        )
+    }
+
+    /// The cap of one push of `problem`'s lasting `duration` (s) at step
+    /// `dt`: [`Limits::for_problem`] of the problem with that push as its
+    /// schedule (a protocol 3 advance), without building it.
+    pub fn for_push(problem: &Problem, duration: f64, dt: f64) -> Self {
+        Self::of(duration, 1, problem.sample_dt, dt)
+    }
+
+    fn of(duration: f64, pushes: usize, sample_dt: f64, dt: f64) -> Self {
         let step = if dt.is_finite() && dt > 0.0 {
-            dt.min(problem.sample_dt)
+            dt.min(sample_dt)
         } else {
-            problem.sample_dt
+            sample_dt
         };
         // Saturating: an absurd dt gives a huge cap, never a wrapped one.
         // A whole number of steps stays whole despite rounding (10 / 0.002).
-        let expected = (problem.duration() / step * (1.0 - 1e-12)).ceil() + 1.0;
+        let expected = (duration / step * (1.0 - 1e-12)).ceil() + 1.0;
         let rows = ((ROW_MARGIN * expected) as u64)
             .saturating_add(ROW_SLACK)
-            .saturating_add(problem.pushes.len() as u64);
+            .saturating_add(pushes as u64);
         Self {
             max_rows: rows,
             max_bytes: rows

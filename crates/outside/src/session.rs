@@ -25,17 +25,15 @@
 //! [`shutdown_sessions`] ends them all; a dropped session ends its process
 //! too.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::mpsc::{channel, Sender};
 use std::sync::{Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use crate::config::Spec;
 use crate::limits::{Limits, Meter};
 use crate::process::ProcessError;
-use crate::stream::{Chunks, Piece, Tail};
+use crate::stream::{Direct, Filled, Input, Tail};
 use crate::tree::{self, Mark};
 
 /// How long a session whose standard input is closed is given to exit on
@@ -98,9 +96,17 @@ pub(crate) struct Answer {
     pub request: u64,
     /// How many documents this process had answered before this one.
     pub answered_before: u64,
+    /// The session's standard error, whose end [`Answer::stderr`] reads
+    /// (only when a message quotes it).
+    pub(crate) err: Tail,
+}
+
+impl Answer {
     /// The end of the session's standard error (earlier answers' lines
     /// included).
-    pub stderr: Vec<u8>,
+    pub(crate) fn stderr(&self) -> Vec<u8> {
+        self.err.get(Duration::ZERO)
+    }
 }
 
 /// How an answer failed.
@@ -119,10 +125,12 @@ struct Session {
     key: Key,
     child: Child,
     mark: Mark,
-    /// Documents to write (a thread writes them, so a process that does not
-    /// read cannot block a run past its timeout); None once closed.
-    input: Option<Sender<Vec<u8>>>,
-    out: Chunks,
+    /// Where documents are written (what the pipe cannot take at once, a
+    /// thread writes, so a process that does not read cannot block a run
+    /// past its timeout); None once closed.
+    input: Option<Input>,
+    /// Standard output, read by the thread waiting for an answer.
+    out: Direct,
     err: Tail,
     /// Bytes read after the last answer's closing line.
     carry: Vec<u8>,
@@ -165,23 +173,14 @@ impl Session {
             what: format!("could not start `{}`: {e}", program.display()),
             stderr: Vec::new(),
         })?;
-        let mut stdin = child.stdin.take().expect("piped");
-        let out = Chunks::spawn(child.stdout.take().expect("piped"));
+        let input = Input::new(child.stdin.take().expect("piped"));
+        let out = Direct::new(child.stdout.take().expect("piped"));
         let err = Tail::spawn(child.stderr.take().expect("piped"));
-        let (tx, rx) = channel::<Vec<u8>>();
-        std::thread::spawn(move || {
-            for doc in rx {
-                if stdin.write_all(&doc).and_then(|()| stdin.flush()).is_err() {
-                    return;
-                }
-            }
-            // The sender is gone: standard input closes here.
-        });
         Ok(Self {
             key,
             child,
             mark,
-            input: Some(tx),
+            input: Some(input),
             out,
             err,
             carry: Vec::new(),
@@ -205,9 +204,7 @@ impl Session {
         what: &str,
     ) -> Result<(u64, Instant), Fail> {
         if self.answered == self.request {
-            while let Some(Piece::Bytes(b)) = self.out.next(Instant::now()) {
-                self.carry.extend_from_slice(&b);
-            }
+            while let Filled::Bytes = self.out.fill(&mut self.carry, Instant::now()) {}
             if !self.carry.iter().all(u8::is_ascii_whitespace) {
                 let first = String::from_utf8_lossy(&self.carry);
                 let first = first.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
@@ -228,7 +225,7 @@ impl Session {
         // One document per line (compact JSON holds no line break).
         line.push(b'\n');
         let written = Instant::now();
-        let sent = self.input.as_ref().is_some_and(|tx| tx.send(line).is_ok());
+        let sent = self.input.as_ref().is_some_and(|input| input.send(line));
         if !sent {
             return Err(Fail::Broken(format!(
                 "its standard input is closed (the session has ended) at request {number} ({what})"
@@ -307,14 +304,14 @@ impl Session {
             } else {
                 deadline.min(written + FIRST_ANSWER_HINT)
             };
-            match self.out.next(wait_until) {
-                Some(Piece::Bytes(b)) => answer.extend_from_slice(&b),
-                Some(Piece::End) => {
+            match self.out.fill(&mut answer, wait_until) {
+                Filled::Bytes => {}
+                Filled::End => {
                     return Err(Fail::Broken(format!(
                         "closed its standard output before the closing line of its answer to request {number} ({what}): the session ended mid-answer"
                     )))
                 }
-                None if Instant::now() < deadline => {
+                Filled::Nothing if Instant::now() < deadline => {
                     hinted = true;
                     eprintln!(
                         "warning: outside engine \"{}\" (command `{}`) has not answered request {number} ({what}), its first document, after {} s; {}. Waiting up to its timeout of {} s.",
@@ -325,7 +322,7 @@ impl Session {
                         timeout.as_secs_f64()
                     );
                 }
-                None => {
+                Filled::Nothing => {
                     let hint = if self.answered == 0 && answer.is_empty() {
                         format!(" ({})", never_answered_hint(&self.key.name))
                     } else {
@@ -559,7 +556,7 @@ impl Lease {
                 pid,
                 request,
                 answered_before,
-                stderr: s.err.get(Duration::ZERO),
+                err: s.err.clone(),
             }),
             Err(Fail::Refused(message)) => Err(ProcessError {
                 what: format!(
@@ -624,7 +621,7 @@ impl Lease {
                     pid,
                     request,
                     answered_before,
-                    stderr: s.err.get(Duration::ZERO),
+                    err: s.err.clone(),
                 })),
                 Err(Fail::Refused(message)) => results.push(Err(ProcessError {
                     what: format!(
