@@ -14,7 +14,9 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::DVec2;
 use bevy::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Time, World};
 
-use pushval_engine::stepping::{Plate, PlateWorld, StepLayout, StepLoop, StepPlan, Stepped, Stepping, SupportForces};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLayout, StepLoop, StepPlan, Stepped, Stepping, SupportForces,
+};
 use pushval_model::{ModelError, Problem, Push};
 
 use crate::clock::Clock;
@@ -259,7 +261,10 @@ impl PlateWorld for World2d {
     /// its drift is measured after the step.
     fn drive(&mut self, _: &State, velocity: [f64; 2], _h: f64) -> f64 {
         let world = self.app.world_mut();
-        if let Some(mut v) = world.entity_mut(self.scene.pusher).get_mut::<LinearVelocity>() {
+        if let Some(mut v) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
             v.0 = DVec2::new(velocity[0], velocity[1]);
         }
         0.0
@@ -309,7 +314,10 @@ impl PlateWorld for World2d {
 /// The scene of `problem` (checked by the caller) in the shared stepping
 /// loop, the object moving with the first push of its schedule unless it
 /// starts at rest.
-pub(crate) fn start(problem: &Problem, s: &Avian2dSettings) -> Result<Stepping<World2d>, ModelError> {
+pub(crate) fn start(
+    problem: &Problem,
+    s: &Avian2dSettings,
+) -> Result<Stepping<World2d>, ModelError> {
     if !problem.initial.from_rest && problem.pushes.is_empty() {
         return Err(ModelError::EmptySchedule);
     }

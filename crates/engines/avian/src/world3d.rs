@@ -411,7 +411,10 @@ impl PlateWorld for World3d {
         let v = DQuat::from_rotation_z(st.theta + 0.5 * plan.h * st.omega)
             * DVec3::new(vc.x, vc.y, 0.0);
         let world = self.app.world_mut();
-        if let Some(mut lv) = world.entity_mut(self.scene.pusher).get_mut::<LinearVelocity>() {
+        if let Some(mut lv) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
             lv.0 = v;
         }
         0.0
@@ -421,7 +424,10 @@ impl PlateWorld for World3d {
     /// contact point); its drift is measured after the step.
     fn drive(&mut self, _: &State, velocity: [f64; 2], _h: f64) -> f64 {
         let world = self.app.world_mut();
-        if let Some(mut v) = world.entity_mut(self.scene.pusher).get_mut::<LinearVelocity>() {
+        if let Some(mut v) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
             v.0 = DVec3::new(velocity[0], velocity[1], 0.0);
         }
         0.0
@@ -498,7 +504,10 @@ impl PlateWorld for World3d {
 /// The scene of `problem` (checked by the caller), settled, calibrated and
 /// given its start velocity (moving with the first push of its schedule
 /// unless it starts at rest), in the shared stepping loop.
-pub(crate) fn start(problem: &Problem, s: &Avian3dSettings) -> Result<Stepping<World3d>, ModelError> {
+pub(crate) fn start(
+    problem: &Problem,
+    s: &Avian3dSettings,
+) -> Result<Stepping<World3d>, ModelError> {
     let body = &problem.body;
     let init = problem.initial;
     if !init.from_rest && problem.pushes.is_empty() {

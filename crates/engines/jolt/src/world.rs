@@ -2,7 +2,9 @@
 
 use std::f64::consts::{PI, TAU};
 
-use pushval_engine::stepping::{Plate, PlateWorld, StepLoop, Stepped, Stepping, SupportForces, TAIL};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLoop, Stepped, Stepping, SupportForces, TAIL,
+};
 use pushval_model::{Body, ModelError, Problem, Vec2};
 
 use crate::predict::{box_corners, friction_slip_angle};

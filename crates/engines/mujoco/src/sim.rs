@@ -4,8 +4,7 @@ use std::time::Instant;
 
 use mujoco_rs::prelude::*;
 use pushval_engine::stepping::{
-    Plate, PlateWorld, StepClock, StepLoop, Stepped, Stepping, SupportForces, TailSteps,
-    TailWeight,
+    Plate, PlateWorld, StepClock, StepLoop, Stepped, Stepping, SupportForces, TailSteps, TailWeight,
 };
 use pushval_model::{ModelError, Problem};
 

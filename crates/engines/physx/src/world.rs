@@ -6,7 +6,9 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use physx::material::Material;
 use physx::prelude::*;
 use physx::traits::Class;
-use pushval_engine::stepping::{Plate, PlateWorld, StepLoop, Stepped, Stepping, SupportForces, TAIL};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLoop, Stepped, Stepping, SupportForces, TAIL,
+};
 use pushval_model::{ModelError, Problem};
 
 use crate::sys;
