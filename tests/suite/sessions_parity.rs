@@ -168,4 +168,3 @@ fn session_state_follows_the_run() {
         assert_eq!(session.finish().unwrap().trajectory, run.trajectory);
     }
 }
-
