@@ -1,27 +1,12 @@
 //! The caller owns the loop: for every compiled-in engine of the build,
 //! `run` is `start`, one `advance` per push and `finish`, bit for bit, on
-//! every shipped scenario (as given, and from rest); and the engines that
-//! step natively keep their world between pushes instead of replaying.
+//! every shipped scenario (as given, and from rest); and every engine steps
+//! natively, keeping its world between pushes instead of replaying.
 
 use pushval_engine::{Engine, EngineRun, EngineSession};
 use pushval_model::{ModelError, Problem};
 
 use crate::common::*;
-
-/// Engines that are still advanced by re-running the schedule applied so
-/// far (a `ReplaySession`): correct at N times the cost. They come in with
-/// the `avian`, `jolt`, `physx` and `mujoco` features.
-const REPLAYING: &[&str] = &[
-    "avian2d",
-    "avian3d",
-    "jolt_box",
-    "jolt_feet",
-    "physx_patch",
-    "physx_two_directional",
-    "physx_one_directional",
-    "mujoco_pyramidal",
-    "mujoco_elliptic",
-];
 
 /// The run with its wall-clock time cleared (the only field that may differ).
 fn timeless(r: Result<EngineRun, ModelError>) -> Result<EngineRun, String> {
@@ -87,12 +72,8 @@ fn stepped(
     dt: f64,
 ) -> Result<EngineRun, ModelError> {
     let mut session: Box<dyn EngineSession + '_> = engine.start(problem, dt)?;
-    assert_eq!(
-        session.replays(),
-        REPLAYING.contains(&engine.name()),
-        "{name}: replays() is {}",
-        session.replays()
-    );
+    // Every compiled-in engine steps natively: none replays.
+    assert!(!session.replays(), "{name}: replays");
     let mut t = 0.0;
     for push in &problem.pushes {
         session.advance(push)?;
@@ -118,9 +99,7 @@ fn stepped(
     }
     let steps = session.steps_taken();
     let run = session.finish()?;
-    if !REPLAYING.contains(&engine.name()) {
-        assert_eq!(steps, run.steps, "{name}: steps_taken");
-    }
+    assert_eq!(steps, run.steps, "{name}: steps_taken");
     Ok(run)
 }
 

@@ -4,13 +4,13 @@
 //! are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys, COULOMB,
+    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
 use crate::predict::Avian3dTilt;
-use crate::{Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator, AVAILABLE};
+use crate::{Avian2dSettings, Avian3dSettings, AVAILABLE};
 
 /// The 2-D engine crate and the version this adapter is built against (the
 /// `avian2d` entry of the workspace's Cargo.toml; a test checks it against
@@ -175,23 +175,57 @@ impl Engine for Avian2dModel {
     fn law(&self) -> Option<&dyn FrictionLaw> {
         Some(avian2d_law())
     }
+    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = Avian2dSimulator::new(Avian2dSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The scene through the shared stepping loop
+    /// ([`pushval_engine::stepping`]) on Avian's clock; an object not
+    /// starting at rest starts with the first push of `problem`'s schedule.
+    /// Without the `avian` feature: [`ModelError::Integration`] with
+    /// [`crate::UNAVAILABLE`].
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let started = std::time::Instant::now();
+        let settings = Avian2dSettings {
             dt,
             ..self.settings
-        })
-        .run(problem)?;
-        Ok(EngineRun {
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "steps": r.steps,
-                "max_joint_drift": r.max_joint_drift,
-            }),
-            trajectory: r.trajectory,
-            contact: None,
-        })
+        };
+        if let Err(e) = settings.check() {
+            return Some(Err(e));
+        }
+        #[cfg(feature = "avian")]
+        {
+            use pushval_engine::stepping::{PlateFinish, PlateSession};
+            let stepping = match crate::world2d::start(problem, &settings) {
+                Ok(s) => s,
+                Err(e) => return Some(Err(e)),
+            };
+            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
+                let r = crate::world2d::finish(&w, stepped, problem, &settings, started);
+                Ok(EngineRun {
+                    dt,
+                    steps: r.steps,
+                    wall_time: r.wall_time,
+                    diagnostics: serde_json::json!({
+                        "steps": r.steps,
+                        "max_joint_drift": r.max_joint_drift,
+                    }),
+                    trajectory: r.trajectory,
+                    contact: None,
+                })
+            });
+            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+        }
+        #[cfg(not(feature = "avian"))]
+        {
+            let _ = (problem, started);
+            Some(Err(crate::unavailable()))
+        }
     }
 }
 
@@ -217,27 +251,61 @@ impl Engine for Avian3dModel {
     fn law(&self) -> Option<&dyn FrictionLaw> {
         Some(&self.law)
     }
+    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = Avian3dSimulator::new(Avian3dSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The scene, settled and calibrated, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]) on Avian's clock; an object not
+    /// starting at rest starts with the first push of `problem`'s schedule.
+    /// Without the `avian` feature: [`ModelError::Integration`] with
+    /// [`crate::UNAVAILABLE`].
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let started = std::time::Instant::now();
+        let settings = Avian3dSettings {
             dt,
             ..self.settings
-        })
-        .run(problem)?;
-        Ok(EngineRun {
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "steps": r.steps,
-                "max_joint_drift": r.max_joint_drift,
-                "max_tilt": r.max_tilt,
-                "rest_loads": r.rest_loads,
-                "mu": r.mu,
-                "loads": r.loads,
-            }),
-            trajectory: r.trajectory,
-            contact: r.contact,
-        })
+        };
+        if let Err(e) = settings.check() {
+            return Some(Err(e));
+        }
+        #[cfg(feature = "avian")]
+        {
+            use pushval_engine::stepping::{PlateFinish, PlateSession};
+            let stepping = match crate::world3d::start(problem, &settings) {
+                Ok(s) => s,
+                Err(e) => return Some(Err(e)),
+            };
+            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
+                let r = crate::world3d::finish(w, stepped, problem, &settings, started);
+                Ok(EngineRun {
+                    dt,
+                    steps: r.steps,
+                    wall_time: r.wall_time,
+                    diagnostics: serde_json::json!({
+                        "steps": r.steps,
+                        "max_joint_drift": r.max_joint_drift,
+                        "max_tilt": r.max_tilt,
+                        "rest_loads": r.rest_loads,
+                        "mu": r.mu,
+                        "loads": r.loads,
+                    }),
+                    trajectory: r.trajectory,
+                    contact: r.contact,
+                })
+            });
+            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+        }
+        #[cfg(not(feature = "avian"))]
+        {
+            let _ = (problem, started);
+            Some(Err(crate::unavailable()))
+        }
     }
 }
 

@@ -1,5 +1,6 @@
 //! The `avian2d` scene: a headless app, the bodies, the support friction in
-//! Avian's substep loop, and the stepping loop (see `Avian2dSettings`).
+//! Avian's substep loop, and the scene as the shared stepping loop sees it
+//! (see `Avian2dSettings`).
 
 use std::f64::consts::{PI, TAU};
 use std::time::Instant;
@@ -13,8 +14,10 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::DVec2;
 use bevy::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Time, World};
 
-use pushval_engine::StepRecord;
-use pushval_model::{ModelError, Problem};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLayout, StepLoop, StepPlan, Stepped, Stepping, SupportForces,
+};
+use pushval_model::{ModelError, Problem, Push};
 
 use crate::clock::Clock;
 use crate::{Avian2dRun, Avian2dSettings};
@@ -164,12 +167,18 @@ fn spawn(world: &mut World, problem: &Problem) -> Scene {
 
 /// The object's state as the engine has it.
 #[derive(Clone, Copy)]
-struct State {
+pub(crate) struct State {
     position: DVec2,
     rotation: Rotation,
     /// Unwrapped angle (rad).
     theta: f64,
+    /// The engine's angular velocity (rad/s).
     omega: f64,
+    /// The engine's velocity of the centre of mass (m/s).
+    velocity: DVec2,
+    /// The step's rotation over its length (rad/s): the ω recorded (at the
+    /// start, the initial one).
+    step_omega: f64,
 }
 
 fn read(world: &World, object: Entity, prev_theta: f64) -> State {
@@ -177,6 +186,7 @@ fn read(world: &World, object: Entity, prev_theta: f64) -> State {
     let position = e.get::<Position>().map_or(DVec2::NAN, |p| p.0);
     let rotation = e.get::<Rotation>().copied().unwrap_or_default();
     let omega = e.get::<AngularVelocity>().map_or(f64::NAN, |w| w.0);
+    let velocity = e.get::<LinearVelocity>().map_or(DVec2::NAN, |v| v.0);
     // Unwrap: the engine's angle lives in (−π, π].
     let d = (rotation.as_radians() - prev_theta.rem_euclid(TAU) + PI).rem_euclid(TAU) - PI;
     State {
@@ -184,77 +194,184 @@ fn read(world: &World, object: Entity, prev_theta: f64) -> State {
         rotation,
         theta: prev_theta + d,
         omega,
+        velocity,
+        step_omega: omega,
     }
 }
 
-/// Runs the problem (checked by the caller).
-pub(crate) fn run(problem: &Problem, s: &Avian2dSettings) -> Result<Avian2dRun, ModelError> {
-    let start = Instant::now();
+/// The scene as the shared stepping loop sees it: steps on Avian's clock
+/// (whole ticks, [`Clock`]), the pusher's velocity set at the mid-step angle
+/// the engine's θ and ω predict, the joint's drift measured after every step.
+pub(crate) struct World2d {
+    app: App,
+    scene: Scene,
+    clock: Clock,
+    dt: f64,
+    /// End time of the segments laid out so far (s).
+    t_seg: f64,
+    /// The current segment's steps in ticks.
+    spans: Vec<(u64, u64)>,
+    /// Index of the current step in its segment.
+    index: usize,
+    /// Length of the last step (s).
+    h: f64,
+    /// Largest distance between the pusher and the object's contact point
+    /// after a step (m).
+    pub(crate) max_drift: f64,
+}
+
+impl PlateWorld for World2d {
+    type State = State;
+
+    fn plate(&self, st: &State) -> Plate {
+        Plate {
+            x: st.position.x,
+            y: st.position.y,
+            z: 0.0,
+            theta: st.theta,
+            omega: st.step_omega,
+            tilt: 0.0,
+        }
+    }
+
+    /// The segment's steps in whole ticks (see [`Clock`]).
+    fn segment_steps(&mut self, push: &Push, _n: usize, _h: f64, _: bool) -> Option<StepLayout> {
+        let c = self.clock;
+        let (a, b) = (c.ticks(self.t_seg), c.ticks(self.t_seg + push.duration));
+        self.spans = c.steps(a, b, push.duration, self.dt);
+        self.t_seg += push.duration;
+        Some(StepLayout::Spans(
+            self.spans
+                .iter()
+                .map(|&(k0, k1)| (c.seconds(k0), c.seconds(k1)))
+                .collect(),
+        ))
+    }
+
+    /// The commanded contact velocity turned by `θ + ω h/2`, θ and ω the
+    /// engine's.
+    fn drive_step(&mut self, st: &State, plan: &StepPlan) -> f64 {
+        self.index = plan.index;
+        let vc = plan.push.velocity();
+        let v = Rotation::radians(st.theta + 0.5 * plan.h * st.omega) * DVec2::new(vc.x, vc.y);
+        self.drive(st, [v.x, v.y], plan.h)
+    }
+
+    /// Sets the pusher's velocity (the joint holds it on the contact point);
+    /// its drift is measured after the step.
+    fn drive(&mut self, _: &State, velocity: [f64; 2], _h: f64) -> f64 {
+        let world = self.app.world_mut();
+        if let Some(mut v) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
+            v.0 = DVec2::new(velocity[0], velocity[1]);
+        }
+        0.0
+    }
+
+    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
+        let (k0, k1) = self.spans[self.index];
+        let world = self.app.world_mut();
+        world
+            .resource_mut::<Time>()
+            .advance_by(self.clock.duration(k1 - k0));
+        world.run_schedule(Step);
+        self.h = h;
+        Ok(())
+    }
+
+    fn state(&mut self, prev: &State) -> State {
+        let mut st = read(self.app.world(), self.scene.object, prev.theta);
+        st.step_omega = (st.theta - prev.theta) / self.h;
+        st
+    }
+
+    fn finite(&self, st: &State) -> bool {
+        st.position.is_finite() && st.theta.is_finite() && st.omega.is_finite()
+    }
+
+    fn after_step(&mut self, st: &State) {
+        let anchor = self
+            .app
+            .world()
+            .entity(self.scene.pusher)
+            .get::<Position>()
+            .map_or(DVec2::NAN, |p| p.0);
+        let drift = (anchor - st.position - st.rotation * self.scene.contact).length();
+        self.max_drift = self.max_drift.max(drift);
+    }
+
+    fn support_forces(&mut self, _: &State, _h: f64) -> Result<Option<SupportForces>, ModelError> {
+        Ok(None)
+    }
+
+    fn cm_velocity(&self, st: &State) -> Option<[f64; 2]> {
+        Some([st.velocity.x, st.velocity.y])
+    }
+}
+
+/// The scene of `problem` (checked by the caller) in the shared stepping
+/// loop, the object moving with the first push of its schedule unless it
+/// starts at rest.
+pub(crate) fn start(
+    problem: &Problem,
+    s: &Avian2dSettings,
+) -> Result<Stepping<World2d>, ModelError> {
+    if !problem.initial.from_rest && problem.pushes.is_empty() {
+        return Err(ModelError::EmptySchedule);
+    }
     let mut app = headless_app(s.substeps);
     let scene = spawn(app.world_mut(), problem);
     let init = problem.initial;
     let mut state = read(app.world(), scene.object, init.theta);
-    let mut history = vec![StepRecord {
-        segment: 0,
-        t0: 0.0,
-        t1: 0.0,
-        x: state.position.x,
-        y: state.position.y,
-        theta: state.theta,
-        omega: if init.from_rest { 0.0 } else { init.omega },
-    }];
-    let clock = Clock::new(s.substeps);
-    let mut max_drift = 0.0f64;
-    let mut t_seg = 0.0;
-    for (j, push) in problem.pushes.iter().enumerate() {
-        let (a, b) = (clock.ticks(t_seg), clock.ticks(t_seg + push.duration));
-        let vc = push.velocity();
-        let vc = DVec2::new(vc.x, vc.y);
-        for (k0, k1) in clock.steps(a, b, push.duration, s.dt) {
-            let (t0, t1) = (clock.seconds(k0), clock.seconds(k1));
-            let h = t1 - t0;
-            let world = app.world_mut();
-            if let Some(mut v) = world.entity_mut(scene.pusher).get_mut::<LinearVelocity>() {
-                v.0 = Rotation::radians(state.theta + 0.5 * h * state.omega) * vc;
-            }
-            world
-                .resource_mut::<Time>()
-                .advance_by(clock.duration(k1 - k0));
-            world.run_schedule(Step);
-            let prev = state.theta;
-            state = read(app.world(), scene.object, prev);
-            if !(state.position.is_finite() && state.theta.is_finite() && state.omega.is_finite()) {
-                return Err(ModelError::NonFinite {
-                    t: t1,
-                    step: history.len(),
-                });
-            }
-            let anchor = app
-                .world()
-                .entity(scene.pusher)
-                .get::<Position>()
-                .map_or(DVec2::NAN, |p| p.0);
-            let drift = (anchor - state.position - state.rotation * scene.contact).length();
-            max_drift = max_drift.max(drift);
-            history.push(StepRecord {
-                segment: j,
-                t0,
-                t1,
-                x: state.position.x,
-                y: state.position.y,
-                theta: state.theta,
-                omega: (state.theta - prev) / h,
-            });
-        }
-        t_seg += push.duration;
-    }
-    let steps = history.len() - 1;
-    Ok(Avian2dRun {
+    state.step_omega = if init.from_rest { 0.0 } else { init.omega };
+    let world = World2d {
+        app,
+        scene,
+        clock: Clock::new(s.substeps),
+        dt: s.dt,
+        t_seg: 0.0,
+        spans: Vec::new(),
+        index: 0,
+        h: s.dt,
+        max_drift: 0.0,
+    };
+    Ok(Stepping::new(
+        world,
+        problem,
+        StepLoop::new(s.dt, 0, 0.0),
+        state,
+    ))
+}
+
+/// The run of the pushes applied (`problem`), from what the loop gathered.
+pub(crate) fn finish(
+    world: &World2d,
+    run: Stepped,
+    problem: &Problem,
+    s: &Avian2dSettings,
+    started: Instant,
+) -> Avian2dRun {
+    let history = run.records();
+    Avian2dRun {
         trajectory: pushval_engine::trajectory_from_steps("avian2d", problem, &history),
         settings: *s,
         history,
-        steps,
-        max_joint_drift: max_drift,
-        wall_time: start.elapsed(),
-    })
+        steps: run.steps,
+        max_joint_drift: world.max_drift,
+        wall_time: started.elapsed(),
+    }
+}
+
+/// Runs the problem (checked by the caller): [`start`], one push at a time,
+/// [`finish`].
+pub(crate) fn run(problem: &Problem, s: &Avian2dSettings) -> Result<Avian2dRun, ModelError> {
+    let started = Instant::now();
+    let mut stepping = start(problem, s)?;
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    let (world, run, applied) = stepping.finish();
+    Ok(finish(&world, run, &applied, s, started))
 }

@@ -1,6 +1,7 @@
 //! The `avian3d` scene: a headless app, the floor, the plate on ball feet,
 //! the pusher and its horizontal pin (a custom XPBD constraint), the settle
-//! phase and the stepping loop (see `Avian3dSettings`).
+//! phase and the scene as the shared stepping loop sees it (see
+//! `Avian3dSettings`).
 
 use std::f64::consts::{PI, TAU};
 use std::time::Instant;
@@ -20,14 +21,13 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::{DQuat, DVec3};
 use bevy::prelude::{ChildOf, Component, Entity, IntoScheduleConfigs, Time, Transform, World};
 
-use pushval_engine::StepRecord;
-use pushval_model::{ModelError, Problem};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLayout, StepLoop, StepPlan, Stepped, Stepping, SupportForces, TailSteps,
+};
+use pushval_model::{ModelError, Problem, Push};
 
 use crate::clock::Clock;
 use crate::{predict, Avian3dRun, Avian3dSettings};
-
-/// Share of a segment, at its end, over which the tail loads are averaged.
-const TAIL: f64 = 0.2;
 
 /// The schedule the app runs once per step.
 #[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
@@ -242,7 +242,7 @@ fn spawn(world: &mut World, problem: &Problem, s: &Avian3dSettings) -> Scene {
 
 /// The object's state as the engine has it.
 #[derive(Clone, Copy)]
-struct State {
+pub(crate) struct State {
     position: DVec3,
     rotation: DQuat,
     /// Unwrapped yaw (rad).
@@ -251,6 +251,11 @@ struct State {
     omega: f64,
     /// Angle between the body's vertical axis and the world's (rad).
     tilt: f64,
+    /// The engine's velocity of the centre of mass (m/s).
+    velocity: DVec3,
+    /// The step's yaw change over its length (rad/s): the ω recorded (at the
+    /// start, the engine's).
+    step_omega: f64,
 }
 
 fn read(world: &World, object: Entity, prev_theta: f64) -> State {
@@ -258,6 +263,7 @@ fn read(world: &World, object: Entity, prev_theta: f64) -> State {
     let position = e.get::<Position>().map_or(DVec3::NAN, |p| p.0);
     let rotation = e.get::<Rotation>().map_or(DQuat::IDENTITY, |r| r.0);
     let omega = e.get::<AngularVelocity>().map_or(f64::NAN, |w| w.0.z);
+    let velocity = e.get::<LinearVelocity>().map_or(DVec3::NAN, |v| v.0);
     let ex = rotation * DVec3::X;
     let ez = rotation * DVec3::Z;
     let d = (ex.y.atan2(ex.x) - prev_theta.rem_euclid(TAU) + PI).rem_euclid(TAU) - PI;
@@ -267,6 +273,8 @@ fn read(world: &World, object: Entity, prev_theta: f64) -> State {
         theta: prev_theta + d,
         omega,
         tilt: ez.z.clamp(-1.0, 1.0).acos(),
+        velocity,
+        step_omega: omega,
     }
 }
 
@@ -296,6 +304,22 @@ fn add_loads(world: &World, feet: &[Entity], h: f64, weight: f64, acc: &mut [f64
     }
 }
 
+/// The feet's accumulated normal impulses after the last step (N s; see
+/// [`loads`]).
+fn impulses(world: &World, feet: &[Entity]) -> Vec<f64> {
+    let graph = world.resource::<ContactGraph>();
+    feet.iter()
+        .map(|&foot| {
+            graph
+                .contact_pairs_with(foot)
+                .flat_map(|pair| &pair.manifolds)
+                .flat_map(|manifold| &manifold.points)
+                .map(|p| p.normal_impulse)
+                .sum::<f64>()
+        })
+        .collect()
+}
+
 /// Runs `steps` steps of `ticks` each with the pusher at rest.
 fn settle(app: &mut App, scene: &Scene, clock: &Clock, ticks: u64, steps: usize) {
     for _ in 0..steps {
@@ -310,11 +334,185 @@ fn settle(app: &mut App, scene: &Scene, clock: &Clock, ticks: u64, steps: usize)
     }
 }
 
-/// Runs the problem (checked by the caller).
-pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, ModelError> {
-    let start = Instant::now();
+/// What a step leaves for the run's last fifth (known at the end only):
+/// its middle, its length and the feet's impulses.
+struct StepImpulses {
+    mid: f64,
+    h: f64,
+    impulses: Vec<f64>,
+}
+
+/// The scene as the shared stepping loop sees it: steps on Avian's clock
+/// (whole ticks, [`Clock`]), the pusher's velocity set at the mid-step yaw
+/// the engine's θ and ω predict, the pin's horizontal drift, the tilt and
+/// the feet's loads measured after every step.
+pub(crate) struct World3d {
+    app: App,
+    scene: Scene,
+    clock: Clock,
+    dt: f64,
+    /// End time of the segments laid out so far (s).
+    t_seg: f64,
+    /// The current segment's steps in ticks.
+    spans: Vec<(u64, u64)>,
+    /// The current step: its index in its segment, start and end (s).
+    index: usize,
+    t0: f64,
+    t1: f64,
+    /// Length of the last step (s).
+    h: f64,
+    /// The current segment's time-weighted tail loads and tail length.
+    acc: Vec<f64>,
+    acc_t: f64,
+    /// Per segment, the feet's mean normal force over its tail (N).
+    tail_loads: Vec<Vec<f64>>,
+    /// Every step's impulses, for the run's last fifth.
+    log: Vec<StepImpulses>,
+    max_tilt: f64,
+    max_drift: f64,
+    rest_loads: Vec<f64>,
+    mu: Vec<f64>,
+}
+
+impl PlateWorld for World3d {
+    type State = State;
+
+    fn plate(&self, st: &State) -> Plate {
+        Plate {
+            x: st.position.x,
+            y: st.position.y,
+            z: st.position.z,
+            theta: st.theta,
+            omega: st.step_omega,
+            tilt: st.tilt,
+        }
+    }
+
+    /// The segment's steps in whole ticks (see [`Clock`]).
+    fn segment_steps(&mut self, push: &Push, _n: usize, _h: f64, _: bool) -> Option<StepLayout> {
+        let c = self.clock;
+        let (a, b) = (c.ticks(self.t_seg), c.ticks(self.t_seg + push.duration));
+        self.spans = c.steps(a, b, push.duration, self.dt);
+        self.t_seg += push.duration;
+        Some(StepLayout::Spans(
+            self.spans
+                .iter()
+                .map(|&(k0, k1)| (c.seconds(k0), c.seconds(k1)))
+                .collect(),
+        ))
+    }
+
+    /// The commanded contact velocity turned by `θ + ω h/2`, θ and ω the
+    /// engine's.
+    fn drive_step(&mut self, st: &State, plan: &StepPlan) -> f64 {
+        self.index = plan.index;
+        (self.t0, self.t1) = (plan.t0, plan.t1);
+        let vc = plan.push.velocity();
+        let v = DQuat::from_rotation_z(st.theta + 0.5 * plan.h * st.omega)
+            * DVec3::new(vc.x, vc.y, 0.0);
+        let world = self.app.world_mut();
+        if let Some(mut lv) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
+            lv.0 = v;
+        }
+        0.0
+    }
+
+    /// Sets the pusher's horizontal velocity (the pin holds it on the
+    /// contact point); its drift is measured after the step.
+    fn drive(&mut self, _: &State, velocity: [f64; 2], _h: f64) -> f64 {
+        let world = self.app.world_mut();
+        if let Some(mut v) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
+            v.0 = DVec3::new(velocity[0], velocity[1], 0.0);
+        }
+        0.0
+    }
+
+    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
+        let (k0, k1) = self.spans[self.index];
+        let world = self.app.world_mut();
+        world
+            .resource_mut::<Time>()
+            .advance_by(self.clock.duration(k1 - k0));
+        world.run_schedule(Step);
+        self.h = h;
+        Ok(())
+    }
+
+    fn state(&mut self, prev: &State) -> State {
+        let mut st = read(self.app.world(), self.scene.object, prev.theta);
+        st.step_omega = (st.theta - prev.theta) / self.h;
+        st
+    }
+
+    fn finite(&self, st: &State) -> bool {
+        st.position.is_finite() && st.theta.is_finite() && st.omega.is_finite()
+    }
+
+    fn after_step(&mut self, st: &State) {
+        self.max_tilt = self.max_tilt.max(st.tilt);
+        let world = self.app.world();
+        let anchor = world
+            .entity(self.scene.pusher)
+            .get::<Position>()
+            .map_or(DVec3::NAN, |p| p.0);
+        let gap = anchor - st.position - st.rotation * self.scene.anchor;
+        self.max_drift = self.max_drift.max(gap.x.hypot(gap.y));
+        self.log.push(StepImpulses {
+            mid: 0.5 * (self.t0 + self.t1),
+            h: self.h,
+            impulses: impulses(world, &self.scene.feet),
+        });
+    }
+
+    fn support_forces(&mut self, _: &State, h: f64) -> Result<Option<SupportForces>, ModelError> {
+        Ok(Some(SupportForces {
+            normal: loads(self.app.world(), &self.scene.feet, h),
+            friction: None,
+        }))
+    }
+
+    /// The segment's tail (steps whose middle is in its last fifth): the
+    /// feet's loads, time-weighted.
+    fn tail_step(&mut self, _: &State, h: f64) -> Result<(), ModelError> {
+        add_loads(self.app.world(), &self.scene.feet, h, h, &mut self.acc);
+        self.acc_t += h;
+        Ok(())
+    }
+
+    fn end_segment(&mut self, _: f64, _t: f64) -> Result<(), ModelError> {
+        let acc_t = std::mem::take(&mut self.acc_t);
+        self.tail_loads.push(
+            self.acc
+                .iter_mut()
+                .map(|a| std::mem::take(a) / acc_t.max(f64::MIN_POSITIVE))
+                .collect(),
+        );
+        Ok(())
+    }
+
+    fn cm_velocity(&self, st: &State) -> Option<[f64; 2]> {
+        Some([st.velocity.x, st.velocity.y])
+    }
+}
+
+/// The scene of `problem` (checked by the caller), settled, calibrated and
+/// given its start velocity (moving with the first push of its schedule
+/// unless it starts at rest), in the shared stepping loop.
+pub(crate) fn start(
+    problem: &Problem,
+    s: &Avian3dSettings,
+) -> Result<Stepping<World3d>, ModelError> {
     let body = &problem.body;
     let init = problem.initial;
+    if !init.from_rest && problem.pushes.is_empty() {
+        return Err(ModelError::EmptySchedule);
+    }
     let mut app = headless_app(s);
     let scene = spawn(app.world_mut(), problem, s);
     let clock = Clock::new(s.substeps);
@@ -353,111 +551,89 @@ pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, 
         let mut e = app.world_mut().entity_mut(scene.object);
         if let Some(mut v) = e.get_mut::<LinearVelocity>() {
             v.0 = DQuat::from_rotation_z(state.theta) * local + DVec3::Z * v.0.z;
+            state.velocity = v.0;
         }
         if let Some(mut w) = e.get_mut::<AngularVelocity>() {
             w.0.z = init.omega;
         }
         state.omega = init.omega;
+        state.step_omega = init.omega;
     }
-    let mut history = vec![StepRecord {
-        segment: 0,
-        t0: 0.0,
-        t1: 0.0,
-        x: state.position.x,
-        y: state.position.y,
-        theta: state.theta,
-        omega: state.omega,
-    }];
     let n_feet = scene.feet.len();
     // Loads per sample and the rise, measured from the settled height.
     let z_rest = state.position.z;
-    let mut recorder = pushval_engine::LoadRecorder::new(problem, n_feet, pushval_laws::GRAVITY);
-    let mut tail_loads = Vec::with_capacity(problem.pushes.len());
+    let world = World3d {
+        app,
+        scene,
+        clock,
+        dt: s.dt,
+        t_seg: 0.0,
+        spans: Vec::new(),
+        index: 0,
+        t0: 0.0,
+        t1: 0.0,
+        h: s.dt,
+        acc: vec![0.0; n_feet],
+        acc_t: 0.0,
+        tail_loads: Vec::new(),
+        log: Vec::new(),
+        max_tilt: 0.0,
+        max_drift: 0.0,
+        rest_loads,
+        mu,
+    };
+    let cfg = StepLoop {
+        tail: TailSteps::ByTime,
+        ..StepLoop::new(s.dt, n_feet, z_rest)
+    };
+    Ok(Stepping::new(world, problem, cfg, state))
+}
+
+/// The run of the pushes applied (`problem`), from what the loop gathered.
+pub(crate) fn finish(
+    world: World3d,
+    run: Stepped,
+    problem: &Problem,
+    s: &Avian3dSettings,
+    started: Instant,
+) -> Avian3dRun {
     // The run's last fifth (steps whose middle is past it), time-weighted.
     let run_from = 0.8 * problem.duration();
-    let (mut run_acc, mut run_t) = (vec![0.0; n_feet], 0.0);
-    let (mut max_tilt, mut max_drift) = (0.0f64, 0.0f64);
-    let mut t_seg = 0.0;
-    for (j, push) in problem.pushes.iter().enumerate() {
-        let (a, b) = (clock.ticks(t_seg), clock.ticks(t_seg + push.duration));
-        let vc = push.velocity();
-        let vc = DVec3::new(vc.x, vc.y, 0.0);
-        let tail_from = clock.seconds(b) - TAIL * push.duration;
-        let (mut acc, mut acc_t) = (vec![0.0; n_feet], 0.0);
-        for (k0, k1) in clock.steps(a, b, push.duration, s.dt) {
-            let (t0, t1) = (clock.seconds(k0), clock.seconds(k1));
-            let h = t1 - t0;
-            let world = app.world_mut();
-            if let Some(mut v) = world.entity_mut(scene.pusher).get_mut::<LinearVelocity>() {
-                v.0 = DQuat::from_rotation_z(state.theta + 0.5 * h * state.omega) * vc;
-            }
-            world
-                .resource_mut::<Time>()
-                .advance_by(clock.duration(k1 - k0));
-            world.run_schedule(Step);
-            let prev = state.theta;
-            state = read(app.world(), scene.object, prev);
-            if !(state.position.is_finite() && state.theta.is_finite() && state.omega.is_finite()) {
-                return Err(ModelError::NonFinite {
-                    t: t1,
-                    step: history.len(),
-                });
-            }
-            max_tilt = max_tilt.max(state.tilt);
-            let anchor = app
-                .world()
-                .entity(scene.pusher)
-                .get::<Position>()
-                .map_or(DVec3::NAN, |p| p.0);
-            let gap = anchor - state.position - state.rotation * scene.anchor;
-            max_drift = max_drift.max(gap.x.hypot(gap.y));
-            recorder.step(
-                t1,
-                h,
-                Some(&loads(app.world(), &scene.feet, h)),
-                Some(state.position.z - z_rest),
-            );
-            if 0.5 * (t0 + t1) >= tail_from {
-                add_loads(app.world(), &scene.feet, h, h, &mut acc);
-                acc_t += h;
-            }
-            if 0.5 * (t0 + t1) >= run_from {
-                add_loads(app.world(), &scene.feet, h, h, &mut run_acc);
-                run_t += h;
-            }
-            history.push(StepRecord {
-                segment: j,
-                t0,
-                t1,
-                x: state.position.x,
-                y: state.position.y,
-                theta: state.theta,
-                omega: (state.theta - prev) / h,
-            });
+    let (mut run_acc, mut run_t) = (vec![0.0; world.scene.feet.len()], 0.0);
+    for step in world.log.iter().filter(|q| q.mid >= run_from) {
+        for (a, impulse) in run_acc.iter_mut().zip(&step.impulses) {
+            *a += step.h * impulse / (2.0 * step.h);
         }
-        tail_loads.push(
-            acc.iter()
-                .map(|a| a / acc_t.max(f64::MIN_POSITIVE))
-                .collect(),
-        );
-        t_seg += push.duration;
+        run_t += step.h;
     }
-    let steps = history.len() - 1;
-    Ok(Avian3dRun {
+    let history = run.records();
+    Avian3dRun {
         trajectory: pushval_engine::trajectory_from_steps("avian3d", problem, &history),
         settings: *s,
         history,
-        rest_loads,
-        mu,
-        segment_tail_loads: tail_loads,
+        rest_loads: world.rest_loads,
+        mu: world.mu,
+        segment_tail_loads: world.tail_loads,
         loads: run_acc
             .iter()
             .map(|a| a / run_t.max(f64::MIN_POSITIVE))
             .collect(),
-        contact: recorder.finish(),
-        max_tilt,
-        max_joint_drift: max_drift,
-        steps,
-        wall_time: start.elapsed(),
-    })
+        contact: run.contact,
+        max_tilt: world.max_tilt,
+        max_joint_drift: world.max_drift,
+        steps: run.steps,
+        wall_time: started.elapsed(),
+    }
+}
+
+/// Runs the problem (checked by the caller): [`start`], one push at a time,
+/// [`finish`].
+pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, ModelError> {
+    let started = Instant::now();
+    let mut stepping = start(problem, s)?;
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    let (world, run, applied) = stepping.finish();
+    Ok(finish(world, run, &applied, s, started))
 }

@@ -4,13 +4,13 @@
 //! listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys,
+    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
 use crate::predict::{JoltBox, JoltFeet};
-use crate::{JoltSettings, JoltSimulator, Scene, AVAILABLE};
+use crate::{JoltRun, JoltSettings, Scene, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the
 /// `oxijolt-sys` entry of the workspace's Cargo.toml).
@@ -125,33 +125,78 @@ impl Engine for JoltModel {
             "label": s.label(),
         })
     }
+    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = JoltSimulator::new(JoltSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The scene, settled, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
+    /// with the first push of `problem`'s schedule. Without the `jolt`
+    /// feature: [`ModelError::Integration`] with [`crate::UNAVAILABLE`].
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let started = std::time::Instant::now();
+        let settings = JoltSettings {
             dt,
             ..self.settings
-        })
-        .run(problem)?;
-        let mut diagnostics = serde_json::json!({
-            "steps": r.steps,
-            "max_joint_drift": r.max_joint_drift,
-            "max_tilt": r.max_tilt,
-            "max_lift": r.max_lift,
-            "rest_loads": r.rest_loads,
-            "manifold_sizes": r.manifold_sizes,
-            "mu": r.mu,
-        });
-        // `jolt_box`: per corner of its manifold, reported only when the
-        // corners are the supports (crate::JoltRun::loads).
-        if let Some(loads) = &r.loads {
-            diagnostics["loads"] = serde_json::json!(loads);
+        };
+        if let Err(e) = settings.check() {
+            return Some(Err(e));
         }
-        Ok(EngineRun {
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics,
-            trajectory: r.trajectory,
-            contact: r.contact,
-        })
+        #[cfg(feature = "jolt")]
+        {
+            use pushval_engine::stepping::{PlateFinish, PlateSession};
+            let stepping = match crate::world::start(problem, &settings) {
+                Ok(s) => s,
+                Err(e) => return Some(Err(e)),
+            };
+            let name = settings.scene.model_name().to_string();
+            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
+                let mut r = crate::world::finish(w, stepped, problem, &settings);
+                r.trajectory.model = name;
+                r.wall_time = started.elapsed();
+                Ok(engine_run(r, dt))
+            });
+            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+        }
+        #[cfg(not(feature = "jolt"))]
+        {
+            let _ = (problem, started);
+            Some(Err(ModelError::Integration {
+                t: 0.0,
+                reason: crate::UNAVAILABLE.into(),
+            }))
+        }
+    }
+}
+
+/// The engine's run of a Jolt run at time step `dt`.
+#[cfg_attr(not(feature = "jolt"), allow(dead_code))]
+fn engine_run(r: JoltRun, dt: f64) -> EngineRun {
+    let mut diagnostics = serde_json::json!({
+        "steps": r.steps,
+        "max_joint_drift": r.max_joint_drift,
+        "max_tilt": r.max_tilt,
+        "max_lift": r.max_lift,
+        "rest_loads": r.rest_loads,
+        "manifold_sizes": r.manifold_sizes,
+        "mu": r.mu,
+    });
+    // `jolt_box`: per corner of its manifold, reported only when the
+    // corners are the supports (crate::JoltRun::loads).
+    if let Some(loads) = &r.loads {
+        diagnostics["loads"] = serde_json::json!(loads);
+    }
+    EngineRun {
+        dt,
+        steps: r.steps,
+        wall_time: r.wall_time,
+        diagnostics,
+        trajectory: r.trajectory,
+        contact: r.contact,
     }
 }

@@ -2,7 +2,9 @@
 
 use std::f64::consts::{PI, TAU};
 
-use pushval_engine::stepping::{self, Plate, PlateWorld, StepLoop, SupportForces, TAIL};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLoop, Stepped, Stepping, SupportForces, TAIL,
+};
 use pushval_model::{Body, ModelError, Problem, Vec2};
 
 use crate::predict::{box_corners, friction_slip_angle};
@@ -258,8 +260,10 @@ fn jolt_error(what: &str) -> ModelError {
     }
 }
 
-/// Runs the problem in Jolt.
-pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, ModelError> {
+/// The scene of `problem` (checked by the caller) in Jolt, settled and
+/// given its start velocity (moving with the first push of its schedule
+/// unless it starts at rest), in the shared stepping loop.
+pub(crate) fn start(problem: &Problem, s: &JoltSettings) -> Result<Stepping<Stepper>, ModelError> {
     let body = &problem.body;
     let init = problem.initial;
     let mass = body.mass();
@@ -341,7 +345,11 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
 
     // Start moving with the first push at ω = initial.omega, unless from rest.
     if !init.from_rest {
-        let vc = problem.pushes[0].velocity();
+        let vc = problem
+            .pushes
+            .first()
+            .ok_or(ModelError::EmptySchedule)?
+            .velocity();
         let local = [vc.x + init.omega * pc.y, vc.y - init.omega * pc.x];
         let (sn, cs) = theta.sin_cos();
         world.set_velocity(
@@ -356,7 +364,7 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         st = world.state(world.object);
     }
 
-    let mut w = Stepper {
+    let w = Stepper {
         world,
         anchor,
         mass_inertia: (mass, iz),
@@ -364,12 +372,20 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         last: None,
         tail: Tail::new(n_sup),
         out: Tails::default(),
+        mu,
+        rest_loads,
+        manifold_sizes,
     };
     let cfg = StepLoop {
         forces_every_step: false,
         ..StepLoop::new(s.dt, n_sup, z_rest)
     };
-    let run = stepping::run_pushes(&mut w, problem, &cfg, (st, theta))?;
+    Ok(Stepping::new(w, problem, cfg, (st, theta)))
+}
+
+/// The run of the pushes applied (`problem`), from what the loop gathered.
+pub(crate) fn finish(w: Stepper, run: Stepped, problem: &Problem, s: &JoltSettings) -> JoltRun {
+    let body = &problem.body;
     let history = run.records();
     let tails = w.out;
     let contact = run.contact.clone().map(|mut c| {
@@ -380,16 +396,16 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
             .unwrap_or_default();
         c
     });
-    Ok(JoltRun {
+    JoltRun {
         trajectory: run.trajectory(problem),
         settings: *s,
         steps: run.steps,
         wall_time: Default::default(),
-        mu,
-        rest_loads,
+        mu: w.mu,
+        rest_loads: w.rest_loads,
         loads: support_loads(body, &w.targets, run.loads),
         contact,
-        manifold_sizes,
+        manifold_sizes: w.manifold_sizes,
         segment_tail_omega: run.segment_tail_omega,
         segment_tail_omega_std: run.segment_tail_omega_std,
         segment_tail_contacts: tails.contacts,
@@ -400,7 +416,18 @@ pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, M
         max_lift: run.max_lift,
         max_joint_drift: run.max_joint_drift,
         history,
-    })
+    }
+}
+
+/// Runs the problem in Jolt (checked by the caller): [`start`], one push at
+/// a time, [`finish`].
+pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, ModelError> {
+    let mut stepping = start(problem, s)?;
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    let (w, run, applied) = stepping.finish();
+    Ok(finish(w, run, &applied, s))
 }
 
 /// The sums of one segment's tail that only Jolt gathers.
@@ -431,8 +458,9 @@ struct Tails {
     load_range: Vec<Vec<[f64; 2]>>,
 }
 
-/// The scene as the shared stepping loop sees it.
-struct Stepper {
+/// The scene as the shared stepping loop sees it, with what the settle
+/// phase found.
+pub(crate) struct Stepper {
     world: World,
     /// The pusher's anchor in the object's frame.
     anchor: [f64; 3],
@@ -443,6 +471,12 @@ struct Stepper {
     last: Option<StepContacts>,
     tail: Tail,
     out: Tails,
+    /// The friction coefficient of every contact.
+    mu: f64,
+    /// The supports' loads at rest (N).
+    rest_loads: Vec<f64>,
+    /// The object–floor manifolds' sizes after the settle phase.
+    manifold_sizes: Vec<usize>,
 }
 
 impl PlateWorld for Stepper {
@@ -520,6 +554,10 @@ impl PlateWorld for Stepper {
             }
         }
         Ok(())
+    }
+
+    fn cm_velocity(&self, (st, _): &(BodyState, f64)) -> Option<[f64; 2]> {
+        Some([st.linear[0], st.linear[1]])
     }
 
     fn end_segment(&mut self, acc_t: f64, _t: f64) -> Result<(), ModelError> {

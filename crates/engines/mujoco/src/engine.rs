@@ -4,13 +4,13 @@
 //! available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys,
+    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
 use crate::theory::MujocoElliptic;
-use crate::{Cone, MujocoSettings, MujocoSimulator, AVAILABLE};
+use crate::{Cone, MujocoRun, MujocoSettings, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the
 /// `mujoco-rs` entry of the workspace's Cargo.toml, whose build metadata
@@ -125,26 +125,69 @@ impl Engine for MujocoModel {
             Cone::Pyramidal => None,
         }
     }
+    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = MujocoSimulator::new(MujocoSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The scene, settled and calibrated, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
+    /// with the first push of `problem`'s schedule. Without the `mujoco`
+    /// feature: [`ModelError::Integration`] with [`crate::UNAVAILABLE`].
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let started = std::time::Instant::now();
+        let settings = MujocoSettings {
             timestep: dt,
             ..self.settings
-        })
-        .run(problem)?;
-        Ok(EngineRun {
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "steps": r.steps,
-                "max_pusher_gap": r.max_pusher_gap,
-                "max_penetration": r.max_penetration,
-                "max_tilt": r.max_tilt,
-                "loads": r.loads,
-            }),
-            trajectory: r.trajectory,
-            contact: r.contact,
-        })
+        };
+        if let Err(e) = settings.check() {
+            return Some(Err(e));
+        }
+        #[cfg(feature = "mujoco")]
+        {
+            use pushval_engine::stepping::{PlateFinish, PlateSession};
+            let stepping = match crate::sim::start(problem, &settings) {
+                Ok(s) => s,
+                Err(e) => return Some(Err(e)),
+            };
+            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
+                let mut r = crate::sim::finish(w, stepped, problem, &settings, started);
+                r.trajectory.model = format!("mujoco_{}", settings.cone.as_str());
+                Ok(engine_run(r, dt))
+            });
+            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+        }
+        #[cfg(not(feature = "mujoco"))]
+        {
+            let _ = (problem, started);
+            Some(Err(ModelError::Integration {
+                t: 0.0,
+                reason: crate::UNAVAILABLE.into(),
+            }))
+        }
+    }
+}
+
+/// The engine's run of a MuJoCo run at time step `dt`.
+#[cfg_attr(not(feature = "mujoco"), allow(dead_code))]
+fn engine_run(r: MujocoRun, dt: f64) -> EngineRun {
+    EngineRun {
+        dt,
+        steps: r.steps,
+        wall_time: r.wall_time,
+        diagnostics: serde_json::json!({
+            "steps": r.steps,
+            "max_pusher_gap": r.max_pusher_gap,
+            "max_penetration": r.max_penetration,
+            "max_tilt": r.max_tilt,
+            "loads": r.loads,
+        }),
+        trajectory: r.trajectory,
+        contact: r.contact,
     }
 }
 

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use mujoco_rs::prelude::*;
 use pushval_engine::stepping::{
-    self, Plate, PlateWorld, StepClock, StepLoop, SupportForces, TailSteps, TailWeight,
+    Plate, PlateWorld, StepClock, StepLoop, Stepped, Stepping, SupportForces, TailSteps, TailWeight,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -90,9 +90,14 @@ fn check_warnings(data: &Data, t: f64) -> Result<(), ModelError> {
     Ok(())
 }
 
-/// Runs the problem (see the crate docs for the scene).
-pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<MujocoRun, ModelError> {
-    let start_time = Instant::now();
+/// The scene of `problem` (checked by the caller; see the crate docs),
+/// settled, calibrated and given its start velocity (moving with the first
+/// push of its schedule unless it starts at rest; the carriage moving with
+/// it), in the shared stepping loop.
+pub(crate) fn start(
+    problem: &Problem,
+    settings: &MujocoSettings,
+) -> Result<Stepping<Stepper>, ModelError> {
     let body = &problem.body;
     let n = body.len();
     let supports: Vec<(f64, f64, f64)> = body
@@ -148,7 +153,7 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
     // 2. The start: the only time the object's state is written.
     let init = problem.initial;
     let s0 = read(&data);
-    let first = problem.pushes[0];
+    let first = *problem.pushes.first().ok_or(ModelError::EmptySchedule)?;
     let command = |yaw: f64, push: &pushval_model::Push| -> [f64; 2] {
         let v = pushval_model::rotate(yaw, &push.velocity());
         [v.x, v.y]
@@ -187,14 +192,16 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         omega: if init.from_rest { 0.0 } else { init.omega },
     };
     let max_pen = max_penetration(&data);
-    let mut w = Stepper {
-        data: &mut data,
-        supports: &supports,
+    let w = Stepper {
+        data,
+        supports,
         h,
         loads: vec![0.0; n],
         max_gap: 0.0,
         max_pen,
         foot_speeds: Vec::new(),
+        rest_loads,
+        mu,
     };
     let cfg = StepLoop {
         forces_every_step: false,
@@ -203,7 +210,18 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         clock: StepClock::FromSegmentStart,
         ..StepLoop::new(settings.timestep, n, 0.0)
     };
-    let run = stepping::run_pushes(&mut w, problem, &cfg, start)?;
+    Ok(Stepping::new(w, problem, cfg, start))
+}
+
+/// The run of the pushes applied (`problem`), from what the loop gathered;
+/// `started` is when the run began.
+pub(crate) fn finish(
+    w: Stepper,
+    run: Stepped,
+    problem: &Problem,
+    settings: &MujocoSettings,
+    started: Instant,
+) -> MujocoRun {
     let (max_gap, max_pen) = (w.max_gap, w.max_pen);
     let history: Vec<MjStep> = run
         .history
@@ -230,12 +248,12 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         .skip(1)
         .map(|r| r.min_foot_speed)
         .fold(f64::INFINITY, f64::min);
-    Ok(MujocoRun {
+    MujocoRun {
         trajectory,
         settings: *settings,
         history,
-        rest_loads,
-        mu,
+        rest_loads: w.rest_loads,
+        mu: w.mu,
         tail_loads: run.segment_tail_loads,
         loads: run.loads,
         contact: run.contact,
@@ -245,13 +263,25 @@ pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<Mujoco
         max_penetration: max_pen,
         max_tilt: run.max_tilt,
         steps: run.steps,
-        wall_time: start_time.elapsed(),
-    })
+        wall_time: started.elapsed(),
+    }
+}
+
+/// Runs the problem (checked by the caller; see the crate docs for the
+/// scene): [`start`], one push at a time, [`finish`].
+pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<MujocoRun, ModelError> {
+    let started = Instant::now();
+    let mut stepping = start(problem, settings)?;
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    let (w, run, applied) = stepping.finish();
+    Ok(finish(w, run, &applied, settings, started))
 }
 
 /// The object as the stepping loop reads it.
 #[derive(Clone, Copy)]
-struct MjState {
+pub(crate) struct MjState {
     s: ObjState,
     /// Yaw, unwrapped (rad).
     theta: f64,
@@ -260,11 +290,12 @@ struct MjState {
     omega: f64,
 }
 
-/// The scene as the shared stepping loop sees it.
-struct Stepper<'a> {
-    data: &'a mut Data,
+/// The scene as the shared stepping loop sees it, with what the settle
+/// phase found.
+pub(crate) struct Stepper {
+    data: Data,
     /// Position and friction of each foot.
-    supports: &'a [(f64, f64, f64)],
+    supports: Vec<(f64, f64, f64)>,
     /// Height of the centre of mass (m).
     h: f64,
     /// The feet's normal forces after the last step (N).
@@ -273,13 +304,17 @@ struct Stepper<'a> {
     max_pen: f64,
     /// Per step, the smallest horizontal speed over the feet (m/s).
     foot_speeds: Vec<f64>,
+    /// Normal force of each foot at rest (N).
+    rest_loads: Vec<f64>,
+    /// The calibrated friction coefficient of each foot.
+    mu: Vec<f64>,
 }
 
-impl Stepper<'_> {
+impl Stepper {
     /// The smallest horizontal speed (m/s) over the feet.
     fn foot_speed(&self, s: &ObjState) -> f64 {
         let mut best = f64::INFINITY;
-        for &(px, py, _) in self.supports {
+        for &(px, py, _) in &self.supports {
             let l = [px, py, -self.h];
             let r = [
                 s.mat[0] * l[0] + s.mat[1] * l[1] + s.mat[2] * l[2],
@@ -294,7 +329,7 @@ impl Stepper<'_> {
     }
 }
 
-impl PlateWorld for Stepper<'_> {
+impl PlateWorld for Stepper {
     type State = MjState;
 
     fn plate(&self, st: &MjState) -> Plate {
@@ -328,7 +363,7 @@ impl PlateWorld for Stepper<'_> {
     }
 
     fn state(&mut self, prev: &MjState) -> MjState {
-        let s = read(self.data);
+        let s = read(&self.data);
         MjState {
             s,
             theta: prev.theta + wrap(s.yaw - prev.theta),
@@ -347,7 +382,7 @@ impl PlateWorld for Stepper<'_> {
             + (sx[0][2] - sx[1][2]).powi(2))
         .sqrt();
         self.max_gap = self.max_gap.max(gap);
-        self.max_pen = self.max_pen.max(max_penetration(self.data));
+        self.max_pen = self.max_pen.max(max_penetration(&self.data));
         let speed = self.foot_speed(&st.s);
         self.foot_speeds.push(speed);
     }
@@ -357,15 +392,19 @@ impl PlateWorld for Stepper<'_> {
         _: &MjState,
         _h: f64,
     ) -> Result<Option<SupportForces>, ModelError> {
-        foot_loads(self.data, self.supports.len(), &mut self.loads);
+        foot_loads(&self.data, self.supports.len(), &mut self.loads);
         Ok(Some(SupportForces {
             normal: self.loads.clone(),
             friction: None,
         }))
     }
 
+    fn cm_velocity(&self, st: &MjState) -> Option<[f64; 2]> {
+        Some([st.s.v[0], st.s.v[1]])
+    }
+
     fn end_segment(&mut self, _count: f64, t: f64) -> Result<(), ModelError> {
-        check_warnings(self.data, t)
+        check_warnings(&self.data, t)
     }
 }
 

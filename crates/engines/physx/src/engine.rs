@@ -4,13 +4,13 @@
 //! `physx` feature they are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys,
+    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys,
 };
 use pushval_model::{ModelError, Problem};
 
 use crate::predict::PhysxClamp;
-use crate::{FootContacts, FrictionType, PhysxSettings, PhysxSimulator, AVAILABLE};
+use crate::{FootContacts, FrictionType, PhysxRun, PhysxSettings, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the `physx`
 /// entry of the workspace's Cargo.toml; a test checks it against Cargo.lock).
@@ -138,28 +138,74 @@ impl Engine for PhysxModel {
             "label": s.label(),
         })
     }
+    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
+    /// time.
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        let r = PhysxSimulator::new(PhysxSettings {
+        run_via_session(self, problem, dt)
+    }
+    /// The scene, settled, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
+    /// with the first push of `problem`'s schedule. The session holds
+    /// PhysX's turn (one foundation per process) until it ends. Without the
+    /// `physx` feature: [`ModelError::Integration`] with
+    /// [`crate::UNAVAILABLE`].
+    fn session<'a>(
+        &'a self,
+        problem: &Problem,
+        dt: f64,
+    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+        let started = std::time::Instant::now();
+        let settings = PhysxSettings {
             dt,
             ..self.settings
-        })
-        .run(problem)?;
-        Ok(EngineRun {
-            dt,
-            steps: r.steps,
-            wall_time: r.wall_time,
-            diagnostics: serde_json::json!({
-                "steps": r.steps,
-                "max_joint_drift": r.max_joint_drift,
-                "max_tilt": r.max_tilt,
-                "max_lift": r.max_lift,
-                "rest_loads": r.rest_loads,
-                "mu": r.mu,
-                "loads": r.loads,
-            }),
-            trajectory: r.trajectory,
-            contact: r.contact,
-        })
+        };
+        if let Err(e) = settings.check() {
+            return Some(Err(e));
+        }
+        #[cfg(feature = "physx")]
+        {
+            use pushval_engine::stepping::{PlateFinish, PlateSession};
+            let stepping = match crate::world::start(problem, &settings) {
+                Ok(s) => s,
+                Err(e) => return Some(Err(e)),
+            };
+            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
+                let mut r = crate::world::finish(w, stepped, problem, &settings);
+                r.trajectory.model = settings.friction.model_name().to_string();
+                r.wall_time = started.elapsed();
+                Ok(engine_run(r, dt))
+            });
+            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+        }
+        #[cfg(not(feature = "physx"))]
+        {
+            let _ = (problem, started);
+            Some(Err(ModelError::Integration {
+                t: 0.0,
+                reason: crate::UNAVAILABLE.into(),
+            }))
+        }
+    }
+}
+
+/// The engine's run of a PhysX run at time step `dt`.
+#[cfg_attr(not(feature = "physx"), allow(dead_code))]
+fn engine_run(r: PhysxRun, dt: f64) -> EngineRun {
+    EngineRun {
+        dt,
+        steps: r.steps,
+        wall_time: r.wall_time,
+        diagnostics: serde_json::json!({
+            "steps": r.steps,
+            "max_joint_drift": r.max_joint_drift,
+            "max_tilt": r.max_tilt,
+            "max_lift": r.max_lift,
+            "rest_loads": r.rest_loads,
+            "mu": r.mu,
+            "loads": r.loads,
+        }),
+        trajectory: r.trajectory,
+        contact: r.contact,
     }
 }
 

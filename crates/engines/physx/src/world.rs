@@ -1,12 +1,14 @@
-//! The PhysX scene and its stepping loop (see the crate docs).
+//! The PhysX scene in the shared stepping loop (see the crate docs).
 
 use std::f64::consts::{PI, TAU};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 use physx::material::Material;
 use physx::prelude::*;
 use physx::traits::Class;
-use pushval_engine::stepping::{self, Plate, PlateWorld, StepLoop, SupportForces, TAIL};
+use pushval_engine::stepping::{
+    Plate, PlateWorld, StepLoop, Stepped, Stepping, SupportForces, TAIL,
+};
 use pushval_model::{ModelError, Problem};
 
 use crate::sys;
@@ -112,7 +114,7 @@ fn raw(t: PxTransform) -> physx_sys::PxTransform {
 
 /// The object's state as read from the engine.
 #[derive(Clone, Copy)]
-struct State {
+pub(crate) struct State {
     pose: PxTransform,
     vel: [f64; 3],
     theta: f64,
@@ -167,18 +169,66 @@ fn physx_error(what: &str) -> ModelError {
     }
 }
 
-/// Runs the problem.
-pub(crate) fn simulate(problem: &Problem, s: &PhysxSettings) -> Result<PhysxRun, ModelError> {
-    let _turn = FOUNDATION.lock().unwrap_or_else(|e| e.into_inner());
+/// The scene of `problem` (checked by the caller) in PhysX, settled and
+/// given its start velocity (moving with the first push of its schedule
+/// unless it starts at rest), in the shared stepping loop. The loop's world
+/// holds PhysX's turn (one foundation per process) until it is dropped.
+pub(crate) fn start(problem: &Problem, s: &PhysxSettings) -> Result<Stepping<Stepper>, ModelError> {
+    let turn = FOUNDATION.lock().unwrap_or_else(|e| e.into_inner());
     let body = &problem.body;
     let mu = body.total_friction() / (body.mass() * s.gravity);
     let mut physics = PhysicsFoundation::<physx::foundation::DefaultAllocator, PxShape>::default();
-    let run = World::new(&mut physics, problem, s, mu).and_then(|mut w| {
-        let settled = w.settle(problem, s)?;
-        w.push(problem, s, settled, mu)
-    });
-    drop(physics);
-    run
+    // Dropped before `physics` on an early return (declared after it).
+    let mut world = World::new(&mut physics, problem, s, mu)?;
+    let settled = world.settle(problem, s)?;
+    let (state, cfg) = world.start(problem, s, settled.state)?;
+    let w = Stepper {
+        world,
+        _physics: physics,
+        _turn: turn,
+        loads: Vec::new(),
+        acc_f: [0.0; 2],
+        tail_force: Vec::new(),
+        mu,
+        rest_loads: settled.loads,
+    };
+    Ok(Stepping::new(w, problem, cfg, state))
+}
+
+/// The run of the pushes applied (`problem`), from what the loop gathered.
+pub(crate) fn finish(w: Stepper, run: Stepped, problem: &Problem, s: &PhysxSettings) -> PhysxRun {
+    let mu = w.mu;
+    PhysxRun {
+        trajectory: run.trajectory(problem),
+        settings: *s,
+        steps: run.steps,
+        wall_time: Default::default(),
+        mu,
+        engine_friction: w.rest_loads.iter().map(|n| mu * n).collect(),
+        rest_loads: w.rest_loads.clone(),
+        segment_tail_omega: run.segment_tail_omega,
+        segment_tail_omega_std: run.segment_tail_omega_std,
+        segment_tail_loads: run.segment_tail_loads,
+        loads: run.loads,
+        contact: run.contact,
+        segment_tail_pusher_force: w.tail_force.clone(),
+        min_loads: run.min_loads,
+        max_tilt: run.max_tilt,
+        max_lift: run.max_lift,
+        max_joint_drift: run.max_joint_drift,
+        history: run.history,
+    }
+}
+
+/// Runs the problem (checked by the caller): [`start`], one push at a time,
+/// [`finish`].
+pub(crate) fn simulate(problem: &Problem, s: &PhysxSettings) -> Result<PhysxRun, ModelError> {
+    let mut stepping = start(problem, s)?;
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    let (w, run, applied) = stepping.finish();
+    Ok(finish(w, run, &applied, s))
 }
 
 /// A built scene. Dropped in PhysX's order: the joint, the scene with its
@@ -406,23 +456,26 @@ impl World {
         Ok(Settled { state, loads })
     }
 
-    /// The push schedule, from the settled state.
-    fn push(
+    /// The start of the push from the settled state `state`: moving with
+    /// the first push at ω = initial.omega, unless from rest. Returns the
+    /// state and the loop's settings.
+    fn start(
         &mut self,
         problem: &Problem,
         s: &PhysxSettings,
-        settled: Settled,
-        mu: f64,
-    ) -> Result<PhysxRun, ModelError> {
+        mut state: State,
+    ) -> Result<(State, StepLoop), ModelError> {
         let init = problem.initial;
         let n_feet = problem.body.len();
         let pc = problem.body.contact();
-        let mut state = settled.state;
         let z_rest = state.position()[2];
 
-        // Start: moving with the first push at ω = initial.omega, unless from rest.
         if !init.from_rest {
-            let vc = problem.pushes[0].velocity();
+            let vc = problem
+                .pushes
+                .first()
+                .ok_or(ModelError::EmptySchedule)?
+                .velocity();
             let local = [vc.x + init.omega * pc.y, vc.y - init.omega * pc.x];
             let (sn, cs) = state.theta.sin_cos();
             let o = actor(self.scene(), OBJECT);
@@ -437,41 +490,19 @@ impl World {
             o.set_angular_velocity(&v3(0.0, 0.0, init.omega), true);
             state.omega = init.omega;
         }
-
-        let cfg = StepLoop::new(s.dt, n_feet, z_rest);
-        let mut w = Stepper {
-            world: self,
-            loads: Vec::new(),
-            acc_f: [0.0; 2],
-            tail_force: Vec::new(),
-        };
-        let run = stepping::run_pushes(&mut w, problem, &cfg, state)?;
-        Ok(PhysxRun {
-            trajectory: run.trajectory(problem),
-            settings: *s,
-            steps: run.steps,
-            wall_time: Default::default(),
-            mu,
-            engine_friction: settled.loads.iter().map(|n| mu * n).collect(),
-            rest_loads: settled.loads,
-            segment_tail_omega: run.segment_tail_omega,
-            segment_tail_omega_std: run.segment_tail_omega_std,
-            segment_tail_loads: run.segment_tail_loads,
-            loads: run.loads,
-            contact: run.contact,
-            segment_tail_pusher_force: w.tail_force,
-            min_loads: run.min_loads,
-            max_tilt: run.max_tilt,
-            max_lift: run.max_lift,
-            max_joint_drift: run.max_joint_drift,
-            history: run.history,
-        })
+        Ok((state, StepLoop::new(s.dt, n_feet, z_rest)))
     }
 }
 
-/// The scene as the shared stepping loop sees it.
-struct Stepper<'a> {
-    world: &'a mut World,
+/// The scene as the shared stepping loop sees it: the world, the
+/// foundation it was built in and PhysX's turn (dropped in that order), and
+/// what the settle phase found.
+pub(crate) struct Stepper {
+    world: World,
+    /// Dropped after the world.
+    _physics: PhysicsFoundation<physx::foundation::DefaultAllocator, PxShape>,
+    /// Released last.
+    _turn: MutexGuard<'static, ()>,
     /// The feet's normal forces over the last step (N).
     loads: Vec<f64>,
     /// The current segment's tail integral of the pusher's force on the
@@ -479,9 +510,14 @@ struct Stepper<'a> {
     acc_f: [f64; 2],
     /// Per segment, that force's tail mean (N).
     tail_force: Vec<[f64; 2]>,
+    /// The friction coefficient of every foot.
+    mu: f64,
+    /// Mean normal force of each foot over the last 20 % of the settle
+    /// phase (N).
+    rest_loads: Vec<f64>,
 }
 
-impl PlateWorld for Stepper<'_> {
+impl PlateWorld for Stepper {
     type State = State;
 
     fn plate(&self, st: &State) -> Plate {
@@ -528,6 +564,10 @@ impl PlateWorld for Stepper<'_> {
         self.acc_f[0] -= (cs * f[0] + sn * f[1]) * h;
         self.acc_f[1] -= (-sn * f[0] + cs * f[1]) * h;
         Ok(())
+    }
+
+    fn cm_velocity(&self, st: &State) -> Option<[f64; 2]> {
+        Some([st.vel[0], st.vel[1]])
     }
 
     fn end_segment(&mut self, acc_t: f64, _t: f64) -> Result<(), ModelError> {
