@@ -560,7 +560,21 @@ fn write_outputs(
     dir.figure("success.svg", &success_figure(names, speeds, &summary))?;
     let paths = paths_figure(problem, names, goals, speeds)?;
     dir.figure("paths.svg", &paths)?;
-    let readme = readme(problem, names, speeds, goals.len(), &summary, quick);
+    let mut failed_runs: BTreeMap<String, usize> = BTreeMap::new();
+    for (t, r) in list.iter().zip(rows) {
+        if r[6] == 1.0 {
+            *failed_runs.entry(t.engine.clone()).or_default() += 1;
+        }
+    }
+    let readme = readme(
+        problem,
+        names,
+        speeds,
+        goals.len(),
+        &summary,
+        &failed_runs,
+        quick,
+    );
     dir.file("README.md", readme.as_bytes())?;
     Ok(())
 }
@@ -788,6 +802,7 @@ fn readme(
     speeds: &[f64],
     goals: usize,
     summary: &BTreeMap<Group, (usize, usize, f64, f64)>,
+    failed_runs: &BTreeMap<String, usize>,
     quick: bool,
 ) -> String {
     let vmax = speeds.iter().copied().fold(f64::MIN, f64::max);
@@ -863,8 +878,14 @@ fn readme(
                 law.clone().unwrap_or_else(|| "it declares no law in closed form".into())
             )
         };
+        let errors = match failed_runs.get(n.as_str()).copied().unwrap_or(0) {
+            0 => String::new(),
+            k => format!(
+                " {k} of its runs ended with an engine error and count as misses (`runs.csv`, column `error`; the study prints the message)."
+            ),
+        };
         s.push_str(&format!(
-            "- **{n}** ({}/{tot} open, {}/{tot} MPC, {}/{tot} MPC on the perturbed plant): {why}.\n",
+            "- **{n}** ({}/{tot} open, {}/{tot} MPC, {}/{tot} MPC on the perturbed plant): {why}.{errors}\n",
             ok_open, ok_mpc, ok_mpc_p
         ));
     }
