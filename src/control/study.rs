@@ -197,6 +197,9 @@ pub fn engines(only: Option<&str>) -> anyhow::Result<Vec<String>> {
                 }
                 out.push(name.to_string());
             }
+            if out.is_empty() {
+                bail!("--only `{list}` names no engine (a comma-separated list of names from `pushval engines`)");
+            }
             Ok(out)
         }
     }

@@ -449,3 +449,30 @@ fn a_shard_needs_only_its_own_engines() {
     let err = String::from_utf8_lossy(&merge.stderr);
     assert!(err.contains("2/2"), "{err}");
 }
+
+/// A `--only` list that names nothing, an unknown engine or one engine
+/// twice is bad input: exit 2 naming the flag, nothing written.
+#[test]
+fn control_study_only_lists_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("study");
+    for (list, says) in [
+        (",", "names no engine"),
+        ("no_such_engine", "no_such_engine"),
+        ("rapier2d,rapier2d", "named twice"),
+    ] {
+        let st = pushval()
+            .current_dir(root())
+            .args(["control-study", "--quick", "--only", list, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(st.status.code(), Some(2), "{list}");
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert!(
+            err.contains("--only") && err.contains(says),
+            "{list}: {err}"
+        );
+        assert!(!out.exists(), "{list} wrote {}", out.display());
+    }
+}
