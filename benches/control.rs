@@ -13,9 +13,10 @@
 
 use criterion::{criterion_group, BatchSize, BenchmarkId, Criterion};
 use pushval::control::mpc::PlantScale;
-use pushval::control::plan::{straight_time, Motion, PlanSpec, Planner, Start};
+use pushval::control::plan::{straight_time, PlanSpec, Planner};
+use pushval::control::predict::{Motion, Start};
 use pushval::control::study::{goals, scene};
-use pushval::control::{Predictor, Reach};
+use pushval::control::{ModelKind as Predictor, Reach};
 use pushval_engine::EngineState;
 use pushval_model::{DynamicModel, Simulator, Vec2};
 
@@ -127,7 +128,8 @@ fn control(c: &mut Criterion) {
 /// of the dynamic predictor with rapier2d as the perturbed plant (20 goals
 /// at 1 m/s; `loop.json`'s `predictor_us_*` over the pooled periods).
 fn cost_table() {
-    use pushval::control::mpc::{median_p99, run_loop, LoopSpec};
+    use pushval::control::mpc::{run_loop, LoopSpec};
+    use pushval::control::stats::median_p99;
     let problem = scene().unwrap();
     let speeds = [0.1, 0.5, 1.0];
     let goals = goals(&problem, &speeds, 20);
@@ -167,17 +169,20 @@ fn cost_table() {
                 predictor: Predictor::Dynamic,
             },
             period: 0.02,
-            plant: PlantScale::PERTURBED,
             reach,
         };
-        let out = run_loop(&problem, engine.as_ref(), engine.default_dt(), *goal, spec).unwrap();
+        let plant = PlantScale::PERTURBED.apply(&problem).unwrap();
+        let dt = engine.default_dt();
+        let mut session = engine.start(&plant, dt).unwrap();
+        let out = run_loop(&problem, session.as_mut(), dt, *goal, spec, &mut ()).unwrap();
         period_us.extend(out.predictor_us);
         period_cpu_us.extend(out.predictor_cpu_us);
         reached += usize::from(out.success);
     }
-    let (pm, pp) = median_p99(&plan_us);
-    let (mm, mp) = median_p99(&period_us);
-    let (cm, cp) = median_p99(&period_cpu_us);
+    let nan = (f64::NAN, f64::NAN);
+    let (pm, pp) = median_p99(&plan_us).unwrap_or(nan);
+    let (mm, mp) = median_p99(&period_us).unwrap_or(nan);
+    let (cm, cp) = median_p99(&period_cpu_us).unwrap_or(nan);
     let load = std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|l| l.split_whitespace().next().map(str::to_string))

@@ -579,12 +579,12 @@ fn main() {
     // writing each document to its closing line, and reading the answers)
     // less the adapter's stepping in them.
     {
-        use pushval::control::mpc::{plan_from_rest, run_loop, LoopSpec, PlantScale};
+        use pushval::control::mpc::{plan_from_rest, run_loop, LoopSpec};
         use pushval::control::plan::PlanSpec;
-        use pushval::control::{Goal, Predictor, Reach};
+        use pushval::control::{ModelKind as Predictor, Reach};
         let text = std::fs::read_to_string(root().join(SCENARIO)).unwrap();
         let loop_problem = pushval::control::cli::problem_from_rest(&sc, &text);
-        let goal = Goal::parse(GOAL).unwrap();
+        let goal = pushval::control::parse_goal(GOAL).unwrap();
         let spec = LoopSpec {
             plan: PlanSpec {
                 segments: 6,
@@ -592,7 +592,6 @@ fn main() {
                 predictor: Predictor::Dynamic,
             },
             period: PERIOD,
-            plant: PlantScale::default(),
             reach: Reach::default(),
         };
         let plan_time = time(runs, || {
@@ -605,16 +604,19 @@ fn main() {
         let mut periods_run = 0;
         for _ in 0..runs {
             let s = Instant::now();
-            let out = run_loop(&loop_problem, &session, DT, goal, spec).unwrap();
+            let engine: &dyn pushval_engine::Engine = &session;
+            let mut plant = engine.start(&loop_problem, DT).unwrap();
+            let out = run_loop(&loop_problem, plant.as_mut(), DT, goal, spec, &mut ()).unwrap();
+            let run = plant.finish().unwrap();
             walls.push(s.elapsed().as_secs_f64());
             assert!(out.success, "the loop reaches its goal");
             assert!(!out.replayed, "the session steps");
             assert_eq!(
-                out.run.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
+                run.diagnostics["session"]["pid"], warm.diagnostics["session"]["pid"],
                 "one process served every run"
             );
             planning.push(plan_time.0 + out.predictor_us.iter().sum::<f64>() * 1e-6);
-            let d = &out.run.diagnostics;
+            let d = &run.diagnostics;
             requests.push(
                 d["process_wall_time_s"].as_f64().unwrap()
                     + d["parse_resample_time_s"].as_f64().unwrap(),

@@ -280,11 +280,15 @@ enum Command {
     },
     /// A push schedule that takes the object from the scenario's start to a
     /// goal pose on a model: DIR/plan.toml (a scenario: `run`, `validate`
-    /// and `study` take it) and DIR/plan.json (errors, solve time, the
-    /// model's assumption checks along the plan, each switch's impulse
-    /// against the contact's friction cone). Exit 1 when no plan reaches
-    /// the goal (the nearest pose and why are printed).
+    /// and `study` take it) and DIR/plan.json (errors, solve time, what the
+    /// search tried, the model's assumption checks along the plan, each
+    /// switch's impulse against the contact's friction cone). Exit 1 when
+    /// no plan reaches the goal (then no plan.toml; the nearest pose and
+    /// why are printed), 2 when the goal or speed is out of range.
     Plan {
+        /// The scenario file: the plate, its supports, the contact and the
+        /// start (its pushes are replaced by the plan's).
+        #[arg(value_name = "FILE")]
         file: PathBuf,
         #[command(flatten)]
         goal: GoalArgs,
@@ -292,18 +296,30 @@ enum Command {
     /// Model-predictive control: every period, re-plan from the engine's
     /// measured state (pose, ω, the centre of mass's velocity) and apply
     /// the next period in the engine. Writes DIR/trajectory.csv (with the
-    /// applied push) and DIR/loop.json. Exit 1 on a miss.
+    /// applied push), DIR/loop.json and DIR/applied.toml (the scenario the
+    /// plant ran: `pushval run` on it reproduces the plant's trajectory).
+    /// Exit 1 on a miss.
     Loop {
+        /// The scenario file: the plate, its supports, the contact, the
+        /// start and the engine settings (its pushes are not used).
+        #[arg(value_name = "FILE")]
         file: PathBuf,
         #[command(flatten)]
         goal: GoalArgs,
         /// The plant: an engine of `pushval engines`.
         #[arg(long, value_name = "NAME")]
         engine: String,
-        /// Control period (s).
-        #[arg(long, default_value_t = 0.02, value_name = "S")]
+        /// Control period (s): rounded to whole steps of the plant, and at
+        /// least one step.
+        #[arg(
+            long,
+            default_value_t = 0.02,
+            value_name = "S",
+            allow_negative_numbers = true
+        )]
         period: f64,
-        /// Perturb the engine's scene only: mu_scale=A,inertia_scale=B.
+        /// Perturb the engine's scene only: mu_scale=A,inertia_scale=B
+        /// [default: the file's scene].
         #[arg(long, value_name = "mu_scale=A,inertia_scale=B")]
         plant: Option<String>,
     },
@@ -335,20 +351,23 @@ struct GoalArgs {
     /// The goal: the centre of mass's world position and the angle (m, m, rad).
     #[arg(long, value_name = "X,Y,THETA", allow_hyphen_values = true)]
     goal: String,
-    /// Pusher speed (m/s); default the file's first push speed.
-    #[arg(long, value_name = "V")]
+    /// Pusher speed (m/s), 0.001 to 20 [default: the file's first push speed].
+    #[arg(long, value_name = "V", allow_negative_numbers = true)]
     speed: Option<f64>,
-    /// Number of pushes of equal duration.
+    /// Number of pushes of equal duration (1 to 12); when no plan of this
+    /// many reaches the goal, the search tries more, up to 12.
     #[arg(long, default_value_t = 6, value_name = "N")]
     segments: usize,
     /// The model the plan is made on: dynamic, kinematic or limit_surface.
-    #[arg(long, default_value = "dynamic")]
+    #[arg(long, default_value = "dynamic", value_name = "MODEL")]
     predictor: String,
-    /// Success: final position and angle within POS (m) and ANGLE (rad).
+    /// Success: final position and angle within POS (m) and ANGLE (rad)
+    /// [default: 0.02,0.0872664626 (20 mm, 5°)].
     #[arg(long, value_name = "POS,ANGLE")]
     tolerance: Option<String>,
-    /// Output folder (created if missing).
-    #[arg(long)]
+    /// Output folder: written whole into a fresh folder and renamed into
+    /// place (what was there before is replaced).
+    #[arg(long, value_name = "DIR")]
     out: PathBuf,
 }
 

@@ -1,16 +1,25 @@
 //! The `plan` and `loop` commands: argument checks, outputs, exit codes.
+//!
+//! Each writes its folder whole ([`FreshDir`]): a fresh temporary folder
+//! renamed into place at the end, so an output folder never mixes files of
+//! two runs. `plan` writes `plan.toml` only when the plan reaches the goal;
+//! `loop` writes `loop.json` (success or not, with the reason of a failure),
+//! `trajectory.csv` and `applied.toml` (the scenario the plant ran).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{bail, Context};
+use anyhow::Context;
+use pushval_control::mpc::{push_at, run_loop, LoopOutcome, LoopSpec, PlantScale};
+use pushval_control::plan::{describe_attempts, make_plan, Bounds, PlanSpec};
+use pushval_control::stats::median_p99;
+use pushval_control::{ControlError, Goal, Reach};
 use pushval_engine::Engine;
+use pushval_model::Push;
 use serde_json::json;
 
-use super::mpc::{median_p99, run_loop, trajectory_csv, LoopSpec, PlantScale};
-use super::plan::{make_plan, plan_toml, PlanSpec};
-use super::{Goal, Predictor, Reach};
-use crate::atomic::write_atomic;
+use super::{parse_goal, parse_model, parse_plant_scale, parse_reach};
+use crate::atomic::FreshDir;
 use crate::outdir::json_num;
 
 /// The arguments both commands share.
@@ -33,6 +42,7 @@ pub struct Common {
 
 struct Parsed {
     sc: pushval_scenario::Scenario,
+    text: String,
     /// The scenario's problem, at rest at the start unless the file's
     /// `[initial]` sets `from_rest`.
     problem: pushval_model::Problem,
@@ -46,30 +56,59 @@ fn parse(c: &Common) -> anyhow::Result<Parsed> {
     let text = std::fs::read_to_string(&c.file)
         .with_context(|| format!("{}: cannot read", c.file.display()))?;
     let problem = problem_from_rest(&sc, &text);
-    let goal = Goal::parse(&c.goal)?;
-    let predictor = Predictor::parse(&c.predictor)?;
-    let speed = c.speed.unwrap_or(sc.pushes[0].speed);
-    if !(speed.is_finite() && speed > 0.0) {
-        bail!("--speed must be finite and > 0, got {speed}");
-    }
-    if !(1..=64).contains(&c.segments) {
-        bail!("--segments must be 1 to 64, got {}", c.segments);
-    }
+    let goal = parse_goal(&c.goal)?;
+    let predictor = parse_model(&c.predictor)?;
+    let speed = match (c.speed, sc.pushes.first()) {
+        (Some(v), _) => v,
+        (None, Some(p)) => p.speed,
+        (None, None) => anyhow::bail!(
+            "{}: the file has no [[push]] to take a speed from: give --speed",
+            c.file.display()
+        ),
+    };
     let reach = match &c.tolerance {
-        Some(t) => Reach::parse(t)?,
+        Some(t) => parse_reach(t)?,
         None => Reach::default(),
     };
+    let spec = PlanSpec {
+        segments: c.segments,
+        speed,
+        predictor,
+    };
+    // Refused here, before any work: speeds, goals and plan lengths out of
+    // range.
+    Bounds::default()
+        .check(
+            &pushval_control::predict::Start::of_problem(&problem),
+            &goal,
+            &spec,
+        )
+        .map_err(|e| flag_error(e, c))?;
     Ok(Parsed {
         sc,
+        text,
         problem,
         goal,
-        spec: PlanSpec {
-            segments: c.segments,
-            speed,
-            predictor,
-        },
+        spec,
         reach,
     })
+}
+
+/// A setting error worded with the flag a user gave.
+fn flag_error(e: ControlError, c: &Common) -> anyhow::Error {
+    match e {
+        ControlError::Setting { name, .. } if name.starts_with("push speed") => {
+            anyhow::anyhow!("--speed: {e}")
+        }
+        ControlError::Setting { name, .. } if name.starts_with("pushes per plan") => {
+            anyhow::anyhow!("--segments: {e}")
+        }
+        ControlError::Setting { name, .. } if name.starts_with("control period") => {
+            anyhow::anyhow!("--period: {e}")
+        }
+        ControlError::GoalOutOfRange(_) => anyhow::anyhow!("--goal {}: {e}", c.goal),
+        e => anyhow::Error::new(e),
+    }
 }
 
 /// The scenario's problem with `from_rest = true` unless the file's
@@ -86,37 +125,83 @@ pub fn problem_from_rest(sc: &pushval_scenario::Scenario, text: &str) -> pushval
     problem
 }
 
+/// `text` (a scenario) with `pushes` as its schedule, the start set to
+/// rest unless the file's `[initial]` says otherwise, and `note` appended to
+/// its description.
+pub fn with_schedule(
+    text: &str,
+    file: &std::path::Path,
+    pushes: &[Push],
+    note: &str,
+) -> anyhow::Result<toml::Table> {
+    let mut doc: toml::Table =
+        toml::from_str(text).with_context(|| format!("{}: not TOML", file.display()))?;
+    let arr: Vec<toml::Value> = pushes
+        .iter()
+        .map(|p| {
+            let mut t = toml::Table::new();
+            t.insert("duration".into(), toml::Value::Float(p.duration));
+            t.insert("speed".into(), toml::Value::Float(p.speed));
+            t.insert("phi".into(), toml::Value::Float(p.phi));
+            toml::Value::Table(t)
+        })
+        .collect();
+    doc.insert("push".into(), toml::Value::Array(arr));
+    let initial = doc
+        .entry("initial")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let toml::Value::Table(t) = initial {
+        t.entry("from_rest").or_insert(toml::Value::Boolean(true));
+    }
+    if let Some(toml::Value::String(d)) = doc.get_mut("description") {
+        *d = format!("{d} | {note}");
+    }
+    Ok(doc)
+}
+
 /// `pushval plan`.
 pub fn plan(c: &Common) -> anyhow::Result<ExitCode> {
     let p = parse(c)?;
-    let problem = p.problem.clone();
-    let outcome = make_plan(&problem, p.goal, p.spec, p.reach)?;
+    let outcome = match make_plan(&p.problem, p.goal, p.spec, p.reach, &Bounds::default()) {
+        Ok(o) => o,
+        Err(e @ ControlError::PredictorFailed(_)) => {
+            let dir = FreshDir::new(&c.out)?;
+            let doc = json!({
+                "scenario": c.file.display().to_string(),
+                "goal": {"x": p.goal.x, "y": p.goal.y, "theta": p.goal.theta},
+                "reached": false,
+                "error": e.to_string(),
+            });
+            dir.write("plan.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+            dir.commit()?;
+            eprintln!("no plan: {e}");
+            return Ok(ExitCode::from(1));
+        }
+        Err(e) => return Err(flag_error(e, c)),
+    };
     let s = &outcome.solution;
-    let text = std::fs::read_to_string(&c.file)
-        .with_context(|| format!("{}: cannot read", c.file.display()))?;
-    let toml_text = plan_toml(&text, &c.file, &s.pushes, &p.goal, &p.spec)?;
-    // The plan must load as a scenario: the same checks as any file.
-    crate::registry::from_toml(&toml_text, &c.out.join("plan.toml"))
-        .context("the written plan does not load as a scenario (a bug)")?;
     let a = &outcome.assumptions;
     let violation = |v: &Option<pushval_model::Violation>| {
         v.map(|v| json!({"first_t": v.first_t, "worst": json_num(v.worst), "segment": v.segment}))
     };
     let slipping: Vec<_> = outcome.switches.iter().filter(|w| !w.inside).collect();
+    let duration: f64 = s.pushes.iter().map(|q| q.duration).sum();
     let doc = json!({
         "scenario": c.file.display().to_string(),
         "goal": {"x": p.goal.x, "y": p.goal.y, "theta": p.goal.theta},
+        "tolerance": {"position_m": p.reach.position, "angle_rad": p.reach.angle},
         "predictor": p.spec.predictor.as_str(),
         "speed": p.spec.speed,
+        "reached": outcome.reached,
         "converged": s.converged,
-        "reached": p.reach.holds(s.position_error, s.angle_error),
         "position_error_m": json_num(s.position_error),
         "angle_error_rad": json_num(s.angle_error),
         "final_pose": {"x": s.pose[0], "y": s.pose[1], "theta": s.pose[2]},
-        "duration_s": s.pushes.iter().map(|q| q.duration).sum::<f64>(),
+        "duration_s": duration,
         "solve_ms": outcome.solve_ms,
         "model_runs": outcome.runs,
         "iterations": s.iterations,
+        "attempts": outcome.attempts,
         "segments": s.pushes.iter().map(|q| json!({"duration": q.duration, "speed": q.speed, "phi": q.phi})).collect::<Vec<_>>(),
         "why_missed": outcome.why,
         "checks": {
@@ -133,25 +218,43 @@ pub fn plan(c: &Common) -> anyhow::Result<ExitCode> {
             "switches_outside_friction_cone": slipping.len(),
         },
     });
-    std::fs::create_dir_all(&c.out).with_context(|| format!("creating {}", c.out.display()))?;
-    write_atomic(&c.out.join("plan.toml"), toml_text.as_bytes())?;
-    write_atomic(
-        &c.out.join("plan.json"),
-        serde_json::to_string_pretty(&doc)?.as_bytes(),
-    )?;
+    let dir = FreshDir::new(&c.out)?;
+    if outcome.reached {
+        let note = format!(
+            "plan: {} pushes at {} m/s to {}, made on the {} model",
+            s.pushes.len(),
+            p.spec.speed,
+            p.goal,
+            p.spec.predictor.as_str()
+        );
+        let doc = with_schedule(&p.text, &c.file, &s.pushes, &note)?;
+        let toml_text = format!(
+            "# Written by `pushval plan`: the goal {} ({} predictor).\n{}",
+            p.goal,
+            p.spec.predictor.as_str(),
+            toml::to_string(&doc)?
+        );
+        // The plan must load as a scenario: the same checks as any file.
+        crate::registry::from_toml(&toml_text, &c.out.join("plan.toml"))
+            .context("the written plan does not load as a scenario (a bug)")?;
+        dir.write("plan.toml", toml_text.as_bytes())?;
+    }
+    dir.write("plan.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+    dir.commit()?;
     println!(
-        "plan ({} model, {} pushes at {} m/s, {:.3} s): final pose {:.4} m, {:.4} m, {:.4} rad; {:.2e} m and {:.2e} rad from the goal; solved in {:.3} ms ({} model runs)",
+        "plan ({} model, {} pushes at {} m/s, {:.3} s): final pose {:.4} m, {:.4} m, {:.4} rad; {:.2e} m and {:.2e} rad from the goal; solved in {:.3} ms ({} model runs; tried {})",
         p.spec.predictor.as_str(),
-        p.spec.segments,
+        s.pushes.len(),
         p.spec.speed,
-        s.pushes.iter().map(|q| q.duration).sum::<f64>(),
+        duration,
         s.pose[0],
         s.pose[1],
         s.pose[2],
         s.position_error,
         s.angle_error,
         outcome.solve_ms,
-        outcome.runs
+        outcome.runs,
+        describe_attempts(&outcome.attempts),
     );
     if !a.all_hold() {
         eprintln!(
@@ -159,24 +262,29 @@ pub fn plan(c: &Common) -> anyhow::Result<ExitCode> {
             c.out.join("plan.json").display()
         );
     }
-    for w in &slipping {
+    for w in slipping.iter().filter(|_| outcome.reached) {
         eprintln!(
-            "warning: the switch into push {} at t = {:.3} s needs an impulse {:.3} rad outside the contact's normal cone (friction angle {:.3} rad): the pusher slips there unless φ ramps over {}",
+            "warning: the switch into push {} at t = {:.3} s needs an impulse {:.3} rad outside the contact's normal cone{}: the pusher slips there unless φ ramps over {}",
             w.segment,
             w.t,
             w.cone_angle_rad,
-            w.friction_angle_rad.unwrap_or(f64::NAN),
+            w.friction_angle_rad
+                .map_or(String::new(), |f| format!(" (friction angle {f:.3} rad)")),
             w.ramp_s.map_or("no ramp (the steady force is outside the cone too)".to_string(), |r| format!("{:.1} ms", r * 1e3))
         );
     }
-    println!(
-        "wrote {} and {}",
-        c.out.join("plan.toml").display(),
-        c.out.join("plan.json").display()
-    );
-    if s.converged || p.reach.holds(s.position_error, s.angle_error) {
+    if outcome.reached {
+        println!(
+            "wrote {} and {}",
+            c.out.join("plan.toml").display(),
+            c.out.join("plan.json").display()
+        );
         Ok(ExitCode::SUCCESS)
     } else {
+        println!(
+            "wrote {} (no plan.toml: no plan reaches the goal)",
+            c.out.join("plan.json").display()
+        );
         eprintln!(
             "no plan reaches {}: nearest pose x {:.4} m, y {:.4} m, θ {:.4} rad ({:.4} m, {:.4} rad away): {}",
             p.goal,
@@ -206,79 +314,204 @@ pub fn engine_of(
         .build(&crate::registry::engine_options(sc))
         .map_err(|e| anyhow::anyhow!("{}: [engine]: {e}", sc.path.display()))?;
     if let Err(why) = engine.availability() {
-        bail!("--engine {name}: not available in this build: {why}");
+        anyhow::bail!("--engine {name}: not available in this build: {why}");
     }
     let dt = sc.engine.dt.unwrap_or(engine.default_dt());
     Ok((engine, dt))
+}
+
+/// `text` (the scenario the loop read) as the scenario its plant ran: the
+/// plant's friction and inertia, `engine` at `dt`, and the pushes applied.
+fn applied_toml(
+    p: &Parsed,
+    file: &std::path::Path,
+    plant: &PlantScale,
+    plant_problem: &pushval_model::Problem,
+    engine: &str,
+    dt: f64,
+    pushes: &[Push],
+) -> anyhow::Result<String> {
+    let note = format!("what `pushval loop` applied to {engine} (goal {})", p.goal);
+    let mut doc = with_schedule(&p.text, file, pushes, &note)?;
+    let table = |doc: &mut toml::Table, key: &str| -> anyhow::Result<toml::Table> {
+        match doc.remove(key) {
+            Some(toml::Value::Table(t)) => Ok(t),
+            None => Ok(toml::Table::new()),
+            Some(_) => anyhow::bail!("{}: `{key}` is not a table", file.display()),
+        }
+    };
+    if !plant.is_nominal() {
+        // The plant's own scene: friction scaled at every support, the
+        // inertia about the centre of mass given outright.
+        let mut supports = table(&mut doc, "supports")?;
+        let scale = |v: &toml::Value| -> toml::Value {
+            match v {
+                toml::Value::Float(x) => toml::Value::Float(x * plant.mu_scale),
+                toml::Value::Integer(x) => toml::Value::Float(*x as f64 * plant.mu_scale),
+                toml::Value::Array(a) => toml::Value::Array(
+                    a.iter()
+                        .map(|x| match x {
+                            toml::Value::Float(x) => toml::Value::Float(x * plant.mu_scale),
+                            toml::Value::Integer(x) => {
+                                toml::Value::Float(*x as f64 * plant.mu_scale)
+                            }
+                            other => other.clone(),
+                        })
+                        .collect(),
+                ),
+                other => other.clone(),
+            }
+        };
+        let mu = supports
+            .get("mu")
+            .map(scale)
+            .with_context(|| format!("{}: [supports] has no mu to scale", file.display()))?;
+        supports.insert("mu".into(), mu);
+        doc.insert("supports".into(), toml::Value::Table(supports));
+        let mut object = table(&mut doc, "object")?;
+        object.remove("inertia_contact");
+        object.insert(
+            "inertia_cm".into(),
+            toml::Value::Float(plant_problem.body.inertia_cm()),
+        );
+        doc.insert("object".into(), toml::Value::Table(object));
+    }
+    let mut run = table(&mut doc, "run")?;
+    run.insert(
+        "models".into(),
+        toml::Value::Array(vec![toml::Value::String(engine.into())]),
+    );
+    // The default gate: the plant engine is gated against the dynamic
+    // model on the plant's scene when it is the default gated engine.
+    run.remove("gate");
+    doc.insert("run".into(), toml::Value::Table(run));
+    let mut eng = table(&mut doc, "engine")?;
+    eng.insert("dt".into(), toml::Value::Float(dt));
+    doc.insert("engine".into(), toml::Value::Table(eng));
+    doc.remove("tolerance");
+    Ok(format!(
+        "# Written by `pushval loop`: the scenario its plant ran ({engine}, dt {dt} s); `pushval run` on this file reproduces the plant's trajectory.\n{}",
+        toml::to_string(&doc)?
+    ))
 }
 
 /// `pushval loop`.
 pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow::Result<ExitCode> {
     let p = parse(c)?;
     let plant = match plant {
-        Some(t) => PlantScale::parse(t)?,
+        Some(t) => parse_plant_scale(t)?,
         None => PlantScale::default(),
     };
     let (engine, dt) = engine_of(&p.sc, engine)?;
-    let problem = p.problem.clone();
+    pushval_control::mpc::period_steps(period, dt).map_err(|e| flag_error(e, c))?;
     let spec = LoopSpec {
         plan: p.spec,
         period,
-        plant,
         reach: p.reach,
     };
-    let out = run_loop(&problem, engine.as_ref(), dt, p.goal, spec)?;
-    let (med, p99) = median_p99(&out.predictor_us);
-    let (cpu_med, cpu_p99) = median_p99(&out.predictor_cpu_us);
-    let last = out
-        .run
-        .trajectory
-        .samples
-        .last()
-        .copied()
-        .unwrap_or_default();
-    let doc = json!({
+    let plant_problem = plant
+        .apply(&p.problem)
+        .with_context(|| format!("--plant: the plant's scene of {}", c.file.display()))?;
+    let base = json!({
         "scenario": c.file.display().to_string(),
         "goal": {"x": p.goal.x, "y": p.goal.y, "theta": p.goal.theta},
+        "tolerance": {"position_m": p.reach.position, "angle_rad": p.reach.angle},
         "engine": engine.name(),
         "engine_version": engine.version(),
         "dt": dt,
         "predictor": p.spec.predictor.as_str(),
-        "period_s": period,
         "speed": p.spec.speed,
         "plant": plant,
+    });
+    let outcome = (|| -> anyhow::Result<(LoopOutcome, pushval_engine::EngineRun)> {
+        let mut session = engine
+            .start(&plant_problem, dt)
+            .with_context(|| format!("{}: starting a session", engine.name()))?;
+        let out = run_loop(&p.problem, session.as_mut(), dt, p.goal, spec, &mut ())
+            .map_err(|e| flag_error(e, c))?;
+        let run = session
+            .finish()
+            .with_context(|| format!("{}: finishing the session", engine.name()))?;
+        Ok((out, run))
+    })();
+    let (out, run) = match outcome {
+        Ok(o) => o,
+        Err(e) => {
+            // The folder says the loop failed and why; nothing of an
+            // earlier run stays in it.
+            let mut doc = base;
+            doc["success"] = json!(false);
+            doc["error"] = json!(format!("{e:#}"));
+            let dir = FreshDir::new(&c.out)?;
+            dir.write("loop.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+            dir.commit()?;
+            return Err(e);
+        }
+    };
+    let timing = median_p99(&out.predictor_us);
+    let cpu = median_p99(&out.predictor_cpu_us);
+    let pushes: Vec<Push> = out.applied.iter().map(|a| a.push).collect();
+    let l = &out.last;
+    let mut doc = base;
+    let extra = json!({
+        "period_s": out.period,
         "success": out.success,
         "position_error_m": json_num(out.position_error),
         "angle_error_rad": json_num(out.angle_error),
-        "final_pose": {"t": last.t, "x": last.x, "y": last.y, "theta": last.theta},
+        "final_pose": {"t": l.t, "x": l.x, "y": l.y, "theta": l.theta},
+        "release_pose": {"t": l.t, "x": l.x, "y": l.y, "theta": l.theta},
+        "release_state": {"t": l.t, "x": l.x, "y": l.y, "theta": l.theta, "omega": l.omega, "vx": l.v_cm[0], "vy": l.v_cm[1]},
         "steps": out.steps,
         "gave_up_at_twice_the_plan": out.gave_up,
-        "predictor_us_median": json_num(med),
-        "predictor_us_p99": json_num(p99),
-        "predictor_cpu_us_median": json_num(cpu_med),
-        "predictor_cpu_us_p99": json_num(cpu_p99),
+        "predictor_us_median": timing.map(|t| t.0),
+        "predictor_us_p99": timing.map(|t| t.1),
+        "predictor_cpu_us_median": cpu.map(|t| t.0),
+        "predictor_cpu_us_p99": cpu.map(|t| t.1),
         "plan_from_rest_converged": out.plan_converged,
         "engine_replayed_each_period": out.replayed,
-        "engine_steps": out.run.steps,
+        "engine_steps": run.steps,
     });
-    write_outputs(&c.out, &trajectory_csv(&out, engine.name()), &doc)?;
+    if let (Some(d), serde_json::Value::Object(e)) = (doc.as_object_mut(), extra) {
+        d.extend(e);
+    }
+    let dir = FreshDir::new(&c.out)?;
+    dir.write(
+        "trajectory.csv",
+        trajectory_csv(&out, &run, engine.name()).as_bytes(),
+    )?;
+    dir.write("loop.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+    let applied = applied_toml(
+        &p,
+        &c.out.join("applied.toml"),
+        &plant,
+        &plant_problem,
+        engine.name(),
+        dt,
+        &pushes,
+    )?;
+    dir.write("applied.toml", applied.as_bytes())?;
+    dir.commit()?;
+    let timing_text = match timing {
+        Some((m, p99)) => format!("predictor {m:.1} µs median, {p99:.1} µs p99"),
+        None => "no re-plan (the plan lasted one period)".into(),
+    };
     println!(
-        "loop ({} predictor, {} plant, period {} s): {} after {} periods: {:.4} m and {:.4} rad from the goal; predictor {:.1} µs median, {:.1} µs p99{}",
+        "loop ({} predictor, {} plant, period {} s): {} after {} periods: {:.4} m and {:.4} rad from the goal; {}{}",
         p.spec.predictor.as_str(),
         engine.name(),
-        period,
+        out.period,
         if out.success { "reached" } else { "MISSED" },
         out.steps,
         out.position_error,
         out.angle_error,
-        med,
-        p99,
+        timing_text,
         if out.replayed { "; the engine cannot step: it re-ran the schedule applied so far every period" } else { "" }
     );
     println!(
-        "wrote {} and {}",
+        "wrote {}, {} and {}",
         c.out.join("trajectory.csv").display(),
-        c.out.join("loop.json").display()
+        c.out.join("loop.json").display(),
+        c.out.join("applied.toml").display()
     );
     Ok(if out.success {
         ExitCode::SUCCESS
@@ -291,11 +524,22 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
     })
 }
 
-fn write_outputs(dir: &Path, csv: &str, doc: &serde_json::Value) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    write_atomic(&dir.join("trajectory.csv"), csv.as_bytes())?;
-    write_atomic(
-        &dir.join("loop.json"),
-        serde_json::to_string_pretty(doc)?.as_bytes(),
-    )
+/// The plant's trajectory rows with the applied push, as CSV.
+pub fn trajectory_csv(out: &LoopOutcome, run: &pushval_engine::EngineRun, model: &str) -> String {
+    let mut s = format!("{},speed,phi\n", pushval_model::format::HEADER);
+    for smp in &run.trajectory.samples {
+        let p = push_at(&out.applied, smp.t);
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{}\n",
+            model,
+            smp.t,
+            smp.x,
+            smp.y,
+            smp.theta,
+            smp.omega,
+            p.map_or(0.0, |p| p.speed),
+            p.map_or(0.0, |p| p.phi)
+        ));
+    }
+    s
 }

@@ -8,8 +8,9 @@ use std::f64::consts::FRAC_PI_2;
 use std::process::Command;
 
 use pushval::control::mpc::{open_loop, run_loop, LoopSpec, PlantScale};
-use pushval::control::plan::{make_plan, straight_time, switch_checks, PlanSpec, Planner, Start};
-use pushval::control::{Goal, Predictor, Reach};
+use pushval::control::plan::{make_plan, straight_time, switch_checks, Bounds, PlanSpec, Planner};
+use pushval::control::predict::Start;
+use pushval::control::{Goal, ModelKind as Predictor, Reach};
 use pushval_model::{DynamicModel, Problem, Push, Simulator};
 
 use crate::common::root;
@@ -56,7 +57,14 @@ const GOAL: Goal = Goal {
 fn a_dynamic_plan_reaches_its_goal_when_the_model_runs_it_at_full_accuracy() {
     let p = plate();
     for v in [0.1, 0.5, 1.0] {
-        let out = make_plan(&p, GOAL, spec(v, Predictor::Dynamic), Reach::default()).unwrap();
+        let out = make_plan(
+            &p,
+            GOAL,
+            spec(v, Predictor::Dynamic),
+            Reach::default(),
+            &Bounds::default(),
+        )
+        .unwrap();
         assert!(out.solution.converged, "{v} m/s: did not converge");
         // The planner's predictor runs at 1e-9; the default model at 1e-10
         // must land on the goal too, well inside the success tolerance.
@@ -80,7 +88,14 @@ fn the_mirror_image_of_a_plan_reaches_the_mirror_image_of_its_goal() {
     // diagonal y = x: reflecting it maps φ to π/2 − φ, (x, y) to (y, x) and
     // θ to −θ. So a plan's reflection reaches the reflected goal.
     let p = plate();
-    let out = make_plan(&p, GOAL, spec(0.5, Predictor::Dynamic), Reach::default()).unwrap();
+    let out = make_plan(
+        &p,
+        GOAL,
+        spec(0.5, Predictor::Dynamic),
+        Reach::default(),
+        &Bounds::default(),
+    )
+    .unwrap();
     let mirrored: Vec<Push> = out
         .solution
         .pushes
@@ -105,7 +120,14 @@ fn a_kinematic_plan_misses_more_the_faster_the_push() {
     // number: slow, its plan works in the dynamic model; fast, it misses.
     let p = plate();
     let miss = |v: f64| {
-        let out = make_plan(&p, GOAL, spec(v, Predictor::Kinematic), Reach::default()).unwrap();
+        let out = make_plan(
+            &p,
+            GOAL,
+            spec(v, Predictor::Kinematic),
+            Reach::default(),
+            &Bounds::default(),
+        )
+        .unwrap();
         assert!(
             out.solution.converged,
             "{v} m/s: the kinematic plan did not converge"
@@ -125,7 +147,14 @@ fn a_kinematic_plan_misses_more_the_faster_the_push() {
 #[test]
 fn a_switch_impulse_and_its_ramp_meet_the_friction_cone_exactly() {
     let p = plate();
-    let out = make_plan(&p, GOAL, spec(1.0, Predictor::Dynamic), Reach::default()).unwrap();
+    let out = make_plan(
+        &p,
+        GOAL,
+        spec(1.0, Predictor::Dynamic),
+        Reach::default(),
+        &Bounds::default(),
+    )
+    .unwrap();
     let mut q = p.clone();
     q.pushes = out.solution.pushes.clone();
     let traj = DynamicModel::default().simulate(&q).unwrap();
@@ -172,28 +201,18 @@ fn mpc_reaches_on_a_perturbed_rapier2d_plant_where_the_open_loop_plan_misses() {
         reach,
     );
     let plan = planner.plan(&start).unwrap();
-    let (_, pe_nom, ae_nom) = open_loop(
-        &p,
-        engine.as_ref(),
-        dt,
-        &plan.pushes,
-        PlantScale::default(),
-        &GOAL,
-    )
-    .unwrap();
+    let open = |scale: PlantScale| {
+        let plant = scale.apply(&p).unwrap();
+        let mut session = engine.start(&plant, dt).unwrap();
+        let st = open_loop(session.as_mut(), &plan.pushes).unwrap();
+        pushval::control::pose_errors(st.x, st.y, st.theta, &GOAL)
+    };
+    let (pe_nom, ae_nom) = open(PlantScale::default());
     assert!(
         reach.holds(pe_nom, ae_nom),
         "open loop, nominal: {pe_nom} m {ae_nom} rad"
     );
-    let (_, pe, ae) = open_loop(
-        &p,
-        engine.as_ref(),
-        dt,
-        &plan.pushes,
-        PlantScale::PERTURBED,
-        &GOAL,
-    )
-    .unwrap();
+    let (pe, ae) = open(PlantScale::PERTURBED);
     assert!(
         !reach.holds(pe, ae),
         "open loop on the perturbed plant: {pe} m {ae} rad"
@@ -201,10 +220,28 @@ fn mpc_reaches_on_a_perturbed_rapier2d_plant_where_the_open_loop_plan_misses() {
     let spec = LoopSpec {
         plan: spec(1.0, Predictor::Dynamic),
         period: 0.02,
-        plant: PlantScale::PERTURBED,
         reach,
     };
-    let out = run_loop(&p, engine.as_ref(), dt, GOAL, spec).unwrap();
+    let plant = PlantScale::PERTURBED.apply(&p).unwrap();
+    let mut session = engine.start(&plant, dt).unwrap();
+    let mut periods = 0usize;
+    struct Count<'a>(&'a mut usize);
+    impl pushval::control::mpc::Observer for Count<'_> {
+        fn period(&mut self, period: &pushval::control::mpc::Period<'_>) {
+            *self.0 += 1;
+            assert_eq!(period.index, *self.0);
+        }
+    }
+    let out = run_loop(
+        &p,
+        session.as_mut(),
+        dt,
+        GOAL,
+        spec,
+        &mut Count(&mut periods),
+    )
+    .unwrap();
+    let run = session.finish().unwrap();
     assert!(
         out.success,
         "MPC: {} m {} rad",
@@ -212,10 +249,151 @@ fn mpc_reaches_on_a_perturbed_rapier2d_plant_where_the_open_loop_plan_misses() {
     );
     assert!(out.position_error < pe && out.angle_error < ae);
     assert!(out.steps > 10);
+    assert_eq!(periods, out.steps, "the observer hears every period");
     // The applied pushes tile the run: their durations add up to its end.
     let total: f64 = out.applied.iter().map(|a| a.push.duration).sum();
-    let end = out.run.trajectory.samples.last().unwrap().t;
+    let end = run.trajectory.samples.last().unwrap().t;
     assert!((total - end).abs() < 1e-9, "{total} {end}");
+    // Every applied duration is a whole number of the plant's steps.
+    for a in &out.applied {
+        let k = a.push.duration / dt;
+        assert!(
+            (k - k.round()).abs() < 1e-6 && k.round() >= 1.0,
+            "{} s is {k} steps of {dt} s",
+            a.push.duration
+        );
+    }
+}
+
+/// Speeds, goals and periods out of range are refused at once, exit 2,
+/// naming the flag, with nothing written; each within a bounded time
+/// (the commands used to allocate 704 GB or run for minutes).
+#[test]
+fn out_of_range_requests_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, flag) in [
+        (
+            vec!["plan", "--goal=0.5,0.1,0.3", "--speed", "1e-9"],
+            "--speed",
+        ),
+        (
+            vec!["plan", "--goal=0.5,0.1,0.3", "--speed", "-1"],
+            "--speed",
+        ),
+        (vec!["plan", "--goal=1e300,0,0", "--speed", "1"], "--goal"),
+        (vec!["plan", "--goal=1e5,0,0", "--speed", "1"], "--goal"),
+        (vec!["plan", "--goal=0.5,0,1e9", "--speed", "1"], "--goal"),
+        (
+            vec!["plan", "--goal=0.5,0,0", "--segments", "40"],
+            "--segments",
+        ),
+        (
+            vec![
+                "loop",
+                "--goal=0.5,0.1,0.3",
+                "--engine",
+                "rapier2d",
+                "--period",
+                "1e-6",
+            ],
+            "--period",
+        ),
+    ] {
+        let out = dir.path().join("o");
+        let clock = std::time::Instant::now();
+        let st = pushval()
+            .arg(args[0])
+            .arg(root().join("scenarios/paper-square-v1.0.toml"))
+            .args(&args[1..])
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(st.status.code(), Some(2), "{args:?}: {st:?}");
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert!(err.contains(flag), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+        // A behaviour bound (refused before any search), not a benchmark.
+        assert!(clock.elapsed().as_secs_f64() < 20.0, "{args:?}");
+    }
+}
+
+/// The goal the old planner called unreachable with 6 pushes ("a turn or
+/// a sideways move it cannot give") is reached once the search tries more
+/// pushes, and plan.json says what it tried.
+#[test]
+fn the_search_tries_more_pushes_before_calling_a_goal_unreachable() {
+    let p = plate();
+    let goal = Goal {
+        x: 0.5,
+        y: 0.1,
+        theta: 0.3,
+    };
+    let out = make_plan(
+        &p,
+        goal,
+        spec(1.0, Predictor::Dynamic),
+        Reach::default(),
+        &Bounds::default(),
+    )
+    .unwrap();
+    assert!(out.attempts.len() > 1, "it tried more pushes");
+    if out.reached {
+        assert!(out.why.is_none());
+        // Checked independently: the default model at 1e-10 lands on the goal.
+        let f = final_pose(&p, &out.solution.pushes);
+        assert!((f[0] - goal.x).hypot(f[1] - goal.y) < 0.02, "{f:?}");
+        assert!((f[2] - goal.theta).abs() < 5f64.to_radians(), "{f:?}");
+        assert!(out.assumptions.pulling_impulse.is_none());
+    } else {
+        // Plans of more pushes reach it on the model but need a pulling
+        // impulse: the reason says so first, not "a turn it cannot give".
+        let refused: usize = out.attempts.iter().map(|a| a.refused_pulling).sum();
+        assert!(refused > 0, "{:?}", out.why);
+        let why = out.why.unwrap();
+        assert!(
+            why.starts_with(&format!("{refused} plans reach the goal")),
+            "{why}"
+        );
+    }
+}
+
+/// A failed plan replaces the folder of an earlier success: no plan.toml is
+/// left to be run as if it reached the goal.
+#[test]
+fn a_failed_plan_leaves_no_plan_toml() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p");
+    let plan = |goal: &str| {
+        pushval()
+            .args(["plan"])
+            .arg(root().join("scenarios/paper-square-v1.0.toml"))
+            .args([goal, "--speed", "0.5", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    assert!(plan("--goal=0.8,0.2,-0.5").status.success());
+    assert!(out.join("plan.toml").exists());
+    let st = plan("--goal=-0.6,-0.6,0");
+    assert_eq!(st.status.code(), Some(1));
+    assert!(
+        !out.join("plan.toml").exists(),
+        "a stale plan.toml survived"
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(doc["reached"], false);
+    assert!(
+        doc["why_missed"].as_str().unwrap().contains("tried"),
+        "{doc}"
+    );
+    // No temporary folder is left beside it.
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
 }
 
 #[test]
@@ -237,6 +415,8 @@ fn plan_writes_a_scenario_every_command_takes_and_its_checks() {
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
     assert_eq!(doc["converged"], true);
+    assert_eq!(doc["reached"], true);
+    assert!(doc["why_missed"].is_null());
     assert_eq!(doc["segments"].as_array().unwrap().len(), 6);
     assert!(doc["position_error_m"].as_f64().unwrap() < 1e-3);
     assert_eq!(doc["checks"]["switches"].as_array().unwrap().len(), 6);
@@ -346,6 +526,45 @@ fn loop_writes_the_applied_push_and_loop_json() {
     assert_eq!(doc["engine"], "box2d");
     assert_eq!(doc["plant"]["mu_scale"], 0.8);
     assert!(doc["predictor_us_median"].as_f64().unwrap() > 0.0);
+    assert_eq!(doc["tolerance"]["position_m"], 0.02);
+    for k in ["omega", "vx", "vy"] {
+        assert!(doc["release_state"][k].as_f64().is_some(), "{k}: {doc}");
+    }
+    // applied.toml is the scenario the plant ran: `pushval run` on it
+    // reproduces the loop's plant trajectory.
+    let run = dir.path().join("run");
+    let st = pushval()
+        .arg("run")
+        .arg(out.join("applied.toml"))
+        .arg("--out")
+        .arg(&run)
+        .output()
+        .unwrap();
+    // Exit 0, or 1 where a gate of the plant against the model fails: the
+    // rows are written either way.
+    assert!(
+        matches!(st.status.code(), Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let last_row = |csv: &str| -> Vec<f64> {
+        csv.lines()
+            .rfind(|l| l.starts_with("box2d,"))
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .take(4)
+            .map(|f| f.parse::<f64>().unwrap())
+            .collect()
+    };
+    let a = last_row(&std::fs::read_to_string(out.join("trajectory.csv")).unwrap());
+    let b = last_row(&std::fs::read_to_string(run.join("trajectory.csv")).unwrap());
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            (x - y).abs() < 1e-9,
+            "loop {a:?}, run of applied.toml {b:?}"
+        );
+    }
     let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(lines.next().unwrap(), "model,t,x,y,theta,omega,speed,phi");

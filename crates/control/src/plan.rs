@@ -1,5 +1,5 @@
-//! `pushval plan`: a push schedule that takes the object to a goal pose on a
-//! model.
+//! Plans: a push schedule that takes the object to a goal pose on a
+//! predictor.
 //!
 //! The unknowns are `N` push directions and the total duration, written
 //! unconstrained: `φ_k = c + h tanh(u_k)` keeps every direction inside the
@@ -9,67 +9,31 @@
 //! `δ = −Jᵀ (J Jᵀ + λ I)⁻¹ r`; the Jacobian is taken by forward differences
 //! once and then kept by Broyden's rank-one update, taken again only when a
 //! step fails. Written here rather than with the `levenberg-marquardt`
-//! crate: that crate solves over-determined problems (m ≥ n) by QR, and this
-//! one is under-determined (3 residuals, N + 1 unknowns), where the
-//! minimum-norm step through the 3 × 3 system is both the right step and
-//! the cheap one; the warm-started Broyden Jacobian is what makes an MPC
-//! period cost one or two model runs.
+//! crate `fit` uses: that crate could take this problem made square (N + 1
+//! regularising residuals that pull the unknowns towards the warm start),
+//! but it asks its caller for a Jacobian at every iteration, N + 1 model
+//! runs by finite differences each time, where Broyden's update here costs
+//! none; the warm-started Jacobian carried from one control period to the
+//! next is what makes an MPC period cost one or two model runs. The
+//! minimum-norm step through the 3 × 3 system `J Jᵀ + λ I` is the
+//! regularised least-squares step of the square problem in the limit of
+//! small regularising weights.
+//!
+//! The search is bounded ([`Bounds`]): goals, speeds and durations outside
+//! them are refused before any work, and the search for a plan tries more
+//! pushes (up to [`MAX_SEGMENTS`]) and more starting guesses within a budget
+//! of model runs before it calls a goal unreachable, and says what it
+//! tried. A plan whose switch needs a pulling impulse is not a plan.
 
 use std::time::Instant;
 
-use anyhow::Context;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use pushval_model::{
-    cross, perp, DynamicModel, Initial, Integrator, ModelError, Problem, Push, SegmentDynamics,
-    Simulator, Switching, Trajectory, Vec2,
+    perp, DynamicModel, Problem, Push, SegmentDynamics, Simulator, Trajectory, Vec2,
 };
 
-use super::{gyration_length, pose_errors, push_cone, Goal, Predictor, Reach};
-
-/// The state a plan starts from.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Start {
-    /// Object angle (rad).
-    pub theta: f64,
-    /// World position of the centre of mass (m).
-    pub position: Vec2,
-    /// How it moves when the plan starts.
-    pub motion: Motion,
-}
-
-/// How the object moves when a plan starts.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Motion {
-    /// At rest: the first push is a switch from rest.
-    Rest,
-    /// Moving: ω (rad/s) and the angular momentum about the world point
-    /// under the contact (kg m²/s), which an impulsive switch keeps.
-    Moving {
-        /// Angular velocity just before the plan's first push (rad/s).
-        omega: f64,
-        /// `I_cm ω + m (r_cm − r_P) × v_cm` (kg m²/s).
-        momentum: f64,
-    },
-}
-
-impl Start {
-    /// The problem's own start.
-    pub fn of_problem(problem: &Problem) -> Self {
-        let i = &problem.initial;
-        Self {
-            theta: i.theta,
-            position: i.position,
-            motion: if i.from_rest {
-                Motion::Rest
-            } else {
-                Motion::Moving {
-                    omega: i.omega,
-                    momentum: f64::NAN,
-                }
-            },
-        }
-    }
-}
+use crate::predict::{ModelKind, ModelPredictor, Motion, Predictor, Start};
+use crate::{gyration_length, pose_errors, push_cone, ControlError, Goal, Reach};
 
 /// What the plan is asked for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,127 +43,7 @@ pub struct PlanSpec {
     /// Pusher speed (m/s).
     pub speed: f64,
     /// The model the plan is made on.
-    pub predictor: Predictor,
-}
-
-/// A predictor of final poses for one problem: the model, a working copy of
-/// the problem (only its schedule and start change between calls), and the
-/// count of model runs.
-#[derive(Clone)]
-pub struct Predict {
-    problem: Problem,
-    model: DynamicModel,
-    predictor: Predictor,
-    /// Model runs so far.
-    pub runs: usize,
-}
-
-impl Predict {
-    /// A predictor on `problem`'s body, contact and switching rule.
-    pub fn new(problem: &Problem, predictor: Predictor) -> Self {
-        Self {
-            problem: problem.clone(),
-            // 1e-9 per step: the pose it predicts is good to well under a
-            // millimetre, far inside any goal tolerance, at a third of the
-            // cost of the default 1e-10.
-            model: DynamicModel {
-                integrator: Integrator::Dop853 { tol: 1e-9 },
-                skip_settled: true,
-                check_assumptions: false,
-                ..DynamicModel::default()
-            },
-            predictor,
-            runs: 0,
-        }
-    }
-
-    /// The problem of the plan `pushes` from `start`, sampled at its start
-    /// and end only (or every `sample_dt` s when given).
-    pub fn problem_of(&self, start: &Start, pushes: &[Push], sample_dt: Option<f64>) -> Problem {
-        let mut p = self.problem.clone();
-        self.set(&mut p, start, pushes, sample_dt);
-        p
-    }
-
-    fn set(&self, p: &mut Problem, start: &Start, pushes: &[Push], sample_dt: Option<f64>) {
-        p.pushes.clear();
-        p.pushes.extend_from_slice(pushes);
-        let total: f64 = pushes.iter().map(|q| q.duration).sum();
-        p.sample_dt = sample_dt.unwrap_or(total);
-        p.initial = match start.motion {
-            Motion::Rest => Initial {
-                theta: start.theta,
-                omega: 0.0,
-                position: start.position,
-                from_rest: true,
-            },
-            Motion::Moving { omega, momentum } => {
-                let first = &pushes[0];
-                let w = match p.switching {
-                    Switching::Impulsive if momentum.is_finite() => {
-                        let body = &p.body;
-                        (momentum + body.mass() * cross(&body.contact(), &first.velocity()))
-                            / body.inertia_contact()
-                    }
-                    _ => omega,
-                };
-                Initial {
-                    theta: start.theta,
-                    omega: w,
-                    position: start.position,
-                    from_rest: false,
-                }
-            }
-        };
-    }
-
-    /// The final pose (x, y, θ) of `pushes` from `start`.
-    pub fn final_pose(&mut self, start: &Start, pushes: &[Push]) -> Result<[f64; 3], ModelError> {
-        let mut p = std::mem::replace(&mut self.problem, placeholder());
-        self.set(&mut p, start, pushes, None);
-        let out = self.simulate(&p);
-        self.problem = p;
-        self.runs += 1;
-        let s = out?
-            .samples
-            .last()
-            .copied()
-            .ok_or(ModelError::EmptySchedule)?;
-        if !(s.x.is_finite() && s.y.is_finite() && s.theta.is_finite()) {
-            return Err(ModelError::NonFinite { t: s.t, step: 0 });
-        }
-        Ok([s.x, s.y, s.theta])
-    }
-
-    /// The predictor's trajectory of `problem`.
-    pub fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
-        match self.predictor {
-            Predictor::Dynamic => self.model.simulate(problem),
-            Predictor::Kinematic => pushval_model::KinematicModel.simulate(problem),
-            Predictor::LimitSurface => pushval_model::LimitSurfaceModel.simulate(problem),
-        }
-    }
-}
-
-/// An empty stand-in while the working problem is lent out.
-fn placeholder() -> Problem {
-    Problem {
-        body: pushval_model::Body::new(
-            1.0,
-            1.0,
-            Vec2::zeros(),
-            &[pushval_model::Support {
-                position: Vec2::new(1.0, 0.0),
-                friction: 1.0,
-            }],
-        )
-        .expect("a valid body"),
-        limits: Default::default(),
-        pushes: Vec::new(),
-        initial: Initial::default(),
-        switching: Switching::default(),
-        sample_dt: 1.0,
-    }
+    pub predictor: ModelKind,
 }
 
 /// The longest plan, in straight-line times.
@@ -218,8 +62,8 @@ pub struct Params {
 /// the duration, and the Jacobian it carries between calls (warm starts).
 #[derive(Clone)]
 pub struct Planner {
-    /// The model runs.
-    pub predict: Predict,
+    /// The predictor (it counts its model runs).
+    pub predict: Box<dyn Predictor>,
     /// The goal.
     pub goal: Goal,
     spec: PlanSpec,
@@ -227,8 +71,26 @@ pub struct Planner {
     t_ref: f64,
     weight: f64,
     jacobian: Option<DMatrix<f64>>,
+    /// When set, the duration is fixed on a step grid (see
+    /// [`Planner::on_grid`]).
+    grid: Option<Grid>,
     /// The stopping rule: position and angle errors on the predictor.
     pub target: Reach,
+}
+
+/// A step grid for a plan's duration: `steps` steps of `dt` s in all.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Grid {
+    dt: f64,
+    steps: usize,
+}
+
+impl Grid {
+    /// The whole steps of push `k` of `n`: the total split as evenly as
+    /// whole steps allow (the counts differ by at most one).
+    fn segment_steps(&self, k: usize, n: usize) -> usize {
+        (k + 1) * self.steps / n - k * self.steps / n
+    }
 }
 
 /// What one solve found.
@@ -264,14 +126,34 @@ impl Planner {
     /// `t_ref`: the duration scale (s), e.g. the straight-line distance over
     /// the speed.
     pub fn new(problem: &Problem, goal: Goal, spec: PlanSpec, t_ref: f64, reach: Reach) -> Self {
-        Self {
-            predict: Predict::new(problem, spec.predictor),
+        Self::with_predictor(
+            Box::new(ModelPredictor::new(problem, spec.predictor)),
             goal,
             spec,
+            t_ref,
+            reach,
+        )
+    }
+
+    /// A planner on any predictor (its problem gives the contact's cone and
+    /// the radius of gyration).
+    pub fn with_predictor(
+        predict: Box<dyn Predictor>,
+        goal: Goal,
+        spec: PlanSpec,
+        t_ref: f64,
+        reach: Reach,
+    ) -> Self {
+        let problem = predict.problem();
+        Self {
             cone: push_cone(problem),
-            t_ref: t_ref.max(1e-3),
             weight: gyration_length(problem),
+            predict,
+            goal,
+            spec,
+            t_ref: t_ref.max(1e-3),
             jacobian: None,
+            grid: None,
             // A twentieth of the success tolerance on the model, so that a
             // miss in an engine measures the engine, not the planner.
             target: Reach {
@@ -286,12 +168,16 @@ impl Planner {
         let (lo, hi) = self.cone;
         let (c, h) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
         let n = params.u.len();
-        let duration = self.duration(params) / n as f64;
+        let equal = self.duration(params) / n as f64;
         params
             .u
             .iter()
-            .map(|&u| Push {
-                duration,
+            .enumerate()
+            .map(|(k, &u)| Push {
+                duration: match self.grid {
+                    Some(g) => g.segment_steps(k, n) as f64 * g.dt,
+                    None => equal,
+                },
                 speed: self.spec.speed,
                 phi: c + h * u.tanh(),
             })
@@ -302,7 +188,37 @@ impl Planner {
     /// straight-line time, so that a plan cannot wander (a plant that does
     /// not turn as predicted would otherwise be sent round ever longer loops).
     pub fn duration(&self, params: &Params) -> f64 {
-        self.t_ref * params.s.min(MAX_TIME.ln()).exp()
+        match self.grid {
+            Some(g) => g.steps as f64 * g.dt,
+            None => self.t_ref * params.s.min(MAX_TIME.ln()).exp(),
+        }
+    }
+
+    /// The plan `solution` re-solved with its total time on a step grid of
+    /// `dt` (s): the nearest whole number of steps (at least one per push;
+    /// fewer pushes when there are fewer steps than pushes), split over the
+    /// pushes in whole steps, and the directions solved again for that
+    /// fixed time. What the loop applies to a fixed-step plant is then
+    /// exactly what it planned. None when the predictor fails.
+    pub fn on_grid(&mut self, start: &Start, solution: &Solution, dt: f64) -> Option<Solution> {
+        let total = self.duration(&solution.params);
+        let steps = ((total / dt).round() as usize).max(1);
+        let segments = solution.params.u.len().min(steps);
+        let params = resample(&solution.params, segments);
+        self.grid = Some(Grid { dt, steps });
+        self.forget();
+        let out = self.solve(start, params, 12);
+        self.forget();
+        self.grid = None;
+        let mut out = out?;
+        // Keep the grid's durations (the solve ran with the grid set).
+        let grid = Grid { dt, steps };
+        let n = out.pushes.len();
+        for (k, p) in out.pushes.iter_mut().enumerate() {
+            p.duration = grid.segment_steps(k, n) as f64 * dt;
+        }
+        out.params.s = (total.max(1e-9) / self.t_ref).ln();
+        Some(out)
     }
 
     /// The unknowns of a total duration `t` (s) with every direction at the
@@ -416,6 +332,11 @@ impl Planner {
                 continue;
             };
             let mut dz = -(j.transpose() * DVector::from_column_slice(y.as_slice()));
+            if self.grid.is_some() {
+                // The duration is fixed on the grid.
+                let last = dz.len() - 1;
+                dz[last] = 0.0;
+            }
             // Keep a step from throwing the directions far into tanh's flat
             // tails or the duration by more than a factor e.
             let big = dz.amax();
@@ -464,6 +385,21 @@ impl Planner {
         Some(self.solution(Self::unflat(&z), pose, iterations))
     }
 
+    /// The solution of `params` as it stands (its pose not yet predicted:
+    /// NaN, not converged): what [`Planner::on_grid`] starts from.
+    pub fn solution_of(&self, params: Params) -> Solution {
+        Solution {
+            pushes: self.pushes(&params),
+            params,
+            pose: [f64::NAN; 3],
+            position_error: f64::NAN,
+            angle_error: f64::NAN,
+            converged: false,
+            iterations: 0,
+            residual: f64::NAN,
+        }
+    }
+
     /// Drops the kept Jacobian (the next solve takes a fresh one).
     pub fn forget(&mut self) {
         self.jacobian = None;
@@ -506,7 +442,13 @@ impl Planner {
         k: usize,
         max_iter: usize,
     ) -> Option<Solution> {
-        let (tm, off) = GUESSES[k % GUESSES.len()];
+        let all = GUESSES.len() + MORE_GUESSES.len();
+        let k = k % all;
+        let (tm, off) = if k < GUESSES.len() {
+            GUESSES[k]
+        } else {
+            MORE_GUESSES[k - GUESSES.len()]
+        };
         self.forget();
         let mut p = self.initial_params(t0 * tm, off);
         p.u.truncate(segments.max(1));
@@ -519,7 +461,7 @@ impl Planner {
         let mut why = Vec::new();
         if at_edge > 0 {
             why.push(format!(
-                "{at_edge} of {} push directions sit at the edge of the pushing cone [{:.3}, {:.3}] rad: the pusher only pushes, and the goal asks for a turn or a sideways move it cannot give over this distance",
+                "in the nearest plan, {at_edge} of {} push directions sit at the edge of the pushing cone [{:.3}, {:.3}] rad (the pusher only pushes): the goal may ask for more turn or sideways move than pushes at this speed give over this distance",
                 s.params.u.len(),
                 self.cone.0,
                 self.cone.1
@@ -531,8 +473,13 @@ impl Planner {
                 "the duration shrank to {t:.3} s: the goal lies behind the pusher"
             ));
         }
+        if self.grid.is_none() && s.params.s >= MAX_TIME.ln() {
+            why.push(format!(
+                "the duration reached its cap, {MAX_TIME} times the straight-line time ({t:.3} s)"
+            ));
+        }
         if why.is_empty() {
-            why.push("no push sequence of this length and speed found a better pose (a local minimum: more segments or another speed may reach it)".into());
+            why.push("the search ended in a local minimum (another speed may reach it)".into());
         }
         why.join("; ")
     }
@@ -550,6 +497,10 @@ pub const GUESSES: [(f64, f64); 7] = [
     (1.6, -0.5),
     (2.5, 0.0),
 ];
+
+/// Starting guesses the search of [`make_plan`] adds once the first
+/// number of pushes found no plan (as in [`GUESSES`]).
+pub const MORE_GUESSES: [(f64, f64); 4] = [(1.3, 0.25), (1.3, -0.25), (2.0, 0.75), (2.0, -0.75)];
 
 /// The straight-line time to the goal at `speed` (s), at least 0.1 s.
 pub fn straight_time(start: &Start, goal: &Goal, speed: f64) -> f64 {
@@ -643,94 +594,309 @@ pub fn switch_checks(problem: &Problem, traj: &Trajectory, from_rest: bool) -> V
     out
 }
 
-/// The scenario text with `pushes` as its schedule and the start set to
-/// rest unless the file's `[initial]` says otherwise.
-pub fn plan_toml(
-    text: &str,
-    file: &std::path::Path,
-    pushes: &[Push],
-    goal: &Goal,
-    spec: &PlanSpec,
-) -> anyhow::Result<String> {
-    let mut doc: toml::Table =
-        toml::from_str(text).with_context(|| format!("{}: not TOML", file.display()))?;
-    let arr: Vec<toml::Value> = pushes
-        .iter()
-        .map(|p| {
-            let mut t = toml::Table::new();
-            t.insert("duration".into(), toml::Value::Float(p.duration));
-            t.insert("speed".into(), toml::Value::Float(p.speed));
-            t.insert("phi".into(), toml::Value::Float(p.phi));
-            toml::Value::Table(t)
-        })
-        .collect();
-    doc.insert("push".into(), toml::Value::Array(arr));
-    let initial = doc
-        .entry("initial")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    if let toml::Value::Table(t) = initial {
-        t.entry("from_rest").or_insert(toml::Value::Boolean(true));
-    }
-    if let Some(toml::Value::String(d)) = doc.get_mut("description") {
-        *d = format!(
-            "{d} | plan: {} pushes at {} m/s to {goal}, made on the {} model",
-            spec.segments,
-            spec.speed,
-            spec.predictor.as_str()
-        );
-    }
-    Ok(format!(
-        "# Written by `pushval plan`: the goal {goal} ({} predictor).\n{}",
-        spec.predictor.as_str(),
-        toml::to_string(&doc)?
-    ))
+/// What a plan may be asked for: refused outside these, before any work.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    /// Slowest push (m/s).
+    pub min_speed: f64,
+    /// Fastest push (m/s).
+    pub max_speed: f64,
+    /// Longest straight-line time to the goal (s): distance over speed.
+    pub max_straight_time: f64,
+    /// Largest distance of the goal from the start (m).
+    pub max_distance: f64,
+    /// Largest turn asked for (rad).
+    pub max_turn: f64,
+    /// Model runs the whole search may spend before it gives up.
+    pub max_runs: usize,
 }
 
-/// What `pushval plan` reports.
+impl Default for Bounds {
+    /// 1 mm/s to 20 m/s, 60 s of straight-line pushing, 100 m, two full
+    /// turns, 20,000 model runs (about a second of the dynamic model).
+    fn default() -> Self {
+        Self {
+            min_speed: 1e-3,
+            max_speed: 20.0,
+            max_straight_time: 60.0,
+            max_distance: 100.0,
+            max_turn: 4.0 * std::f64::consts::PI,
+            max_runs: 20_000,
+        }
+    }
+}
+
+impl Bounds {
+    /// Refuses a speed, a goal or a plan length outside the bounds.
+    pub fn check(&self, start: &Start, goal: &Goal, spec: &PlanSpec) -> Result<(), ControlError> {
+        let speed = spec.speed;
+        if !(speed.is_finite() && speed >= self.min_speed && speed <= self.max_speed) {
+            return Err(ControlError::Setting {
+                name: "push speed (m/s)",
+                requirement: format!("between {} and {}", self.min_speed, self.max_speed),
+                value: speed,
+            });
+        }
+        if !(1..=MAX_SEGMENTS).contains(&spec.segments) {
+            return Err(ControlError::Setting {
+                name: "pushes per plan",
+                requirement: format!("1 to {MAX_SEGMENTS}"),
+                value: spec.segments as f64,
+            });
+        }
+        if !(goal.x.is_finite() && goal.y.is_finite() && goal.theta.is_finite()) {
+            return Err(ControlError::GoalOutOfRange(format!(
+                "{goal} is not finite"
+            )));
+        }
+        let d = (goal.x - start.position.x).hypot(goal.y - start.position.y);
+        if d > self.max_distance {
+            return Err(ControlError::GoalOutOfRange(format!(
+                "it is {d:.4e} m from the start; plans reach at most {} m",
+                self.max_distance
+            )));
+        }
+        let turn = (goal.theta - start.theta).abs();
+        if turn > self.max_turn {
+            return Err(ControlError::GoalOutOfRange(format!(
+                "it asks for a turn of {turn:.4e} rad; plans turn at most {:.4} rad",
+                self.max_turn
+            )));
+        }
+        let t = d / speed;
+        if t > self.max_straight_time {
+            return Err(ControlError::GoalOutOfRange(format!(
+                "at {speed} m/s it is {t:.4e} s of straight pushing away; plans last at most {} s of straight pushing ({} times that in all)",
+                self.max_straight_time, MAX_TIME
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The most pushes a search tries.
+pub const MAX_SEGMENTS: usize = 12;
+
+/// One stage of the search: a number of pushes and the starting guesses
+/// tried with it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Attempt {
+    /// Pushes per plan.
+    pub segments: usize,
+    /// Starting guesses solved from.
+    pub guesses: usize,
+    /// The nearest pose's residual (m; the angle weighed by the radius of
+    /// gyration), None when the predictor failed on every guess.
+    pub best_residual_m: Option<f64>,
+    /// Plans that reached the goal on the predictor but were refused
+    /// because a switch needs a pulling impulse.
+    pub refused_pulling: usize,
+}
+
+/// What a plan search reports.
 pub struct PlanOutcome {
-    /// The nearest plan found.
+    /// The plan found, or the nearest one (see `reached`).
     pub solution: Solution,
-    /// Milliseconds of the solve.
+    /// Whether the plan reaches the goal on the predictor (within the
+    /// tolerance) and needs no pulling impulse.
+    pub reached: bool,
+    /// Milliseconds of the search.
     pub solve_ms: f64,
-    /// Model runs of the solve.
+    /// Model runs of the search.
     pub runs: usize,
+    /// What the search tried, stage by stage.
+    pub attempts: Vec<Attempt>,
     /// The assumption checks of the dynamic model along the plan.
     pub assumptions: pushval_model::Assumptions,
     /// Each switch's impulse against the friction cone.
     pub switches: Vec<SwitchCheck>,
-    /// Why it misses, when it does.
+    /// Why it misses (None when it reaches the goal).
     pub why: Option<String>,
 }
 
-/// Plans `goal` on `problem` from its start.
+/// The dynamic model's checks of `pushes` from `start` on `problem`: the
+/// trajectory (sampled at most 10,000 times) and its switches.
+fn checked(
+    problem: &Problem,
+    start: &Start,
+    pushes: &[Push],
+) -> Result<(Trajectory, Vec<SwitchCheck>), ControlError> {
+    let mut p = crate::predict::problem_of(problem, start, pushes, None);
+    let total = p.duration();
+    p.sample_dt = problem.sample_dt.max(total / 10_000.0).min(total);
+    let traj = DynamicModel::default().simulate(&p)?;
+    let from_rest = matches!(start.motion, Motion::Rest);
+    let switches = switch_checks(&p, &traj, from_rest);
+    Ok((traj, switches))
+}
+
+/// Plans `goal` on `problem` from its start: the search of
+/// [`Planner::plan_with_time`] with `spec.segments` pushes, then with more
+/// (up to [`MAX_SEGMENTS`]) while no plan reaches the goal, within
+/// `bounds.max_runs` model runs. A plan that reaches the goal on the
+/// predictor but needs a pulling impulse at a switch (the dynamic model's
+/// check) is refused and the search goes on.
 pub fn make_plan(
     problem: &Problem,
     goal: Goal,
     spec: PlanSpec,
     reach: Reach,
-) -> anyhow::Result<PlanOutcome> {
+    bounds: &Bounds,
+) -> Result<PlanOutcome, ControlError> {
     let start = Start::of_problem(problem);
+    bounds.check(&start, &goal, &spec)?;
     let t_ref = straight_time(&start, &goal, spec.speed);
-    let mut planner = Planner::new(problem, goal, spec, t_ref, reach);
     let clock = Instant::now();
-    let solution = planner
-        .plan(&start)
-        .context("the predictor failed on every starting guess")?;
+    let mut counts = vec![spec.segments];
+    counts.extend(
+        [8, 10, MAX_SEGMENTS]
+            .into_iter()
+            .filter(|&n| n > spec.segments),
+    );
+    let mut attempts = Vec::new();
+    let mut best: Option<(Solution, Trajectory, Vec<SwitchCheck>)> = None;
+    let mut found = None;
+    let mut runs = 0;
+    'search: for &segments in &counts {
+        let mut planner = Planner::new(problem, goal, PlanSpec { segments, ..spec }, t_ref, reach);
+        let mut attempt = Attempt {
+            segments,
+            guesses: 0,
+            best_residual_m: None,
+            refused_pulling: 0,
+        };
+        let guesses = if segments == spec.segments {
+            GUESSES.len()
+        } else {
+            GUESSES.len() + MORE_GUESSES.len()
+        };
+        for k in 0..guesses {
+            if runs + planner.predict.runs() > bounds.max_runs {
+                break;
+            }
+            attempt.guesses += 1;
+            let Some(s) = planner.from_guess(&start, t_ref, segments, k, 40) else {
+                continue;
+            };
+            attempt.best_residual_m = Some(
+                attempt
+                    .best_residual_m
+                    .map_or(s.residual, |r: f64| r.min(s.residual)),
+            );
+            let (traj, switches) = checked(problem, &start, &s.pushes)?;
+            let pulls = traj.assumptions.pulling_impulse.is_some();
+            let hit = s.converged || reach.holds(s.position_error, s.angle_error);
+            if hit && pulls {
+                attempt.refused_pulling += 1;
+            }
+            if hit && !pulls {
+                found = Some((s, traj, switches));
+                attempts.push(attempt);
+                runs += planner.predict.runs();
+                break 'search;
+            }
+            // The nearest so far, preferring plans without a pulling impulse.
+            let better = match &best {
+                None => true,
+                Some((b, bt, _)) => {
+                    let b_pulls = bt.assumptions.pulling_impulse.is_some();
+                    (b_pulls && !pulls) || (b_pulls == pulls && s.score() < b.score())
+                }
+            };
+            if better {
+                best = Some((s, traj, switches));
+            }
+        }
+        runs += planner.predict.runs();
+        attempts.push(attempt);
+        if runs > bounds.max_runs {
+            break;
+        }
+    }
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
-    // The checks on the dynamic model, whatever the plan was made on.
-    let checked = DynamicModel::default();
-    let mut p = planner.predict.problem_of(&start, &solution.pushes, None);
-    p.sample_dt = (problem.sample_dt).min(p.duration());
-    let traj = checked.simulate(&p)?;
-    let from_rest = matches!(start.motion, Motion::Rest);
-    let switches = switch_checks(&p, &traj, from_rest);
-    let why = (!solution.converged).then(|| planner.why_missed(&solution));
+    let reached = found.is_some();
+    let (solution, traj, switches) = match found.or(best) {
+        Some(f) => f,
+        None => {
+            return Err(ControlError::PredictorFailed(format!(
+                "tried {}",
+                describe_attempts(&attempts)
+            )))
+        }
+    };
+    let why = (!reached).then(|| {
+        let planner = Planner::new(
+            problem,
+            goal,
+            PlanSpec {
+                segments: solution.params.u.len(),
+                ..spec
+            },
+            t_ref,
+            reach,
+        );
+        let refused: usize = attempts.iter().map(|a| a.refused_pulling).sum();
+        let mut why = planner.why_missed(&solution);
+        if refused > 0 {
+            why = format!(
+                "{refused} plans reach the goal on the model but need a pulling impulse at a switch, and a point pusher cannot pull, so none is a plan; the nearest plan without one misses: {why}"
+            );
+        } else if traj.assumptions.pulling_impulse.is_some() {
+            why = format!(
+                "the nearest plan needs a pulling impulse at a switch (a point pusher cannot pull); {why}"
+            );
+        }
+        format!("{why} (tried {})", describe_attempts(&attempts))
+    });
     Ok(PlanOutcome {
-        runs: planner.predict.runs,
         solution,
+        reached,
         solve_ms,
+        runs,
+        attempts,
         assumptions: traj.assumptions,
         switches,
         why,
     })
+}
+
+/// `6 pushes × 7 guesses, 8 pushes × 7 guesses, …`.
+pub fn describe_attempts(attempts: &[Attempt]) -> String {
+    let parts: Vec<String> = attempts
+        .iter()
+        .map(|a| {
+            let mut t = format!("{} pushes × {} starting guesses", a.segments, a.guesses);
+            if a.refused_pulling > 0 {
+                t.push_str(&format!(
+                    " ({} refused for a pulling impulse)",
+                    a.refused_pulling
+                ));
+            }
+            t
+        })
+        .collect();
+    parts.join(", ")
+}
+
+/// `params` with `segments` pushes: each new push takes the direction of the
+/// old push at its middle (the same piecewise-constant schedule, coarser).
+pub fn resample(params: &Params, segments: usize) -> Params {
+    let old = params.u.len();
+    if old == segments {
+        return params.clone();
+    }
+    Params {
+        u: (0..segments)
+            .map(|k| params.u[(((k as f64 + 0.5) / segments as f64) * old as f64) as usize % old])
+            .collect(),
+        s: params.s,
+    }
+}
+
+/// The nearer of two solutions to the goal.
+pub fn nearest(a: Option<Solution>, b: Option<Solution>) -> Option<Solution> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(if b.score() < a.score() { b } else { a }),
+        (a, b) => a.or(b),
+    }
 }

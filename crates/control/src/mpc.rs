@@ -1,22 +1,28 @@
-//! `pushval loop`: model-predictive control with an engine as the plant.
+//! Model-predictive control with an engine session as the plant.
 //!
 //! The plan from rest is made first (a [`Planner`] on the predictor). Then,
-//! every control period, the engine's session advances by one period under
-//! the first push of the current plan; pushval reads the engine's state
-//! (pose, ω and the centre of mass's velocity, which give the angular
-//! momentum about the contact that an impulsive switch keeps) and re-plans
-//! the remaining time from it, warm-started from the last plan and its
-//! Jacobian. When the time left is shorter than one period per segment,
-//! the rest of the plan is applied as it stands.
+//! every control period, the plant advances by one period under the first
+//! push of the current plan; the loop reads the plant's state (pose, ω and
+//! the centre of mass's velocity, which give the angular momentum about the
+//! contact that an impulsive switch keeps) and re-plans the remaining time
+//! from it, warm-started from the last plan and its Jacobian. When the time
+//! left is one period or less, the rest of the plan is re-solved with its
+//! time on the plant's step grid and applied.
+//!
+//! Every duration the loop applies is a whole number of the plant's steps
+//! (`dt`): the period is rounded to whole steps (and must be at least one),
+//! and the plan's last stretch is re-solved on the grid
+//! ([`Planner::on_grid`]), so a fixed-step plant ends its rows exactly where
+//! the loop said it would.
 
 use std::time::Instant;
 
-use anyhow::{bail, Context};
-use pushval_engine::{Engine, EngineRun};
-use pushval_model::{Body, Problem, Push, Support};
+use pushval_engine::{EngineSession, EngineState};
+use pushval_model::{Body, ModelError, Problem, Push, Support, Vec2};
 
-use super::plan::{straight_time, Motion, PlanSpec, Planner, Start, GUESSES};
-use super::{pose_errors, Goal, Predictor, Reach};
+use crate::plan::{nearest, resample, straight_time, PlanSpec, Planner, Solution, GUESSES};
+use crate::predict::{Motion, Start};
+use crate::{pose_errors, ControlError, Goal, Reach};
 
 /// How the plant differs from the predictor's scene.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -43,36 +49,13 @@ impl PlantScale {
         inertia_scale: 1.2,
     };
 
-    /// Parses `mu_scale=A,inertia_scale=B` (either may be left out).
-    pub fn parse(text: &str) -> anyhow::Result<Self> {
-        let mut out = Self::default();
-        for part in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let (k, v) = part
-                .split_once('=')
-                .with_context(|| format!("--plant: `{part}` is not KEY=VALUE"))?;
-            let v: f64 = v
-                .trim()
-                .parse()
-                .with_context(|| format!("--plant: `{}` is not a number", v.trim()))?;
-            if !(v.is_finite() && v > 0.0) {
-                bail!("--plant: {k} must be finite and > 0, got {v}");
-            }
-            match k.trim() {
-                "mu_scale" => out.mu_scale = v,
-                "inertia_scale" => out.inertia_scale = v,
-                other => bail!("--plant: unknown key `{other}` (mu_scale, inertia_scale)"),
-            }
-        }
-        Ok(out)
-    }
-
     /// Whether it changes nothing.
     pub fn is_nominal(&self) -> bool {
         self.mu_scale == 1.0 && self.inertia_scale == 1.0
     }
 
     /// `problem` with the plant's friction and inertia.
-    pub fn apply(&self, problem: &Problem) -> anyhow::Result<Problem> {
+    pub fn apply(&self, problem: &Problem) -> Result<Problem, ModelError> {
         if self.is_nominal() {
             return Ok(problem.clone());
         }
@@ -102,10 +85,8 @@ impl PlantScale {
 pub struct LoopSpec {
     /// The plan's shape and predictor.
     pub plan: PlanSpec,
-    /// The control period (s).
+    /// The control period (s); rounded to whole plant steps.
     pub period: f64,
-    /// The plant's perturbation.
-    pub plant: PlantScale,
     /// What counts as reaching the goal.
     pub reach: Reach,
 }
@@ -119,12 +100,39 @@ pub struct Applied {
     pub push: Push,
 }
 
+/// What the loop tells its observer at the end of each control period.
+#[derive(Debug, Clone)]
+pub struct Period<'a> {
+    /// Periods done so far (1 for the first).
+    pub index: usize,
+    /// The plant's state the re-plan started from.
+    pub state: EngineState,
+    /// The plan after the re-plan (the pushes still to apply).
+    pub plan: &'a [Push],
+    /// Whether the re-plan converged on the predictor.
+    pub converged: bool,
+    /// The calling thread's CPU time of the re-plan (µs).
+    pub predictor_cpu_us: f64,
+}
+
+/// Watches the loop: called once per control period, after its re-plan.
+pub trait Observer {
+    /// One period done.
+    fn period(&mut self, period: &Period<'_>);
+}
+
+/// No observer.
+impl Observer for () {
+    fn period(&mut self, _period: &Period<'_>) {}
+}
+
 /// What one closed-loop run did.
+#[derive(Debug, Clone)]
 pub struct LoopOutcome {
-    /// The engine's run of the applied pushes.
-    pub run: EngineRun,
-    /// The pushes applied, in order.
+    /// The pushes applied, in order (each a whole number of plant steps).
     pub applied: Vec<Applied>,
+    /// The plant's state when the last push ended.
+    pub last: EngineState,
     /// Final distance from the goal (m).
     pub position_error: f64,
     /// Final angle error (rad).
@@ -136,6 +144,8 @@ pub struct LoopOutcome {
     pub gave_up: bool,
     /// Control periods (re-plans).
     pub steps: usize,
+    /// The control period applied (s): whole plant steps.
+    pub period: f64,
     /// Wall time of each re-plan (µs).
     pub predictor_us: Vec<f64>,
     /// The calling thread's CPU time of each re-plan (µs): what the
@@ -143,7 +153,7 @@ pub struct LoopOutcome {
     pub predictor_cpu_us: Vec<f64>,
     /// Whether the plan from rest converged on the predictor.
     pub plan_converged: bool,
-    /// Whether the engine re-ran its schedule at every period (it cannot step).
+    /// Whether the plant re-ran its schedule at every period (it cannot step).
     pub replayed: bool,
 }
 
@@ -153,7 +163,7 @@ pub fn plan_from_rest(
     goal: Goal,
     spec: PlanSpec,
     reach: Reach,
-) -> Option<(Planner, super::plan::Solution)> {
+) -> Option<(Planner, Solution)> {
     let start = Start::of_problem(problem);
     let t_ref = straight_time(&start, &goal, spec.speed);
     let mut planner = Planner::new(problem, goal, spec, t_ref, reach);
@@ -161,27 +171,45 @@ pub fn plan_from_rest(
     Some((planner, s))
 }
 
-/// Runs `pushes` open loop in `engine` on the plant, returning the final
-/// errors and the run.
+/// The calling thread's CPU time (s).
+pub fn thread_cpu_time() -> f64 {
+    let ts = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// The whole plant steps of `period` (s) at `dt` (s): refused when shorter
+/// than one step.
+pub fn period_steps(period: f64, dt: f64) -> Result<usize, ControlError> {
+    if !(period.is_finite() && period > 0.0) {
+        return Err(ControlError::Setting {
+            name: "control period (s)",
+            requirement: "finite and > 0".into(),
+            value: period,
+        });
+    }
+    let k = (period / dt * (1.0 + 1e-12)).round();
+    if k < 1.0 || period < dt * (1.0 - 1e-9) {
+        return Err(ControlError::Setting {
+            name: "control period (s)",
+            requirement: format!("at least the plant's step, {dt} s"),
+            value: period,
+        });
+    }
+    Ok(k as usize)
+}
+
+/// Applies `pushes` to the plant open loop; its state after them.
 pub fn open_loop(
-    problem: &Problem,
-    engine: &dyn Engine,
-    dt: f64,
+    plant: &mut dyn EngineSession,
     pushes: &[Push],
-    plant: PlantScale,
-    goal: &Goal,
-) -> anyhow::Result<(EngineRun, f64, f64)> {
-    let mut p = plant.apply(problem)?;
-    p.pushes = pushes.to_vec();
-    let run = engine.run(&p, dt)?;
-    let s = run
-        .trajectory
-        .samples
-        .last()
-        .copied()
-        .context("an empty run")?;
-    let (pe, ae) = pose_errors(s.x, s.y, s.theta, goal);
-    Ok((run, pe, ae))
+) -> Result<EngineState, ControlError> {
+    for p in pushes {
+        let t = plant.state().t;
+        plant
+            .advance(p)
+            .map_err(|source| ControlError::Plant { t, source })?;
+    }
+    Ok(plant.state())
 }
 
 /// Levenberg–Marquardt steps of one fallback stage (with its fresh
@@ -189,28 +217,39 @@ pub fn open_loop(
 /// next period's warm start, so the search goes on.
 pub const STAGE_STEPS: usize = 6;
 
-/// Model-predictive control of `engine` towards `goal`.
+fn start_of(problem: &Problem, st: &EngineState) -> Start {
+    Start {
+        theta: st.theta,
+        position: Vec2::new(st.x, st.y),
+        motion: Motion::Moving {
+            omega: st.omega,
+            momentum: st.contact_momentum(problem),
+        },
+    }
+}
+
+/// Model-predictive control of `plant` (a session started on the plant's
+/// scene at step `dt`, s) towards `goal`, planned on `problem`'s scene.
+/// The caller owns the plant and finishes it.
 pub fn run_loop(
     problem: &Problem,
-    engine: &dyn Engine,
+    plant: &mut dyn EngineSession,
     dt: f64,
     goal: Goal,
     spec: LoopSpec,
-) -> anyhow::Result<LoopOutcome> {
-    if !(spec.period.is_finite() && spec.period > 0.0) {
-        bail!("--period must be finite and > 0, got {}", spec.period);
-    }
+    observer: &mut dyn Observer,
+) -> Result<LoopOutcome, ControlError> {
+    let k = period_steps(spec.period, dt)?;
+    let period = k as f64 * dt;
     let (mut planner, first) = plan_from_rest(problem, goal, spec.plan, spec.reach)
-        .context("the predictor failed on every starting guess from rest")?;
+        .ok_or_else(|| ControlError::PredictorFailed("from rest".into()))?;
     let plan_converged = first.converged;
-    // The session starts on the first plan's schedule: what an engine reads
-    // of the schedule at `start` (a push following a segment) is the best
-    // guess there is of what the loop will apply.
-    let mut plant = spec.plant.apply(problem)?;
-    plant.pushes = first.pushes.clone();
-    let mut session = engine
-        .start(&plant, dt)
-        .with_context(|| format!("{}: starting a session", engine.name()))?;
+    let advance = |plant: &mut dyn EngineSession, p: &Push| {
+        let t = plant.state().t;
+        plant
+            .advance(p)
+            .map_err(|source| ControlError::Plant { t, source })
+    };
     let n = spec.plan.segments;
     let mut params = first.params.clone();
     let mut pushes = first.pushes.clone();
@@ -227,53 +266,55 @@ pub fn run_loop(
     loop {
         if t + remaining > give_up {
             // The plan keeps growing: the plant does not move as predicted.
-            let rest = (give_up - t).max(0.0);
+            let rest = ((give_up - t) / dt).round().max(0.0) * dt;
             if rest > 0.0 {
                 let p = Push {
                     duration: rest,
                     ..pushes[0]
                 };
-                session.advance(&p)?;
+                advance(plant, &p)?;
                 applied.push(Applied { t0: t, push: p });
             }
             gave_up = true;
             break;
         }
-        if remaining <= spec.period * (1.0 + 1e-9) {
-            // The last period: the rest as planned.
-            for p in &pushes {
-                session.advance(p)?;
+        if remaining <= period * (1.0 + 1e-9) {
+            // The last stretch: its time on the plant's grid, re-solved
+            // there, then applied as it stands.
+            let last_start = if steps == 0 {
+                Start::of_problem(problem)
+            } else {
+                start_of(problem, &plant.state())
+            };
+            let current = planner.solution_of(params.clone());
+            let on_grid = planner
+                .on_grid(&last_start, &current, dt)
+                .map(|s| s.pushes)
+                .unwrap_or_else(|| grid_pushes(&pushes, dt));
+            for p in &on_grid {
+                advance(plant, p)?;
                 applied.push(Applied { t0: t, push: *p });
                 t += p.duration;
             }
             break;
         }
         let push = Push {
-            duration: spec.period,
+            duration: period,
             ..pushes[0]
         };
-        session
-            .advance(&push)
-            .with_context(|| format!("{}: advancing at t = {t:.3} s", engine.name()))?;
+        advance(plant, &push)?;
         applied.push(Applied { t0: t, push });
-        t += spec.period;
-        remaining -= spec.period;
+        t += period;
+        remaining -= period;
         steps += 1;
-        let st = session.state();
-        let start = Start {
-            theta: st.theta,
-            position: pushval_model::Vec2::new(st.x, st.y),
-            motion: Motion::Moving {
-                omega: st.omega,
-                momentum: st.contact_momentum(problem),
-            },
-        };
+        let st = plant.state();
+        let start = start_of(problem, &st);
         let clock = Instant::now();
-        let cpu = crate::track::thread_cpu_time();
+        let cpu = thread_cpu_time();
         // As the time left shrinks, so does the number of pushes: each keeps
         // at least one period (down to one push: then the least-squares
         // pose nearest the goal).
-        let segments = ((remaining / spec.period * (1.0 + 1e-9)).floor() as usize).clamp(1, n);
+        let segments = ((remaining / period * (1.0 + 1e-9)).floor() as usize).clamp(1, n);
         let warm = planner.with_duration(&resample(&params, segments), remaining);
         let mut solved = planner.solve(&start, warm.clone(), 4);
         if solved.as_ref().is_some_and(|s| s.converged) {
@@ -299,7 +340,9 @@ pub fn run_loop(
             };
         }
         predictor_us.push(clock.elapsed().as_secs_f64() * 1e6);
-        predictor_cpu_us.push((crate::track::thread_cpu_time() - cpu) * 1e6);
+        let cpu_us = (thread_cpu_time() - cpu) * 1e6;
+        predictor_cpu_us.push(cpu_us);
+        let converged = solved.as_ref().is_some_and(|s| s.converged);
         match solved {
             Some(s) => {
                 params = s.params;
@@ -314,61 +357,42 @@ pub fn run_loop(
                 pushes = planner.pushes(&params);
             }
         }
+        observer.period(&Period {
+            index: steps,
+            state: st,
+            plan: &pushes,
+            converged,
+            predictor_cpu_us: cpu_us,
+        });
     }
-    let replayed = session.replays();
-    let st = session.state();
-    let run = session.finish()?;
-    let (pe, ae) = pose_errors(st.x, st.y, st.theta, &goal);
+    let last = plant.state();
+    let (pe, ae) = pose_errors(last.x, last.y, last.theta, &goal);
     Ok(LoopOutcome {
-        run,
         applied,
+        last,
         position_error: pe,
         angle_error: ae,
         success: spec.reach.holds(pe, ae),
         gave_up,
         steps,
+        period,
         predictor_us,
         predictor_cpu_us,
         plan_converged,
-        replayed,
+        replayed: plant.replays(),
     })
 }
 
-/// `params` with `segments` pushes: each new push takes the direction of the
-/// old push at its middle (the same piecewise-constant schedule, coarser).
-fn resample(params: &super::plan::Params, segments: usize) -> super::plan::Params {
-    let old = params.u.len();
-    if old == segments {
-        return params.clone();
-    }
-    super::plan::Params {
-        u: (0..segments)
-            .map(|k| params.u[(((k as f64 + 0.5) / segments as f64) * old as f64) as usize % old])
-            .collect(),
-        s: params.s,
-    }
-}
-
-/// The nearer of two solutions to the goal.
-fn nearest(
-    a: Option<super::plan::Solution>,
-    b: Option<super::plan::Solution>,
-) -> Option<super::plan::Solution> {
-    match (a, b) {
-        (Some(a), Some(b)) => Some(if b.score() < a.score() { b } else { a }),
-        (a, b) => a.or(b),
-    }
-}
-
-/// The median and the 99th percentile of `v` (nearest rank), NaN when empty.
-pub fn median_p99(v: &[f64]) -> (f64, f64) {
-    if v.is_empty() {
-        return (f64::NAN, f64::NAN);
-    }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let rank = |q: f64| s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1];
-    (rank(0.5), rank(0.99))
+/// `pushes` with each duration rounded to whole steps of `dt` (at least
+/// one): the fallback when the re-solve on the grid fails.
+fn grid_pushes(pushes: &[Push], dt: f64) -> Vec<Push> {
+    pushes
+        .iter()
+        .map(|p| Push {
+            duration: (p.duration / dt).round().max(1.0) * dt,
+            ..*p
+        })
+        .collect()
 }
 
 /// The push applied at time `t` (s): the one whose interval holds it, the
@@ -379,29 +403,4 @@ pub fn push_at(applied: &[Applied], t: f64) -> Option<&Push> {
         .rev()
         .find(|a| a.t0 <= t + 1e-12)
         .map(|a| &a.push)
-}
-
-/// `predictor` name and the trajectory rows with the applied push, as CSV.
-pub fn trajectory_csv(out: &LoopOutcome, model: &str) -> String {
-    let mut s = format!("{},speed,phi\n", pushval_model::format::HEADER);
-    for smp in &out.run.trajectory.samples {
-        let p = push_at(&out.applied, smp.t);
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{}\n",
-            model,
-            smp.t,
-            smp.x,
-            smp.y,
-            smp.theta,
-            smp.omega,
-            p.map_or(0.0, |p| p.speed),
-            p.map_or(0.0, |p| p.phi)
-        ));
-    }
-    s
-}
-
-/// The predictor's name as outputs give it.
-pub fn predictor_name(p: Predictor) -> &'static str {
-    p.as_str()
 }
