@@ -5,6 +5,7 @@
 //! `--predictor`), the output folders and the study across engines.
 
 pub mod cli;
+pub mod figures;
 pub mod study;
 
 use anyhow::{bail, Context};

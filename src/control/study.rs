@@ -471,7 +471,7 @@ pub fn cli(
 }
 
 /// One success.csv row's key.
-type Group = (String, u64, &'static str, &'static str, &'static str);
+pub(crate) type Group = (String, u64, &'static str, &'static str, &'static str);
 
 #[allow(clippy::too_many_arguments)]
 fn write_outputs(
@@ -588,8 +588,11 @@ fn write_outputs(
         goals_csv.row(&[i.to_string(), num(g.x), num(g.y), num(g.theta)]);
     }
     dir.file("goals.csv", goals_csv.as_bytes())?;
-    dir.figure("success.svg", &success_figure(names, speeds, &summary))?;
-    let paths = paths_figure(problem, names, goals, speeds)?;
+    dir.figure(
+        "success.svg",
+        &super::figures::success_figure(names, speeds, &summary),
+    )?;
+    let paths = super::figures::paths_figure(problem, names, goals, speeds)?;
     dir.figure("paths.svg", &paths)?;
     let mut failed_runs: BTreeMap<String, usize> = BTreeMap::new();
     for (t, r) in list.iter().zip(rows) {
@@ -608,198 +611,6 @@ fn write_outputs(
     );
     dir.file("README.md", readme.as_bytes())?;
     Ok(())
-}
-
-const COLUMNS: [(&str, &str, &str); 8] = [
-    ("dynamic", "open", "nominal"),
-    ("dynamic", "mpc", "nominal"),
-    ("dynamic", "open", "perturbed"),
-    ("dynamic", "mpc", "perturbed"),
-    ("kinematic", "open", "nominal"),
-    ("kinematic", "mpc", "nominal"),
-    ("kinematic", "open", "perturbed"),
-    ("kinematic", "mpc", "perturbed"),
-];
-
-fn short(c: &(&str, &str, &str)) -> String {
-    format!(
-        "{}·{}·{}",
-        if c.0 == "dynamic" { "dyn" } else { "kin" },
-        c.1,
-        if c.2 == "nominal" { "nom" } else { "pert" }
-    )
-}
-
-fn success_figure(
-    names: &[String],
-    speeds: &[f64],
-    summary: &BTreeMap<Group, (usize, usize, f64, f64)>,
-) -> Figure {
-    let colors = vec![
-        plot::RED_,
-        plot::ORANGE,
-        plot::OLIVE,
-        plot::CYAN_,
-        plot::GREEN_,
-    ];
-    let scale = Scale::Classes(colors);
-    let mut panels = Vec::new();
-    for &v in speeds {
-        let mut cells = Vec::new();
-        let n = names.len();
-        for (row, name) in names.iter().enumerate() {
-            let y = (n - 1 - row) as f64;
-            for (col, c) in COLUMNS.iter().enumerate() {
-                let k: Group = (name.clone(), v.to_bits(), c.0, c.1, c.2);
-                let (value, mark) = match summary.get(&k) {
-                    Some(&(ok, total, _, _)) if total > 0 => {
-                        let share = ok as f64 / total as f64;
-                        let class = if share >= 0.95 {
-                            4.0
-                        } else if share >= 0.75 {
-                            3.0
-                        } else if share >= 0.5 {
-                            2.0
-                        } else if share >= 0.25 {
-                            1.0
-                        } else {
-                            0.0
-                        };
-                        (class, format!("{ok}/{total}"))
-                    }
-                    _ => (f64::NAN, String::new()),
-                };
-                cells.push(MapCell {
-                    x: (col as f64 + 3.0, col as f64 + 4.0),
-                    y: (y, y + 1.0),
-                    value,
-                    mark,
-                });
-            }
-            // The engine's name in a white column on the left.
-            cells.push(MapCell {
-                x: (0.0, 3.0),
-                y: (y, y + 1.0),
-                value: 5.0,
-                mark: name.clone(),
-            });
-        }
-        for (col, c) in COLUMNS.iter().enumerate() {
-            cells.push(MapCell {
-                x: (col as f64 + 3.0, col as f64 + 4.0),
-                y: (n as f64, n as f64 + 1.0),
-                value: 5.0,
-                mark: short(c),
-            });
-        }
-        let mut with_white = scale.clone();
-        if let Scale::Classes(c) = &mut with_white {
-            c.push(plotters::style::RGBColor(255, 255, 255));
-        }
-        let panel = plot::heat_map(
-            format!("goals reached at {v} m/s"),
-            Axis::lin("plan predictor · open loop or MPC · plant").range(0.0, 11.0),
-            Axis::lin("engine").range(0.0, n as f64 + 1.0),
-            &cells,
-            &with_white,
-        )
-        .legend(Legend::None);
-        panels.push(panel);
-    }
-    let labels = ["< 25 %", "25–50 %", "50–75 %", "75–95 %", "≥ 95 %"];
-    let notes = vec![
-        "goals reached (20 mm, 5°)".to_string(),
-        "dyn/kin: plan made on the".to_string(),
-        "dynamic / kinematic model;".to_string(),
-        "pert: plant μ × 0.8, I_cm × 1.2".to_string(),
-    ];
-    let key = scale.key("success", &labels, &notes);
-    let rows = names.len().max(4) as u32;
-    Figure {
-        size: (1500, 120 + 34 * (rows + 1) * speeds.len() as u32),
-        cols: 1,
-        panels,
-        key: Some(key),
-    }
-}
-
-/// The first goal's paths (dynamic plan, open loop, nominal plant, at the
-/// grid's fastest speed) in every engine, drawn over the goal and the
-/// dynamic model's prediction.
-fn paths_figure(
-    problem: &Problem,
-    names: &[String],
-    goals: &[Goal],
-    speeds: &[f64],
-) -> anyhow::Result<Figure> {
-    let v = speeds.iter().copied().fold(f64::MIN, f64::max);
-    let goal = goals[0];
-    let start = Start::of_problem(problem);
-    let spec = PlanSpec {
-        segments: SEGMENTS,
-        speed: v,
-        predictor: Predictor::Dynamic,
-    };
-    let mut planner = Planner::new(
-        problem,
-        goal,
-        spec,
-        straight_time(&start, &goal, v),
-        Reach::default(),
-    );
-    let plan = planner.plan(&start).context("the first goal's plan")?;
-    let mut p = problem.clone();
-    p.pushes = plan.pushes.clone();
-    p.sample_dt = p.duration() / 200.0;
-    let labels: Vec<&str> = names.iter().map(String::as_str).collect();
-    let styles = plot::family_styles(&labels);
-    let mut panel = Panel::new(
-        format!("goal 0 ({goal}) at {v} m/s: the dynamic plan replayed open loop"),
-        Axis::lin("x (m)"),
-        Axis::lin("y (m)"),
-    )
-    .legend(Legend::Outside)
-    .equal_aspect();
-    let model = pushval_model::DynamicModel::default();
-    let traj = pushval_model::Simulator::simulate(&model, &p)?;
-    panel = panel.series(
-        Series::new("dynamic model", plot::DARK, Stroke::Solid)
-            .width(3)
-            .points(traj.samples.iter().map(|s| (s.x, s.y)).collect()),
-    );
-    for (name, (color, stroke)) in names.iter().zip(styles) {
-        let e = crate::registry::entry(name)
-            .expect("listed")
-            .default_engine();
-        match e.run(&p, e.default_dt()) {
-            Ok(run) => {
-                panel = panel.series(
-                    Series::new(name.clone(), color, stroke)
-                        .points(run.trajectory.samples.iter().map(|s| (s.x, s.y)).collect()),
-                );
-            }
-            Err(err) => eprintln!("control-study: paths: {name}: {err}"),
-        }
-    }
-    // The goal: a cross of the plate's half-width, and its heading.
-    let a = 0.05;
-    let (s, c) = goal.theta.sin_cos();
-    panel = panel
-        .series(
-            Series::new("goal (heading)", plot::RED_, Stroke::Solid)
-                .width(3)
-                .points(vec![
-                    (goal.x, goal.y),
-                    (goal.x + 2.0 * a * c, goal.y + 2.0 * a * s),
-                ]),
-        )
-        .series(Series::new("goal", plot::RED_, Stroke::Dots).points(vec![(goal.x, goal.y)]));
-    Ok(Figure {
-        size: (1400, 900),
-        cols: 1,
-        panels: vec![panel],
-        key: None,
-    })
 }
 
 /// The law's steady ω against Coulomb's for the scene's middle push at

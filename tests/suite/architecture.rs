@@ -662,6 +662,7 @@ fn crates_depend_downwards() {
             "pushval-laws",
             "pushval-engine",
             "pushval-outside",
+            "pushval-control",
         ]
         .contains(&name.as_str());
         let expected = if core_crate {
@@ -685,11 +686,23 @@ fn crates_depend_downwards() {
         deps["pushval-engine"],
         set(&["pushval-model", "pushval-laws"])
     );
+    // The control library: the model, the laws and the engine interface
+    // only (DESIGN: no engine crate, no scenario files, no command line).
+    assert!(
+        deps["pushval-control"].is_subset(&set(&[
+            "pushval-model",
+            "pushval-laws",
+            "pushval-engine"
+        ])),
+        "pushval-control depends on {:?}",
+        deps["pushval-control"]
+    );
     let core = [
         "pushval-model",
         "pushval-scenario",
         "pushval-laws",
         "pushval-engine",
+        "pushval-control",
     ];
     let engine_side = set(&["pushval-model", "pushval-laws", "pushval-engine"]);
     for (name, d) in &deps {
