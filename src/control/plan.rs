@@ -132,6 +132,7 @@ impl Predict {
                 omega: 0.0,
                 position: start.position,
                 from_rest: true,
+                velocity: pushval_model::Vec2::zeros(),
             },
             Motion::Moving { omega, momentum } => {
                 let first = &pushes[0];
@@ -148,6 +149,7 @@ impl Predict {
                     omega: w,
                     position: start.position,
                     from_rest: false,
+                    velocity: pushval_model::Vec2::zeros(),
                 }
             }
         };
@@ -199,6 +201,7 @@ fn placeholder() -> Problem {
         initial: Initial::default(),
         switching: Switching::default(),
         sample_dt: 1.0,
+        release: None,
     }
 }
 

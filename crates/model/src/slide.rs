@@ -582,9 +582,6 @@ impl Run<'_, '_, '_> {
             });
             self.out.rhs_evals += 12;
             if !(a.err <= 1.0) {
-                if std::env::var_os("SLIDE_DEBUG").is_some() {
-                    eprintln!("REJ h {h:.3e} err {:.2e}", a.err);
-                }
                 self.out.rejected += 1;
                 h = next_step8(h, a.err).min(0.9 * h);
                 if h < 1e-12 {
@@ -596,9 +593,6 @@ impl Run<'_, '_, '_> {
                 continue;
             }
             self.out.steps += 1;
-            if std::env::var_os("SLIDE_DEBUG").is_some() {
-                eprintln!("h {h:.3e} s {:.3e} err {:.2e} q ({:.4},{:.4},{:.4})", speed(&a.y1), a.err, a.y1[0]/speed(&a.y1), a.y1[1]/speed(&a.y1), a.y1[2]/speed(&a.y1));
-            }
             let (t0, t1) = (y[T], a.y1[T]);
             if self.sampler.due(t1.min(self.t_max)).is_some() || t1 >= self.t_max {
                 let dense = a.dense(&mut rhs, 0.0, &y, h);
@@ -723,9 +717,6 @@ impl Run<'_, '_, '_> {
                         self.sampler.push(st);
                     }
                     return Ok(Phase::Pivot(i, yp));
-                }
-                if std::env::var_os("SLIDE_DEBUG").is_some() {
-                    eprintln!("aim {i} rel {rel:.3e} delta {delta:.3e} h {h:.3e}");
                 }
                 // Aimed a little short: a step ending on the pivot has
                 // stages beyond it, where the support's friction has turned

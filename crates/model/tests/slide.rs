@@ -323,3 +323,81 @@ fn a_mirrored_throw_rests_at_the_mirrored_pose() {
         assert!((a.end.theta + b.end.theta).abs() < 1e-11, "{:?} {:?}", a.end, b.end);
     }
 }
+
+/// A square plate with most of its load on one corner (3 N of friction
+/// there, 0.5 N at the others).
+fn heavy_foot() -> Body {
+    let a = 0.125;
+    plate(
+        1.0,
+        (2.0 * a) * (2.0 * a) / 6.0,
+        &[(a, a, 3.0), (-a, a, 0.5), (-a, -a, 0.5), (a, -a, 0.5)],
+    )
+}
+
+/// World sliding velocity of support `sp` at a sampled state.
+fn slip(s: &SlideState, sp: &Support) -> Vec2 {
+    let (sn, cs) = s.theta.sin_cos();
+    let r = Vec2::new(
+        cs * sp.position.x - sn * sp.position.y,
+        sn * sp.position.x + cs * sp.position.y,
+    );
+    Vec2::new(s.vx - s.omega * r.y, s.vy + s.omega * r.x)
+}
+
+/// An uneven plate ends its slide pivoting about its heavy foot: the foot
+/// stops while the others slide. The pivot is found and the slide
+/// finishes; while stuck the foot does not move (its sliding velocity is
+/// zero in the samples) and the reaction it must supply, from Newton's law
+/// on the sampled motion (`R = m a_cm − Σ_{j≠foot} Fⱼ`, a_cm by central
+/// differences of the sampled velocity), stays inside its friction cone
+/// |R| ≤ f_foot. The energy balance holds across the stick (the stuck foot
+/// does no work).
+#[test]
+fn a_plate_pivots_about_its_heavy_foot() {
+    let body = heavy_foot();
+    let start = throw(0.0, 0.0, 0.4, 0.8, 0.6, 3.0);
+    let sl = run(&body, &start);
+    let stop = sl.stop.expect("the slide finishes");
+    assert_eq!(sl.pivots.len(), 1, "{:?}", sl.pivots);
+    let p = sl.pivots[0];
+    assert_eq!((p.support, p.end), (0, PivotEnd::Rest), "{p:?}");
+    assert_eq!(p.t_end, stop);
+    assert!(p.t_start > 0.0 && p.t_start < stop - 0.05, "{p:?}");
+    let foot = body.support(0);
+    let s0 = f64::hypot(f64::hypot(start.vx, start.vy), 0.1 * start.omega);
+    // Before the pivot the foot slides; during it, it does not.
+    let dt = 1e-5;
+    let mid: Vec<f64> = (1..10)
+        .map(|k| p.t_start + (p.t_end - p.t_start) * k as f64 / 10.0)
+        .collect();
+    let mut ts = vec![p.t_start * 0.5];
+    for &t in &mid {
+        ts.extend([t - dt, t, t + dt]);
+    }
+    let smp = sampled(&body, &start, &ts).samples;
+    assert_eq!(smp.len(), ts.len());
+    assert!(slip(&smp[0], &foot).norm() > 1e-3 * s0);
+    for k in 0..mid.len() {
+        let (a, s, b) = (smp[1 + 3 * k], smp[2 + 3 * k], smp[3 + 3 * k]);
+        assert!(slip(&s, &foot).norm() < 1e-9 * s0, "{s:?}");
+        let acc = Vec2::new(b.vx - a.vx, b.vy - a.vy) / (2.0 * dt);
+        let mut others = Vec2::zeros();
+        for j in 1..body.len() {
+            let u = slip(&s, &body.support(j));
+            others -= u * (body.support(j).friction / u.norm());
+        }
+        let reaction = acc * body.mass() - others;
+        assert!(
+            reaction.norm() <= foot.friction * (1.0 + 1e-6),
+            "t {}: |R| {} > {}",
+            s.t,
+            reaction.norm(),
+            foot.friction
+        );
+        assert!(reaction.norm() > 0.1 * foot.friction);
+    }
+    let (work, _) = dissipated(&body, &start, stop, 4000);
+    let e0 = energy(&body, &start);
+    assert!((work - e0).abs() < 1e-7 * e0, "{work} vs {e0}");
+}
