@@ -53,8 +53,10 @@ pub use dynamic::{InertialTerm, RootKind, SegmentDynamics, SteadyState};
 pub use error::ModelError;
 pub use kappa::{kappa_exact, kappa_series, KappaSeries};
 pub use problem::{ContactLimits, Initial, Problem, Release, Simulator, Switching};
-pub use slide::{slide_to_rest, PivotEnd, PivotPhase, Slide, SlideOptions, SlideReport, SlideState};
 pub use rotor::Rotor;
+pub use slide::{
+    slide_to_rest, PivotEnd, PivotPhase, Slide, SlideOptions, SlideReport, SlideState,
+};
 pub use trajectory::{
     Assumptions, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel, Sample,
     SegmentReport, SolverStats, Trajectory, Violation,

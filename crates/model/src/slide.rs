@@ -182,7 +182,17 @@ const AIM: f64 = 0.8;
 
 /// Relative slip `|uᵢ|/s` given to a support leaving a pivot, in the
 /// direction friction already pulls it (no state has a direction at zero).
+/// The slip then grows from this size through a stiff regime (its
+/// direction relaxes on a time proportional to |uᵢ|), which the explicit
+/// steps follow slowly: a pivot that ends in a slip costs thousands of
+/// steps.
 const NUDGE: f64 = 1e-12;
+
+/// A support that has just left a pivot.
+#[derive(Debug, Clone, Copy)]
+struct Escape {
+    support: usize,
+}
 
 /// Accepted steps before a slide is declared stuck in the integrator.
 const MAX_STEPS: usize = 100_000;
@@ -472,7 +482,7 @@ impl Run<'_, '_, '_> {
     fn go(&mut self, mut y: Y) -> Result<(), ModelError> {
         // A support that is exactly at rest at the start: a pivot already,
         // or a support about to slip (given the direction it slips in).
-        let mut left: Option<usize> = None;
+        let mut left: Option<Escape> = None;
         loop {
             let s = speed(&y);
             if s == 0.0 {
@@ -482,14 +492,13 @@ impl Run<'_, '_, '_> {
             let resting = (0..self.plate.f.len())
                 .find(|&i| self.plate.f[i] > 0.0 && self.plate.slip(i, &y).norm() <= NUDGE * s);
             let phase = match resting {
-                Some(i) if Some(i) != left => {
+                Some(i) if left.map(|e| e.support) != Some(i) => {
                     let omega = y[W] / self.plate.rho;
                     let pd = self.plate.pivot(i, omega);
                     if pd.reaction(self.plate.mass, omega).norm() <= pd.cap {
                         Phase::Pivot(i, y)
                     } else {
-                        nudge(self.plate, &mut y, i, &pd, omega);
-                        left = Some(i);
+                        left = Some(nudge(self.plate, &mut y, i, &pd, omega));
                         self.integrate(y, left)?
                     }
                 }
@@ -514,8 +523,7 @@ impl Run<'_, '_, '_> {
                             y = self.plate.y_of(&st);
                             let omega = st.omega;
                             let pd = self.plate.pivot(i, omega);
-                            nudge(self.plate, &mut y, i, &pd, omega);
-                            left = Some(i);
+                            left = Some(nudge(self.plate, &mut y, i, &pd, omega));
                         }
                     }
                 }
@@ -539,7 +547,7 @@ impl Run<'_, '_, '_> {
     /// Integrates in σ from `y` until the stop, the time limit or a pivot.
     /// `left`: a support that has just left a pivot (not stuck again until
     /// it has clearly slipped).
-    fn integrate(&mut self, mut y: Y, mut left: Option<usize>) -> Result<Phase, ModelError> {
+    fn integrate(&mut self, mut y: Y, mut left: Option<Escape>) -> Result<Phase, ModelError> {
         let plate = self.plate;
         let mut rhs = |y: &Y| plate.rhs(y);
         let mut k1 = rhs(&y);
@@ -557,7 +565,11 @@ impl Run<'_, '_, '_> {
                 .map(|i| plate.sx[i].hypot(plate.sy[i]))
                 .fold(0.0, f64::max)
                 / plate.rho;
-        let mut h: f64 = 0.1;
+        // First step: a tenth of the σ over which the direction turns by a
+        // radian (the body frame turns at ω dt/dσ, which is large for a
+        // plate that spins many times before it stops).
+        let turn = (k1[VX].hypot(k1[VY]).hypot(k1[W]) / speed(&y)).max(1.0);
+        let mut h: f64 = 0.1 / turn;
         for step in 0.. {
             if step > MAX_STEPS {
                 return Err(ModelError::Integration {
@@ -581,7 +593,9 @@ impl Run<'_, '_, '_> {
                 _ => tol,
             });
             self.out.rhs_evals += 12;
-            if !(a.err <= 1.0) {
+            // A non-finite stage can make the error norm vanish: refuse the
+            // step on its result instead.
+            if !(a.err <= 1.0 && a.y1.iter().all(|c| c.is_finite())) {
                 self.out.rejected += 1;
                 h = next_step8(h, a.err).min(0.9 * h);
                 if h < 1e-12 {
@@ -675,12 +689,12 @@ impl Run<'_, '_, '_> {
                 let u = plate.slip(i, &y);
                 let rel = u.norm() / s;
                 if rel >= 0.5 {
-                    if left == Some(i) && rel >= 1e-3 {
+                    if left.map(|e| e.support) == Some(i) {
                         left = None;
                     }
                     continue;
                 }
-                if left == Some(i) {
+                if left.map(|e| e.support) == Some(i) {
                     if rel >= 1e-3 {
                         left = None;
                     } else {
@@ -815,7 +829,11 @@ impl Run<'_, '_, '_> {
             support: i,
             t_start: t0,
             t_end,
-            max_load: if pd.cap > 0.0 { load / pd.cap } else { f64::INFINITY },
+            max_load: if pd.cap > 0.0 {
+                load / pd.cap
+            } else {
+                f64::INFINITY
+            },
             end,
         });
         (end, fin)
@@ -825,7 +843,7 @@ impl Run<'_, '_, '_> {
 /// Gives support i, at rest in `y`, the slip `NUDGE s` in the direction it
 /// starts to slip: against the reaction that would have held it, so that
 /// its friction `−fᵢ û` continues that reaction.
-fn nudge(plate: &Plate, y: &mut Y, i: usize, pd: &PivotDyn, omega: f64) {
+fn nudge(plate: &Plate, y: &mut Y, i: usize, pd: &PivotDyn, omega: f64) -> Escape {
     let s = speed(y);
     let rr = pd.reaction(plate.mass, omega);
     let dir = if rr.norm() > 0.0 {
@@ -837,6 +855,7 @@ fn nudge(plate: &Plate, y: &mut Y, i: usize, pd: &PivotDyn, omega: f64) {
     let want = dir * (NUDGE * s);
     y[VX] += want.x - u.x;
     y[VY] += want.y - u.y;
+    Escape { support: i }
 }
 
 /// The state at the release from the pushing model's end: contact point
@@ -901,7 +920,7 @@ pub(crate) fn continue_run(
         theta: s.theta,
         omega: s.omega,
     };
-    if out.samples.last().map_or(true, |l| l.t < start.t - eps) {
+    if out.samples.last().is_none_or(|l| l.t < start.t - eps) {
         out.samples.push(row(&start));
     }
     let slide = slide_to_rest(

@@ -53,7 +53,10 @@ fn bad_release_input_names_the_key() {
     let e = load(&format!("{PUSH}[initial]\nvelocity = [1.0, 0.0]\n")).unwrap_err();
     assert_eq!(e.key, "initial.velocity", "{e}");
     assert!(e.message.contains("without [[push]]"), "{e}");
-    let e = load(&format!("{PUSH}[initial]\nvelocity = [1.0, 0.0]\n[release]\n")).unwrap_err();
+    let e = load(&format!(
+        "{PUSH}[initial]\nvelocity = [1.0, 0.0]\n[release]\n"
+    ))
+    .unwrap_err();
     assert_eq!(e.key, "initial.velocity", "{e}");
     let e = load("[release]\nmax_duration = -1.0\n").unwrap_err();
     assert_eq!(e.key, "release.max_duration", "{e}");
