@@ -4,7 +4,9 @@
 //! energy balance, mirror symmetry and a pivot about a heavily loaded foot.
 
 use pushval_model::{
-    slide_to_rest, Body, PivotEnd, Slide, SlideOptions, SlideState, Support, Vec2,
+    slide_to_rest, Body, ContactLimits, DynamicModel, Initial, KinematicModel, LimitSurfaceModel,
+    ModelError, PivotEnd, Problem, Push, Release, Simulator, Slide, SlideOptions, SlideState,
+    Support, Switching, Vec2,
 };
 
 const G: f64 = 9.81;
@@ -475,4 +477,121 @@ fn a_pivot_that_leaves_the_cone_slips_and_the_slide_finishes() {
     let (work, _) = dissipated(&body, &start, stop, 20000);
     let e0 = energy(&body, &start);
     assert!((work - e0).abs() < 1e-6 * e0, "{work} vs {e0}");
+}
+
+/// A problem on the seed plate (0.25 m, 1 kg, μ 0.5) with a release.
+fn released(pushes: Vec<Push>, initial: Initial) -> Problem {
+    let a = 0.125;
+    let f = 0.5 * G / 4.0;
+    let sup: Vec<Support> = [(-a, -a), (a, -a), (a, a), (-a, a)]
+        .iter()
+        .map(|&(x, y)| Support {
+            position: Vec2::new(x, y),
+            friction: f,
+        })
+        .collect();
+    Problem {
+        body: Body::new(1.0, (2.0 * a) * (2.0 * a) / 6.0, Vec2::new(-a, -a), &sup).unwrap(),
+        limits: ContactLimits::default(),
+        pushes,
+        initial,
+        switching: Switching::Impulsive,
+        sample_dt: 0.01,
+        release: Some(Release::default()),
+    }
+}
+
+/// The dynamic model goes on through the slide: after the last push the
+/// plate keeps its velocity (no impulse) and slides on the sample grid to
+/// its rest, the last row. A thrown plate (no pushes) slides from
+/// `[initial]` at t = 0 and must rest where `slide_to_rest` puts it; after
+/// a push, the release velocity is the pushed plate's (the rows just
+/// before and after the release continue smoothly) and the plate travels
+/// on by at most v²/(2μg).
+#[test]
+fn the_dynamic_model_slides_to_rest_after_the_release() {
+    let throw0 = Initial {
+        theta: 0.3,
+        omega: 2.5,
+        position: Vec2::new(0.1, -0.2),
+        velocity: Vec2::new(0.8, 0.6),
+        ..Default::default()
+    };
+    let p = released(vec![], throw0);
+    let tr = DynamicModel::default().simulate(&p).unwrap();
+    let report = tr.slide.clone().expect("a slide report");
+    let stop = report.t_stop.expect("stops");
+    let direct = run(&p.body, &throw(0.1, -0.2, 0.3, 0.8, 0.6, 2.5));
+    assert_eq!(Some(stop), direct.stop);
+    let last = tr.samples.last().unwrap();
+    assert_eq!(
+        (last.t, last.x, last.y, last.theta, last.omega),
+        (stop, direct.end.x, direct.end.y, direct.end.theta, 0.0)
+    );
+    assert_eq!(tr.samples[0].t, 0.0);
+    assert_eq!((tr.samples[0].x, tr.samples[0].theta), (0.1, 0.3));
+    for (k, s) in tr.samples[..tr.samples.len() - 1].iter().enumerate() {
+        assert!((s.t - k as f64 * 0.01).abs() < 1e-12, "{s:?}");
+    }
+    assert!(stop - tr.samples[tr.samples.len() - 2].t <= 0.01);
+
+    // After a push: the run's push part is the run without release, then
+    // the slide.
+    let push = Push {
+        duration: 0.5,
+        speed: 1.0,
+        phi: 1.0,
+    };
+    let p = released(vec![push], Initial::default());
+    let mut p0 = p.clone();
+    p0.release = None;
+    let (with, without) = (
+        DynamicModel::default().simulate(&p).unwrap(),
+        DynamicModel::default().simulate(&p0).unwrap(),
+    );
+    let n = without.samples.len();
+    assert_eq!(with.samples[..n], without.samples[..]);
+    let rel = with.slide.as_ref().unwrap();
+    assert_eq!(rel.t_release, 0.5);
+    let stop = rel.t_stop.expect("stops");
+    // No impulse at the release: ω is continuous there, and the pose
+    // moves on from the release pose smoothly (first row after it).
+    let (a, b) = (with.samples[n - 1], with.samples[n]);
+    assert!((b.t - a.t - 0.01).abs() < 1e-12);
+    assert!(
+        (b.theta - (a.theta + a.omega * 0.01)).abs() < 0.01 * 0.01 * 100.0,
+        "{a:?} {b:?}"
+    );
+    // The plate is slower than the pusher's 1 m/s at its centre of mass
+    // at most by its turning: it stops within v²/(2μg) of the release, v ≤
+    // 1 m/s + |ω| |p_c|.
+    let last = with.samples.last().unwrap();
+    assert_eq!(last.t, stop);
+    let v = 1.0 + a.omega.abs() * 0.125 * 2f64.sqrt();
+    let d = f64::hypot(last.x - a.x, last.y - a.y);
+    assert!(d > 0.0 && d <= v * v / (2.0 * 0.5 * G), "{d}");
+}
+
+/// The quasi-static models have no velocity of their own after the
+/// release: they refuse the problem, naming the reason, rather than end
+/// the run at the release.
+#[test]
+fn the_quasi_static_models_do_not_slide() {
+    let p = released(
+        vec![Push {
+            duration: 0.5,
+            speed: 1.0,
+            phi: 1.0,
+        }],
+        Initial::default(),
+    );
+    for (name, r) in [
+        ("kinematic", KinematicModel.simulate(&p)),
+        ("limit_surface", LimitSurfaceModel.simulate(&p)),
+    ] {
+        match r {
+            Err(ModelError::NoSlide { model }) => assert_eq!(model, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
 }
