@@ -185,6 +185,7 @@ impl Case {
             },
             switching: Switching::Impulsive,
             sample_dt: self.horizon / 400.0,
+            release: None,
         }
     }
 }

@@ -19,6 +19,7 @@ fn engine_step(c: &mut Criterion) {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     };
     let mut g = c.benchmark_group("engine_step");
     g.throughput(Throughput::Elements(1000));

@@ -25,6 +25,7 @@ fn rapier_step(c: &mut Criterion) {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     };
     let mut g = c.benchmark_group("rapier_step");
     g.throughput(Throughput::Elements(1000));

@@ -23,7 +23,6 @@ use pushval_engine::Engine;
 use pushval_model::{Problem, Push};
 
 use crate::outdir::{num, Csv, Writer as OutDir};
-use crate::plot::{self, Axis, Figure, Legend, MapCell, Panel, Scale, Series, Stroke};
 use crate::shard::{grid_hash, grid_name, Parts, Shard};
 use pushval_control::mpc::{open_loop, run_loop, LoopSpec, PlantScale};
 use pushval_control::plan::{straight_time, PlanSpec, Planner, Solution};

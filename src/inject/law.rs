@@ -256,6 +256,7 @@ mod tests {
             initial: Default::default(),
             switching: Switching::Impulsive,
             sample_dt: 0.01,
+            release: None,
         };
         for _ in 0..500 {
             let push = Push {

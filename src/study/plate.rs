@@ -74,6 +74,7 @@ pub fn paper_plate(speed: f64, phi: f64, duration: f64, supports_half: Option<f6
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

@@ -657,6 +657,7 @@ fn step_samples(sc: &Scenario, rate: f64) -> Vec<Sample> {
         omega: end.omega,
         position: Vec2::new(end.x, end.y),
         from_rest: false,
+        velocity: pushval_model::Vec2::zeros(),
     };
     let b = simulate(&rest);
     a.into_iter()

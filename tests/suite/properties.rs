@@ -62,6 +62,7 @@ impl Scene {
             initial: self.initial,
             switching: Switching::Impulsive,
             sample_dt,
+            release: None,
         }
     }
     /// Reflected across the x axis (y → −y): polygon order reversed to stay
@@ -176,6 +177,7 @@ fn scene() -> impl Strategy<Value = Scene> {
                         omega: 0.0,
                         position: Vec2::new(px, py),
                         from_rest: rest,
+                        velocity: pushval_model::Vec2::zeros(),
                     },
                 }
             },
@@ -514,6 +516,7 @@ fn energy_balance_holds_for_the_engine_to_order_dt() {
         },
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     };
     let mismatch = |dt: f64| {
         let b = engine_books(&p, dt);

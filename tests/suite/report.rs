@@ -191,6 +191,7 @@ fn one_push(sc: &pushval_scenario::Scenario, speed: f64, phi: f64, duration: f64
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: duration / 100.0,
+        release: None,
     }
 }
 

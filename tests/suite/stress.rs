@@ -410,6 +410,7 @@ fn thousand_second_horizon_keeps_theta_precise() {
         omega: ws,
         position: Vec2::new(1.0, -2.0),
         from_rest: false,
+        velocity: pushval_model::Vec2::zeros(),
     };
     let p = Problem {
         sample_dt: 1.0,

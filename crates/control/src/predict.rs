@@ -247,6 +247,7 @@ fn set_start(p: &mut Problem, start: &Start, pushes: &[Push], sample_dt: Option<
             omega: 0.0,
             position: start.position,
             from_rest: true,
+            velocity: Vec2::zeros(),
         },
         Motion::Moving { omega, momentum } => {
             let first = &pushes[0];
@@ -263,6 +264,7 @@ fn set_start(p: &mut Problem, start: &Start, pushes: &[Push], sample_dt: Option<
                 omega: w,
                 position: start.position,
                 from_rest: false,
+                velocity: Vec2::zeros(),
             }
         }
     };
@@ -286,5 +288,6 @@ fn placeholder() -> Problem {
         initial: Initial::default(),
         switching: Switching::default(),
         sample_dt: 1.0,
+        release: None,
     }
 }

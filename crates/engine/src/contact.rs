@@ -161,6 +161,7 @@ mod tests {
             initial: Default::default(),
             switching: Switching::Impulsive,
             sample_dt,
+            release: None,
         }
     }
 

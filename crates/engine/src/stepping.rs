@@ -886,6 +886,7 @@ mod tests {
             initial: Initial::default(),
             switching: Switching::Impulsive,
             sample_dt: 0.05,
+            release: None,
         }
     }
 

@@ -362,6 +362,7 @@ mod tests {
             initial: Default::default(),
             switching: Switching::Impulsive,
             sample_dt: 0.01,
+            release: None,
         }
     }
 

@@ -27,6 +27,7 @@ fn main() {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     };
     let reference = DynamicModel {
         integrator: Integrator::Dop853 { tol: 1e-14 },

@@ -66,6 +66,7 @@ fn main() {
         },
         switching: Switching::Impulsive,
         sample_dt: dt_override.unwrap_or(sample_dt),
+        release: None,
     };
     // `TOL=…` overrides the tolerance.
     let tol = std::env::var("TOL")

@@ -49,6 +49,14 @@ pub enum ModelError {
         /// The limit |ω| passed (rad/s).
         limit: f64,
     },
+    /// The model cannot follow the free slide after the release: a
+    /// quasi-static model has no velocity of its own once the pusher lets
+    /// go. The run is refused rather than ended at the release.
+    #[error("the {model} model is quasi-static and does not slide: it cannot run a problem with a release (the dynamic model slides to rest)")]
+    NoSlide {
+        /// The model's name.
+        model: String,
+    },
     /// The engine could not be run at all (an outside engine's process
     /// failed to start, exited with an error, timed out or wrote rows that
     /// do not parse): an input error, not a result. The harness stops with

@@ -338,28 +338,37 @@ mod tests {
 /// ODEs I, Sec. II.10) with its 7th-order continuous extension. Twelve stages
 /// per step (the thirteenth, f at the new point, is the next step's first);
 /// the dense output costs three more, taken only for steps that hold a sample.
+///
+/// Generic over the state size `M` (default [`N`], the pushing ODE's): the
+/// free slide (`crate::slide`) integrates a larger state with the same pair.
 pub mod dop853 {
-    use super::{State, N};
+    use super::N;
     use crate::dop853_tables::{A, D, E3_SUB, E5};
 
     /// One attempted step.
-    pub struct Attempt {
+    pub struct Attempt<const M: usize = N> {
         /// The state at the step's end (8th order).
-        pub y1: State,
+        pub y1: [f64; M],
         /// f(y1): the next step's first stage.
-        pub k13: State,
+        pub k13: [f64; M],
         /// Error norm; acceptable when ≤ 1.
         pub err: f64,
-        k: [State; 13],
+        k: [[f64; M]; 13],
     }
 
     #[inline]
-    fn stage(y0: &State, h: f64, k: &[State], row: &[f64; 16], upto: usize) -> State {
+    fn stage<const M: usize>(
+        y0: &[f64; M],
+        h: f64,
+        k: &[[f64; M]],
+        row: &[f64; 16],
+        upto: usize,
+    ) -> [f64; M] {
         let mut out = *y0;
         for (j, kj) in k.iter().enumerate().take(upto) {
             let a = row[j];
             if a != 0.0 {
-                for i in 0..N {
+                for i in 0..M {
                     out[i] += h * a * kj[i];
                 }
             }
@@ -370,15 +379,34 @@ pub mod dop853 {
     /// One DOP853 step of size `h` from `y0` with derivative `k1`; error
     /// weights `atol + rtol_i max(|y0_i|, |y1_i|)`, the combined 5th/3rd-order
     /// estimate of Hairer's code.
-    pub fn attempt<F: FnMut(&State) -> State>(
+    pub fn attempt<const M: usize, F: FnMut(&[f64; M]) -> [f64; M]>(
         f: &mut F,
-        y0: &State,
-        k1: &State,
+        y0: &[f64; M],
+        k1: &[f64; M],
         h: f64,
         atol: f64,
-        rtol: &State,
-    ) -> Attempt {
-        let mut k = [[0.0; N]; 13];
+        rtol: &[f64; M],
+    ) -> Attempt<M> {
+        attempt_with(f, y0, k1, h, |i, a: f64, b: f64| {
+            atol + rtol[i] * a.abs().max(b.abs())
+        })
+    }
+
+    /// [`attempt`] with the error weight of component `i` chosen by the
+    /// caller, `weight(i, y0_i, y1_i)` (for components whose error is
+    /// measured against another component's size).
+    pub fn attempt_with<const M: usize, F, W>(
+        f: &mut F,
+        y0: &[f64; M],
+        k1: &[f64; M],
+        h: f64,
+        weight: W,
+    ) -> Attempt<M>
+    where
+        F: FnMut(&[f64; M]) -> [f64; M],
+        W: Fn(usize, f64, f64) -> f64,
+    {
+        let mut k = [[0.0; M]; 13];
         k[0] = *k1;
         for s in 1..12 {
             k[s] = f(&stage(y0, h, &k, &A[s], s));
@@ -386,8 +414,8 @@ pub mod dop853 {
         let y1 = stage(y0, h, &k, &A[12], 12);
         k[12] = f(&y1);
         let (mut e5, mut e3) = (0.0, 0.0);
-        for i in 0..N {
-            let sc = atol + rtol[i] * y0[i].abs().max(y1[i].abs());
+        for i in 0..M {
+            let sc = weight(i, y0[i], y1[i]);
             let mut d5 = 0.0;
             let mut d3 = 0.0;
             for s in 0..13 {
@@ -403,7 +431,7 @@ pub mod dop853 {
         }
         let deno = e5 + 0.01 * e3;
         let err = if deno > 0.0 {
-            h.abs() * e5 / (deno * N as f64).sqrt()
+            h.abs() * e5 / (deno * M as f64).sqrt()
         } else {
             0.0
         };
@@ -417,31 +445,31 @@ pub mod dop853 {
 
     /// The 7th-order dense output over an accepted step.
     #[derive(Debug, Clone, Copy)]
-    pub struct Dense {
+    pub struct Dense<const M: usize = N> {
         /// Start of the step (s).
         pub t0: f64,
         /// Step size (s).
         pub h: f64,
-        y0: State,
-        r: [State; 7],
+        y0: [f64; M],
+        r: [[f64; M]; 7],
     }
 
-    impl Attempt {
+    impl<const M: usize> Attempt<M> {
         /// Builds the dense output (three more evaluations of `f`).
-        pub fn dense<F: FnMut(&State) -> State>(
+        pub fn dense<F: FnMut(&[f64; M]) -> [f64; M]>(
             &self,
             f: &mut F,
             t0: f64,
-            y0: &State,
+            y0: &[f64; M],
             h: f64,
-        ) -> Dense {
-            let mut k = [[0.0; N]; 16];
+        ) -> Dense<M> {
+            let mut k = [[0.0; M]; 16];
             k[..13].copy_from_slice(&self.k);
             for s in 13..16 {
                 k[s] = f(&stage(y0, h, &k, &A[s], s));
             }
-            let mut r = [[0.0; N]; 7];
-            for i in 0..N {
+            let mut r = [[0.0; M]; 7];
+            for i in 0..M {
                 let dy = self.y1[i] - y0[i];
                 r[0][i] = dy;
                 r[1][i] = h * k[0][i] - dy;
@@ -458,12 +486,12 @@ pub mod dop853 {
         }
     }
 
-    impl Dense {
+    impl<const M: usize> Dense<M> {
         /// The state at time `t` within the step.
-        pub fn eval(&self, t: f64) -> State {
+        pub fn eval(&self, t: f64) -> [f64; M] {
             let s = (t - self.t0) / self.h;
             let s1 = 1.0 - s;
-            let mut out = [0.0; N];
+            let mut out = [0.0; M];
             for (i, o) in out.iter_mut().enumerate() {
                 let r = &self.r;
                 // y0 + s(r0 + s1(r1 + s(r2 + s1(r3 + s(r4 + s1(r5 + s r6))))))

@@ -17,6 +17,8 @@
 //!   a stream of pose samples, and the resultant friction force.
 //! * [`limit_surface`]: the ellipsoidal limit-surface approximation used in
 //!   quasi-static planning (Goyal, Ruina & Papadopoulos; Lynch, Maekawa & Tanie).
+//! * [`slide`]: the free slide after the pusher lets go, to rest (Coulomb
+//!   friction at every support, pivots about a sticking support included).
 //! * [`format`]: the one trajectory format (`t,x,y,theta[,omega][,model]`),
 //!   its streaming reader and its writer.
 //!
@@ -40,6 +42,7 @@ pub mod kinematic;
 pub mod limit_surface;
 mod problem;
 mod rotor;
+pub mod slide;
 mod tail;
 pub mod track;
 mod trajectory;
@@ -49,8 +52,11 @@ pub use body::{Body, Push, Support};
 pub use dynamic::{InertialTerm, RootKind, SegmentDynamics, SteadyState};
 pub use error::ModelError;
 pub use kappa::{kappa_exact, kappa_series, KappaSeries};
-pub use problem::{ContactLimits, Initial, Problem, Simulator, Switching};
+pub use problem::{ContactLimits, Initial, Problem, Release, Simulator, Switching};
 pub use rotor::Rotor;
+pub use slide::{
+    slide_to_rest, PivotEnd, PivotPhase, Slide, SlideOptions, SlideReport, SlideState,
+};
 pub use trajectory::{
     Assumptions, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel, Sample,
     SegmentReport, SolverStats, Trajectory, Violation,

@@ -13,7 +13,8 @@ pub enum Switching {
     Continuous,
 }
 
-/// The state of the object when the first push starts.
+/// The state of the object when the first push starts (without pushes: when
+/// the free slide starts).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Initial {
     /// Object angle θ (rad).
@@ -27,6 +28,26 @@ pub struct Initial {
     /// `H = 0` gives). When false, the object already moves with the pusher at
     /// ω = `omega` (the seed paper's start).
     pub from_rest: bool,
+    /// Velocity of the centre of mass (m/s, world frame); default zero. Only
+    /// a problem without pushes may set it (a push prescribes the contact's
+    /// velocity): the free slide then starts from it at t = 0.
+    pub velocity: Vec2,
+}
+
+/// The pusher lets go: after the last push (or at t = 0 without pushes) it
+/// withdraws without an impulse, and the plate slides on its supports until
+/// it stops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Release {
+    /// Longest slide (s), > 0; default 10. A plate still moving then is
+    /// reported as not stopped, never as at rest.
+    pub max_duration: f64,
+}
+
+impl Default for Release {
+    fn default() -> Self {
+        Self { max_duration: 10.0 }
+    }
 }
 
 /// What the contact can transmit, for the assumption checks.
@@ -80,7 +101,8 @@ pub struct Problem {
     pub body: Body,
     /// Contact geometry and limits for the assumption checks.
     pub limits: ContactLimits,
-    /// The piecewise-constant input, in order (at least one).
+    /// The piecewise-constant input, in order (at least one, unless
+    /// `release` is set).
     pub pushes: Vec<Push>,
     /// The state when the first push starts.
     pub initial: Initial,
@@ -88,13 +110,37 @@ pub struct Problem {
     pub switching: Switching,
     /// Spacing of the output samples (s), > 0.
     pub sample_dt: f64,
+    /// The free slide after the last push; None: the run ends with it.
+    pub release: Option<Release>,
 }
 
 impl Problem {
-    /// Checks the schedule and the sampling interval.
+    /// Checks the schedule, the release and the sampling interval. An empty
+    /// schedule is a problem only without a release; an initial velocity
+    /// only without pushes.
     pub fn check(&self) -> Result<(), ModelError> {
-        if self.pushes.is_empty() {
+        if self.pushes.is_empty() && self.release.is_none() {
             return Err(ModelError::EmptySchedule);
+        }
+        if let Some(r) = &self.release {
+            ModelError::require_positive("release max_duration", r.max_duration)?;
+        }
+        let v = self.initial.velocity;
+        for c in [v.x, v.y] {
+            if !c.is_finite() {
+                return Err(ModelError::Parameter {
+                    name: "initial velocity",
+                    requirement: "finite",
+                    value: c,
+                });
+            }
+        }
+        if !self.pushes.is_empty() && v != Vec2::zeros() {
+            return Err(ModelError::Parameter {
+                name: "initial velocity",
+                requirement: "zero when there are pushes (the pusher sets the velocity)",
+                value: v.norm(),
+            });
         }
         for p in &self.pushes {
             if !(p.duration.is_finite() && p.duration > 0.0) {
@@ -149,8 +195,15 @@ impl Problem {
 
     /// The output sample times: `k · sample_dt` up to the end (inclusive, within
     /// a relative 1e-9 of a step), plus the end time when it is not on the grid.
+    /// With a release these are the pushes' samples only: the slide's go on
+    /// on the same grid to its stop ([`Problem::sample_times_through`]).
     pub fn sample_times(&self) -> Vec<f64> {
-        let end = self.duration();
+        self.sample_times_through(self.duration())
+    }
+
+    /// The sample grid `k · sample_dt` up to `end` (s, inclusive within a
+    /// relative 1e-9 of a step), plus `end` when it is not on the grid.
+    pub fn sample_times_through(&self, end: f64) -> Vec<f64> {
         let n = (end / self.sample_dt * (1.0 + 1e-12) + 1e-9).floor() as usize;
         let mut times: Vec<f64> = (0..=n).map(|k| k as f64 * self.sample_dt).collect();
         if let Some(&last) = times.last() {

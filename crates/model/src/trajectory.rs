@@ -162,6 +162,9 @@ pub struct Trajectory {
     pub assumptions: Assumptions,
     /// Integrator work.
     pub stats: SolverStats,
+    /// The free slide after the release (None: the problem has no release,
+    /// or the model does not report one).
+    pub slide: Option<crate::SlideReport>,
 }
 
 /// Runs a model whose ω is constant over each segment: the pose follows
@@ -172,6 +175,9 @@ fn constant_omega_run(
     omega_of: impl Fn(&Body, &Push) -> f64,
 ) -> Result<Trajectory, ModelError> {
     problem.check()?;
+    if problem.release.is_some() {
+        return Err(ModelError::NoSlide { model: name.into() });
+    }
     let pc = problem.body.contact();
     let mut sampler = Sampler::new(problem);
     let mut out = Trajectory {

@@ -238,6 +238,7 @@ fn limit_surface_model_turns_at_the_closed_form_rate() {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.05,
+        release: None,
     };
     let tr = LimitSurfaceModel.simulate(&p).unwrap();
     let w = v / (3.0 * a);

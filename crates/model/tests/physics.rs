@@ -131,6 +131,7 @@ fn mirror_reflection_negates_omega() {
         omega: sign * 0.5,
         position: Vec2::new(0.1, sign * 0.3),
         from_rest: false,
+        velocity: pushval_model::Vec2::zeros(),
     };
     let a = run(
         &adaptive(1e-11, true),

@@ -251,6 +251,7 @@ fn a_mu_step_is_detected_and_followed() {
         omega: end.omega,
         position: Vec2::new(end.x, end.y),
         from_rest: false,
+        velocity: pushval_model::Vec2::zeros(),
     };
     let b = sim
         .simulate(&problem(

@@ -54,6 +54,9 @@ pub struct RawScenario {
     /// `[[push]]`, in order.
     #[serde(default)]
     pub push: Vec<RawPush>,
+    /// `[release]`: the plate slides to rest after the last push; absent:
+    /// the run ends with the last push.
+    pub release: Option<RawRelease>,
     /// `[run]`; absent: the defaults.
     pub run: Option<RawRun>,
     /// `[tolerance]`; absent: every figure `"auto"`.
@@ -144,6 +147,19 @@ pub struct RawInitial {
     pub position: Option<[f64; 2]>,
     /// At rest when the pusher starts (an impulsive start); default false
     pub from_rest: Option<bool>,
+    /// m/s, world velocity of the centre of mass; default [0, 0]; only
+    /// without `[[push]]` (the slide starts from it)
+    #[serde(default, deserialize_with = "opt_xy")]
+    pub velocity: Option<[f64; 2]>,
+}
+
+/// `[release]`: after the last push (at t = 0 without `[[push]]`) the pusher
+/// withdraws and the plate slides on its supports until it stops.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRelease {
+    /// s, > 0, default 10: the longest slide; not stopped by then is reported
+    pub max_duration: Option<f64>,
 }
 
 /// One `[[push]]`: a constant pusher velocity for a while.

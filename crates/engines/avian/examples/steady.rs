@@ -33,6 +33,7 @@ fn plate(speed: f64, duration: f64) -> Problem {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

@@ -38,6 +38,7 @@ fn plate(half: f64, support_half: f64, speed: f64, phi: f64) -> Problem {
         initial: Initial::default(),
         switching: Default::default(),
         sample_dt: 0.01,
+        release: None,
     }
 }
 

@@ -42,6 +42,7 @@ fn plate(from_rest: bool) -> Problem {
         },
         switching: Default::default(),
         sample_dt: 0.01,
+        release: None,
     }
 }
 

@@ -64,6 +64,7 @@ fn problem(speed: f64, phi: f64, duration: f64) -> Problem {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

@@ -44,6 +44,7 @@ fn scene_text() {
         initial: Default::default(),
         switching: Default::default(),
         sample_dt: 0.01,
+        release: None,
     };
     let x = pushval_mujoco::scene::mjcf(&p, &MujocoSettings::default(), &[0.7]);
     assert!(x.contains(r#"diaginertia="0.025 0.025 0.05""#), "{x}");

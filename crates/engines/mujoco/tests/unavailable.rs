@@ -29,6 +29,7 @@ fn reports_unavailable() {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     };
     let err = MujocoSimulator::new(MujocoSettings::default())
         .simulate(&p)

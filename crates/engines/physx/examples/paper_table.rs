@@ -44,6 +44,7 @@ fn main() {
                 initial: Initial::default(),
                 switching: Switching::Impulsive,
                 sample_dt: 0.01,
+                release: None,
             };
             let coulomb = steady_omega(&body, &push, Law::Coulomb, 0.0).omega;
             for f in FrictionType::ALL {

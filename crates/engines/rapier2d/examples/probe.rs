@@ -47,6 +47,7 @@ fn main() {
         },
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     };
     let r = DynamicModel::default().simulate(&problem).unwrap();
     let pgs = std::env::var("PV_PGS")

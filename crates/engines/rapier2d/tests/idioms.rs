@@ -42,6 +42,7 @@ fn run(pushes: Vec<Push>, theta: f64, model: FrictionModel, dt: f64) -> RapierRu
         },
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     };
     RapierSimulator::new(EngineSettings {
         dt,

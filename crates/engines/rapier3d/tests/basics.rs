@@ -35,6 +35,7 @@ fn problem(body: Body, pushes: Vec<Push>) -> Problem {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

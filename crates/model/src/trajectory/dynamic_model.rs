@@ -260,7 +260,7 @@ impl Simulator for DynamicModel {
         let mut theta = init.theta;
         let mut c = init.position + rotate(theta, &pc);
         let mut omega = if init.from_rest { 0.0 } else { init.omega };
-        let mut prev: Option<Push> = (!init.from_rest).then(|| problem.pushes[0]);
+        let mut prev: Option<Push> = problem.pushes.first().copied().filter(|_| !init.from_rest);
         // The contact velocity of `prev` (object frame, m/s): each push's
         // direction is computed once.
         let mut prev_vel: Option<Vec2> = prev.as_ref().map(Push::velocity);
@@ -329,6 +329,10 @@ impl Simulator for DynamicModel {
             spare = Some(seg.dynamics);
         }
         rec.out.assumptions = rec.checker.finish();
+        if let Some(release) = &problem.release {
+            let start = crate::slide::release_state(problem, c, theta, omega, prev_vel);
+            crate::slide::continue_run(problem, release, start, &mut rec.out)?;
+        }
         Ok(rec.out)
     }
 }

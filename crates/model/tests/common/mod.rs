@@ -45,6 +45,7 @@ pub fn problem(body: Body, pushes: Vec<Push>, initial: Initial, switching: Switc
         initial,
         switching,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

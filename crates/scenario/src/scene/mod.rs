@@ -19,7 +19,9 @@ mod tolerance;
 
 use std::path::{Path, PathBuf};
 
-use pushval_model::{Body, ContactLimits, Initial, Problem, Push, Support, Switching, Vec2};
+use pushval_model::{
+    Body, ContactLimits, Initial, Problem, Push, Release, Support, Switching, Vec2,
+};
 
 pub use engine::{EngineTable, MAX_ENGINE_STEPS};
 pub use run::{check_sample_count, ANALYTIC_MODELS, DEFAULT_GATE, DEFAULT_MODELS, MAX_SAMPLES};
@@ -63,8 +65,12 @@ pub struct Scenario {
     pub contact_limits: ContactLimits,
     /// The input schedule, in order.
     pub pushes: Vec<Push>,
-    /// The state when the first push starts.
+    /// The state when the first push starts (without pushes: when the slide
+    /// starts).
     pub initial: Initial,
+    /// `[release]`: the slide to rest after the last push; None: the run
+    /// ends with the last push.
+    pub release: Option<Release>,
     /// What ω does at a switch.
     pub switching: Switching,
     /// Sample interval (s).
@@ -140,9 +146,11 @@ impl Scenario {
         let (contact, contact_limits) = contact::from_raw(&raw.contact, &object, file)?;
         let (inertia_cm, inertia_source) = object::inertia(&raw.object, &object, contact, file)?;
         let supports = supports::from_raw(&raw.supports, &object, file)?;
-        let pushes = schedule::pushes(&raw.push, file)?;
-        let initial = schedule::initial(raw.initial, file)?;
-        let run = run::from_raw(raw.run, &pushes, file)?;
+        let release = schedule::release(raw.release, file)?;
+        let pushes = schedule::pushes(&raw.push, release.as_ref(), file)?;
+        let initial = schedule::initial(raw.initial, &pushes, file)?;
+        let slide = release.map_or(0.0, |r| r.max_duration);
+        let run = run::from_raw(raw.run, &pushes, slide, file)?;
         let tolerance = tolerance::from_raw(raw.tolerance, file)?;
         let engine = engine::from_raw(raw.engine, file, &pushes)?;
         let sc = Self {
@@ -162,6 +170,7 @@ impl Scenario {
             contact_limits,
             pushes,
             initial,
+            release,
             switching: run.switching,
             sample_dt: run.sample_dt,
             models: run.models,
@@ -215,6 +224,7 @@ impl Scenario {
             initial: self.initial,
             switching: self.switching,
             sample_dt: self.sample_dt,
+            release: self.release,
         }
     }
 

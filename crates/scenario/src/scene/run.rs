@@ -45,18 +45,20 @@ pub fn check_sample_count(total: f64, sample_dt: f64) -> Result<(), String> {
     Ok(())
 }
 
-/// The run settings for the schedule `pushes`: a sample interval that gives
-/// at most 1e7 samples, a known switching rule, model and gate lists (names
-/// are checked against the engine registry by the command line).
+/// The run settings for the schedule `pushes` and a slide of at most
+/// `slide` s after it: a sample interval that gives at most 1e7 samples, a
+/// known switching rule, model and gate lists (names are checked against
+/// the engine registry by the command line).
 pub(super) fn from_raw(
     raw: Option<RawRun>,
     pushes: &[Push],
+    slide: f64,
     file: &Path,
 ) -> Result<Run, ScenarioError> {
     let err = |key: &str, msg: String| ScenarioError::new(file, key, msg);
     let rr = raw.unwrap_or_default();
     let sample_dt = finite_pos(file, "run.sample_dt", rr.sample_dt.unwrap_or(0.01))?;
-    let total: f64 = pushes.iter().map(|p| p.duration).sum();
+    let total: f64 = pushes.iter().map(|p| p.duration).sum::<f64>() + slide;
     if let Err(m) = check_sample_count(total, sample_dt) {
         return Err(err("run.sample_dt", m));
     }

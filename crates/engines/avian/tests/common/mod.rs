@@ -39,6 +39,7 @@ pub fn plate(pushes: &[(f64, f64, f64)], from_rest: bool) -> Problem {
         },
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

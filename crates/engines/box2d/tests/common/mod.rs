@@ -40,6 +40,7 @@ pub fn plate(speed: f64, from_rest: bool) -> Problem {
         },
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

@@ -45,6 +45,7 @@ pub fn problem(body: &Body, speed: f64, phi: f64, duration: f64) -> Problem {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 

@@ -60,6 +60,7 @@ pub fn problem(body: &Body, p: Push) -> Problem {
         initial: Initial::default(),
         switching: Switching::Impulsive,
         sample_dt: 0.01,
+        release: None,
     }
 }
 
