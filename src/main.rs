@@ -1,7 +1,8 @@
 //! The pushval command line.
 //!
 //! Exit codes: 0 every gated tolerance holds, 1 a tolerance failed, 2 unusable
-//! input or an error (nothing is written then).
+//! input or an error (nothing is written then), 141 the reader of standard
+//! output went away before pushval finished printing (see [`closed`]).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -582,8 +583,90 @@ fn stress(out: PathBuf, quick: bool) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Ending quietly when the reader of standard output (or standard error)
+/// goes away: `pushval engines | head -1`.
+///
+/// A C program is killed by SIGPIPE there, which a shell reports as status
+/// 141 (128 + 13) and says nothing about. Rust ignores SIGPIPE, so a write
+/// fails with `EPIPE` instead and `println!` panics; restoring the signal's
+/// default needs `unsafe`, which the workspace forbids. So pushval ends the
+/// same way by hand: no message, status 141. Not 0: pushval's 0 means
+/// "every gated tolerance holds", which a run whose table nobody read to the
+/// end has not shown (under `set -o pipefail` a shell sees what it sees
+/// from `cat`). Every print of pushval goes through `print!`/`println!` (or
+/// returns the write's error to [`main`]), so one panic hook covers them
+/// all, in any thread.
+mod closed {
+    use std::os::fd::AsFd;
+
+    /// The status of a command cut off by its reader: 128 + SIGPIPE.
+    pub const STATUS: u8 = 141;
+
+    /// Whether `fd` is a pipe or socket whose reader has gone: `poll(2)`
+    /// reports an error or a hang-up on its writing end.
+    pub fn reader_gone(fd: impl AsFd) -> bool {
+        use rustix::event::{poll, PollFd, PollFlags};
+        let mut fds = [PollFd::new(&fd, PollFlags::OUT)];
+        let now = rustix::time::Timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        matches!(poll(&mut fds, Some(&now)), Ok(n) if n > 0)
+            && fds[0].revents().intersects(PollFlags::ERR | PollFlags::HUP)
+    }
+
+    /// Whether standard output or standard error has lost its reader.
+    pub fn output_closed() -> bool {
+        reader_gone(std::io::stdout()) || reader_gone(std::io::stderr())
+    }
+
+    /// Makes a failed `print!` or `eprint!` to a closed pipe end pushval
+    /// with [`STATUS`] and no message (after ending the outside engines'
+    /// sessions); every other panic is reported as before.
+    pub fn install() {
+        let report = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            let payload = info.payload();
+            let message = payload
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| payload.downcast_ref::<&str>().copied())
+                .unwrap_or("");
+            // std's words for a failed `print!`/`eprint!`.
+            let closed = (message.starts_with("failed printing to stdout")
+                && reader_gone(std::io::stdout()))
+                || (message.starts_with("failed printing to stderr")
+                    && reader_gone(std::io::stderr()));
+            if closed {
+                pushval::registry::shutdown_sessions();
+                std::process::exit(STATUS.into());
+            }
+            report(info);
+        }));
+    }
+
+    /// Whether `e` is a write that failed because the reader went away.
+    pub fn is_closed_pipe(e: &anyhow::Error) -> bool {
+        e.chain().any(|c| {
+            c.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+        }) && output_closed()
+    }
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    closed::install();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help, version or a usage error: clap's text and status, or 141
+        // when the text could not be written for want of a reader.
+        Err(e) => {
+            if e.print().is_err() && closed::output_closed() {
+                return ExitCode::from(closed::STATUS);
+            }
+            return ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
+        }
+    };
     if let Err(e) = pushval::registry::use_engines_file(cli.engines.as_deref()) {
         eprintln!("error: {e}");
         return ExitCode::from(2);
@@ -722,6 +805,7 @@ fn main() -> ExitCode {
     pushval::registry::shutdown_sessions();
     match result {
         Ok(code) => code,
+        Err(e) if closed::is_closed_pipe(&e) => ExitCode::from(closed::STATUS),
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

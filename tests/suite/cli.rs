@@ -273,3 +273,46 @@ fn outputs_get_the_umask_mode() {
         assert_eq!(std::fs::read_dir(&out).unwrap().count(), 2);
     }
 }
+
+/// A standard output nobody reads any more: the writing end of a pipe
+/// whose reading end is closed (a `true` that has exited held it), so the
+/// first write fails however fast pushval is.
+fn closed_stdout() -> std::process::Stdio {
+    let mut reader = Command::new("true")
+        .stdin(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pipe = reader.stdin.take().unwrap();
+    reader.wait().unwrap();
+    pipe.into()
+}
+
+/// `pushval engines | head -1`: every command that prints ends quietly
+/// when its reader goes away, with the status a shell shows for a program
+/// SIGPIPE ended (141), never a panic (101).
+#[test]
+fn a_closed_standard_output_ends_pushval_quietly() {
+    let scenario = root().join("scenarios/paper-square-v1.0.toml");
+    let scenario = scenario.to_str().unwrap();
+    let commands: &[&[&str]] = &[
+        &["engines"],
+        &["laws"],
+        &["laws", "--json"],
+        &["problem", scenario],
+        &["validate", scenario],
+        &["--help"],
+        &["run", "--help"],
+        &["--version"],
+    ];
+    for args in commands {
+        let o = pushval()
+            .args(*args)
+            .stdout(closed_stdout())
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(141), "pushval {args:?}: {err}");
+        assert!(err.is_empty(), "pushval {args:?} said: {err}");
+    }
+}
