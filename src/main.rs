@@ -16,14 +16,15 @@ use pushval_scenario::Scenario;
 #[command(
     name = "pushval",
     version,
-    about = "Cross-validates an analytic model of single-point pushing against physics engines.\n\nWith no command: validate every scenario in scenarios/."
+    about = "Cross-validates an analytic model of single-point pushing against physics engines.\n\nWith no command: validate every scenario of the project (the scenarios/ folder beside the pushval.toml in use, else ./scenarios, else the scenarios shipped inside pushval)."
 )]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
     /// Outside engines: the pushval.toml-format file declaring them (default:
-    /// ./pushval.toml when present). Trusted like a build script: its
-    /// commands run.
+    /// the pushval.toml of the current folder, else of its nearest parent
+    /// folder that has one; none when no folder up to the root has one).
+    /// Trusted like a build script: its commands run.
     #[arg(long, global = true, value_name = "FILE")]
     engines: Option<PathBuf>,
 }
@@ -33,12 +34,15 @@ enum Command {
     /// Run every model of the given scenarios, compare them with the dynamic
     /// model and print a table; exit 1 when a gated tolerance fails.
     Validate {
-        /// Scenario files (default: every *.toml in scenarios/).
+        /// Scenario files (TOML; default: every *.toml of the project's
+        /// scenarios/ beside the pushval.toml in use, else of ./scenarios,
+        /// else the scenarios shipped inside pushval).
         files: Vec<PathBuf>,
         /// Print the table as JSON instead (one summary.json document per scenario).
         #[arg(long)]
         json: bool,
-        /// Also write a JUnit XML report to this file (for CI systems).
+        /// Also write a JUnit XML report to this file (for CI systems);
+        /// default: none.
         #[arg(long, value_name = "FILE")]
         junit: Option<PathBuf>,
         /// Refuse (exit 2) any [tolerance] number above the default auto
@@ -51,6 +55,7 @@ enum Command {
     /// dynamic model and rapier2d with the scenario's tolerances; exit 1 when
     /// one fails.
     Compare {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The outside trajectory (t,x,y,theta; omega, model optional) on the scenario's time grid.
         #[arg(long, value_name = "CSV")]
@@ -78,7 +83,8 @@ enum Command {
         /// Reduced sweep grids (for tests).
         #[arg(long)]
         quick: bool,
-        /// Compute only part K of N of the sweeps into OUT/parts/ (batch schedulers).
+        /// Compute only part K of N of the sweeps into OUT/parts/ (batch
+        /// schedulers); default: every sweep, no parts.
         #[arg(long, value_name = "K/N", conflicts_with = "merge")]
         shard: Option<pushval::shard::Shard>,
         /// Build the outputs from the parts in OUT/parts/ instead of computing the sweeps.
@@ -99,14 +105,16 @@ enum Command {
         #[arg(long)]
         quick: bool,
         /// Compute only part K of N of the tasks (K/N contiguous, hash:K/N by
-        /// each task's key) into parts/; without it, a Slurm array task
-        /// (SLURM_ARRAY_TASK_ID/COUNT) computes its own part.
+        /// each task's key) into parts/; default: a Slurm array task
+        /// (SLURM_ARRAY_TASK_ID/COUNT) computes its own part, any other run
+        /// every task.
         #[arg(long, value_name = "[hash:]K/N", conflicts_with = "merge")]
         shard: Option<pushval::shard::Shard>,
         /// Build the outputs from the part files instead of running the engines.
         #[arg(long)]
         merge: bool,
-        /// Folder of the study files (MODEL.toml); default studies/.
+        /// Folder of the study files (MODEL.toml); default ./studies when it
+        /// exists, else the study files shipped inside pushval.
         #[arg(long, value_name = "DIR")]
         studies: Option<PathBuf>,
     },
@@ -125,6 +133,7 @@ enum Command {
     /// write DIR/fit.json. Exit 1 when the fit does not converge or a
     /// parameter is unidentifiable.
     Fit {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The trajectory (t,x,y,theta; omega, model optional) on the scenario's time grid.
         #[arg(long, value_name = "CSV")]
@@ -162,6 +171,7 @@ enum Command {
     /// write DIR/track.csv and DIR/track.json. Exit 1 when an estimate does
     /// not converge or the model does not explain the data.
     Track {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The trajectory (t,x,y,theta; omega, model, fx, fy optional), or `-` for standard input.
         #[arg(long, value_name = "CSV|-")]
@@ -185,7 +195,8 @@ enum Command {
         /// Noise level of theta (rad).
         #[arg(long, default_value_t = 1e-3, value_name = "RAD")]
         sigma_theta: f64,
-        /// Use the omega column as a measurement with this noise level (rad/s).
+        /// Use the omega column as a measurement with this noise level
+        /// (rad/s); default: the omega column is not used.
         #[arg(long, value_name = "RAD/S")]
         sigma_omega: Option<f64>,
         /// Noise level of each pusher force component when the CSV has fx, fy (N).
@@ -223,9 +234,10 @@ enum Command {
         replot: bool,
     },
     /// Print the pushval-problem JSON document an outside engine receives
-    /// for this scenario (adapters/pushval-problem-1.schema.json, or -2 with
-    /// --protocol 2).
+    /// for this scenario (its JSON schema, pushval-problem-1.schema.json or
+    /// -2 with --protocol 2, is one of those `pushval shipped` writes).
     Problem {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The time step written into the document (s); default the
         /// scenario's [engine] dt, else 1e-3.
@@ -261,7 +273,8 @@ enum Command {
         force: bool,
     },
     /// Write results/MANIFEST.csv: every file of results/ and the one
-    /// command that regenerates it, from the rules of src/manifest.rs.
+    /// command that regenerates it, from the rules built into pushval (for
+    /// pushval's own repository).
     Manifest {
         /// Write nothing; exit 1 listing every difference between the
         /// committed MANIFEST.csv and the rules, every file no rule matches
@@ -274,9 +287,10 @@ enum Command {
     },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// Output folder (created if missing).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
     /// A push schedule that takes the object from the scenario's start to a
@@ -654,9 +668,50 @@ mod closed {
     }
 }
 
+/// The command line's grammar: [`Cli`], where every option or argument
+/// that takes a number takes a negative one the same way (`--dt -1`,
+/// `--sigma-theta -1e-3` reach the command, which refuses them naming the
+/// option, as `--goal -0.5,0,0` reaches `plan`). Without this clap takes
+/// `-1` for an unknown flag; its own negative-number rule misses `-1e-3`
+/// and `-.5`, so a numeric value may start with a hyphen (a flag given by
+/// mistake is then a value that does not parse, named as such). Other
+/// values take what clap reads as a negative number. One rule for every
+/// command, applied here so no argument can miss it.
+fn grammar() -> clap::Command {
+    use std::any::TypeId;
+    let numeric = [
+        TypeId::of::<f64>(),
+        TypeId::of::<f32>(),
+        TypeId::of::<i64>(),
+        TypeId::of::<i32>(),
+        TypeId::of::<u64>(),
+        TypeId::of::<u32>(),
+        TypeId::of::<u16>(),
+        TypeId::of::<u8>(),
+        TypeId::of::<usize>(),
+    ];
+    fn negatives(command: clap::Command, numeric: &[std::any::TypeId]) -> clap::Command {
+        command
+            .mut_args(|a| {
+                if !a.get_action().takes_values() {
+                    a
+                } else if numeric.iter().any(|t| a.get_value_parser().type_id() == *t) {
+                    a.allow_hyphen_values(true)
+                } else {
+                    a.allow_negative_numbers(true)
+                }
+            })
+            .mut_subcommands(|c| negatives(c, numeric))
+    }
+    negatives(<Cli as clap::CommandFactory>::command(), &numeric)
+}
+
 fn main() -> ExitCode {
     closed::install();
-    let cli = match Cli::try_parse() {
+    let parsed = grammar()
+        .try_get_matches()
+        .and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(cli) => cli,
         // Help, version or a usage error: clap's text and status, or 141
         // when the text could not be written for want of a reader.
