@@ -1,7 +1,8 @@
 //! The pushval command line.
 //!
 //! Exit codes: 0 every gated tolerance holds, 1 a tolerance failed, 2 unusable
-//! input or an error (nothing is written then).
+//! input or an error (nothing is written then), 141 the reader of standard
+//! output went away before pushval finished printing (see [`closed`]).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -15,14 +16,15 @@ use pushval_scenario::Scenario;
 #[command(
     name = "pushval",
     version,
-    about = "Cross-validates an analytic model of single-point pushing against physics engines.\n\nWith no command: validate every scenario in scenarios/."
+    about = "Cross-validates an analytic model of single-point pushing against physics engines.\n\nWith no command: validate every scenario of the project (the scenarios/ folder beside the pushval.toml in use, else ./scenarios, else the scenarios shipped inside pushval)."
 )]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
     /// Outside engines: the pushval.toml-format file declaring them (default:
-    /// ./pushval.toml when present). Trusted like a build script: its
-    /// commands run.
+    /// the pushval.toml of the current folder, else of its nearest parent
+    /// folder that has one; none when no folder up to the root has one).
+    /// Trusted like a build script: its commands run.
     #[arg(long, global = true, value_name = "FILE")]
     engines: Option<PathBuf>,
 }
@@ -32,12 +34,15 @@ enum Command {
     /// Run every model of the given scenarios, compare them with the dynamic
     /// model and print a table; exit 1 when a gated tolerance fails.
     Validate {
-        /// Scenario files (default: every *.toml in scenarios/).
+        /// Scenario files (TOML; default: every *.toml of the project's
+        /// scenarios/ beside the pushval.toml in use, else of ./scenarios,
+        /// else the scenarios shipped inside pushval).
         files: Vec<PathBuf>,
         /// Print the table as JSON instead (one summary.json document per scenario).
         #[arg(long)]
         json: bool,
-        /// Also write a JUnit XML report to this file (for CI systems).
+        /// Also write a JUnit XML report to this file (for CI systems);
+        /// default: none.
         #[arg(long, value_name = "FILE")]
         junit: Option<PathBuf>,
         /// Refuse (exit 2) any [tolerance] number above the default auto
@@ -50,6 +55,7 @@ enum Command {
     /// dynamic model and rapier2d with the scenario's tolerances; exit 1 when
     /// one fails.
     Compare {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The outside trajectory (t,x,y,theta; omega, model optional) on the scenario's time grid.
         #[arg(long, value_name = "CSV")]
@@ -77,7 +83,8 @@ enum Command {
         /// Reduced sweep grids (for tests).
         #[arg(long)]
         quick: bool,
-        /// Compute only part K of N of the sweeps into OUT/parts/ (batch schedulers).
+        /// Compute only part K of N of the sweeps into OUT/parts/ (batch
+        /// schedulers); default: every sweep, no parts.
         #[arg(long, value_name = "K/N", conflicts_with = "merge")]
         shard: Option<pushval::shard::Shard>,
         /// Build the outputs from the parts in OUT/parts/ instead of computing the sweeps.
@@ -98,14 +105,16 @@ enum Command {
         #[arg(long)]
         quick: bool,
         /// Compute only part K of N of the tasks (K/N contiguous, hash:K/N by
-        /// each task's key) into parts/; without it, a Slurm array task
-        /// (SLURM_ARRAY_TASK_ID/COUNT) computes its own part.
+        /// each task's key) into parts/; default: a Slurm array task
+        /// (SLURM_ARRAY_TASK_ID/COUNT) computes its own part, any other run
+        /// every task.
         #[arg(long, value_name = "[hash:]K/N", conflicts_with = "merge")]
         shard: Option<pushval::shard::Shard>,
         /// Build the outputs from the part files instead of running the engines.
         #[arg(long)]
         merge: bool,
-        /// Folder of the study files (MODEL.toml); default studies/.
+        /// Folder of the study files (MODEL.toml); default ./studies when it
+        /// exists, else the study files shipped inside pushval.
         #[arg(long, value_name = "DIR")]
         studies: Option<PathBuf>,
     },
@@ -124,6 +133,7 @@ enum Command {
     /// write DIR/fit.json. Exit 1 when the fit does not converge or a
     /// parameter is unidentifiable.
     Fit {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The trajectory (t,x,y,theta; omega, model optional) on the scenario's time grid.
         #[arg(long, value_name = "CSV")]
@@ -161,6 +171,7 @@ enum Command {
     /// write DIR/track.csv and DIR/track.json. Exit 1 when an estimate does
     /// not converge or the model does not explain the data.
     Track {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The trajectory (t,x,y,theta; omega, model, fx, fy optional), or `-` for standard input.
         #[arg(long, value_name = "CSV|-")]
@@ -184,7 +195,8 @@ enum Command {
         /// Noise level of theta (rad).
         #[arg(long, default_value_t = 1e-3, value_name = "RAD")]
         sigma_theta: f64,
-        /// Use the omega column as a measurement with this noise level (rad/s).
+        /// Use the omega column as a measurement with this noise level
+        /// (rad/s); default: the omega column is not used.
         #[arg(long, value_name = "RAD/S")]
         sigma_omega: Option<f64>,
         /// Noise level of each pusher force component when the CSV has fx, fy (N).
@@ -222,9 +234,10 @@ enum Command {
         replot: bool,
     },
     /// Print the pushval-problem JSON document an outside engine receives
-    /// for this scenario (adapters/pushval-problem-1.schema.json, or -2 with
-    /// --protocol 2).
+    /// for this scenario (its JSON schema, pushval-problem-1.schema.json or
+    /// -2 with --protocol 2, is one of those `pushval shipped` writes).
     Problem {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// The time step written into the document (s); default the
         /// scenario's [engine] dt, else 1e-3.
@@ -260,7 +273,8 @@ enum Command {
         force: bool,
     },
     /// Write results/MANIFEST.csv: every file of results/ and the one
-    /// command that regenerates it, from the rules of src/manifest.rs.
+    /// command that regenerates it, from the rules built into pushval (for
+    /// pushval's own repository).
     Manifest {
         /// Write nothing; exit 1 listing every difference between the
         /// committed MANIFEST.csv and the rules, every file no rule matches
@@ -273,9 +287,10 @@ enum Command {
     },
     /// Run one scenario and write DIR/summary.json and DIR/trajectory.csv.
     Run {
+        /// The scenario file (TOML).
         file: PathBuf,
         /// Output folder (created if missing).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
     /// A push schedule that takes the object from the scenario's start to a
@@ -601,8 +616,131 @@ fn stress(out: PathBuf, quick: bool) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Ending quietly when the reader of standard output (or standard error)
+/// goes away: `pushval engines | head -1`.
+///
+/// A C program is killed by SIGPIPE there, which a shell reports as status
+/// 141 (128 + 13) and says nothing about. Rust ignores SIGPIPE, so a write
+/// fails with `EPIPE` instead and `println!` panics; restoring the signal's
+/// default needs `unsafe`, which the workspace forbids. So pushval ends the
+/// same way by hand: no message, status 141. Not 0: pushval's 0 means
+/// "every gated tolerance holds", which a run whose table nobody read to the
+/// end has not shown (under `set -o pipefail` a shell sees what it sees
+/// from `cat`). Every print of pushval goes through `print!`/`println!` (or
+/// returns the write's error to [`main`]), so one panic hook covers them
+/// all, in any thread.
+mod closed {
+    use std::os::fd::AsFd;
+
+    /// The status of a command cut off by its reader: 128 + SIGPIPE.
+    pub const STATUS: u8 = 141;
+
+    /// Whether `fd` is a pipe or socket whose reader has gone: `poll(2)`
+    /// reports an error or a hang-up on its writing end.
+    pub fn reader_gone(fd: impl AsFd) -> bool {
+        use rustix::event::{poll, PollFd, PollFlags};
+        let mut fds = [PollFd::new(&fd, PollFlags::OUT)];
+        let now = rustix::time::Timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        matches!(poll(&mut fds, Some(&now)), Ok(n) if n > 0)
+            && fds[0].revents().intersects(PollFlags::ERR | PollFlags::HUP)
+    }
+
+    /// Whether standard output or standard error has lost its reader.
+    pub fn output_closed() -> bool {
+        reader_gone(std::io::stdout()) || reader_gone(std::io::stderr())
+    }
+
+    /// Makes a failed `print!` or `eprint!` to a closed pipe end pushval
+    /// with [`STATUS`] and no message (after ending the outside engines'
+    /// sessions); every other panic is reported as before.
+    pub fn install() {
+        let report = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            let payload = info.payload();
+            let message = payload
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| payload.downcast_ref::<&str>().copied())
+                .unwrap_or("");
+            // std's words for a failed `print!`/`eprint!`.
+            let closed = (message.starts_with("failed printing to stdout")
+                && reader_gone(std::io::stdout()))
+                || (message.starts_with("failed printing to stderr")
+                    && reader_gone(std::io::stderr()));
+            if closed {
+                pushval::registry::shutdown_sessions();
+                std::process::exit(STATUS.into());
+            }
+            report(info);
+        }));
+    }
+
+    /// Whether `e` is a write that failed because the reader went away.
+    pub fn is_closed_pipe(e: &anyhow::Error) -> bool {
+        e.chain().any(|c| {
+            c.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+        }) && output_closed()
+    }
+}
+
+/// The command line's grammar: [`Cli`], where every option or argument
+/// that takes a number takes a negative one the same way (`--dt -1`,
+/// `--sigma-theta -1e-3` reach the command, which refuses them naming the
+/// option, as `--goal -0.5,0,0` reaches `plan`). Without this clap takes
+/// `-1` for an unknown flag; its own negative-number rule misses `-1e-3`
+/// and `-.5`, so a numeric value may start with a hyphen (a flag given by
+/// mistake is then a value that does not parse, named as such). Other
+/// values take what clap reads as a negative number. One rule for every
+/// command, applied here so no argument can miss it.
+fn grammar() -> clap::Command {
+    use std::any::TypeId;
+    let numeric = [
+        TypeId::of::<f64>(),
+        TypeId::of::<f32>(),
+        TypeId::of::<i64>(),
+        TypeId::of::<i32>(),
+        TypeId::of::<u64>(),
+        TypeId::of::<u32>(),
+        TypeId::of::<u16>(),
+        TypeId::of::<u8>(),
+        TypeId::of::<usize>(),
+    ];
+    fn negatives(command: clap::Command, numeric: &[std::any::TypeId]) -> clap::Command {
+        command
+            .mut_args(|a| {
+                if !a.get_action().takes_values() {
+                    a
+                } else if numeric.iter().any(|t| a.get_value_parser().type_id() == *t) {
+                    a.allow_hyphen_values(true)
+                } else {
+                    a.allow_negative_numbers(true)
+                }
+            })
+            .mut_subcommands(|c| negatives(c, numeric))
+    }
+    negatives(<Cli as clap::CommandFactory>::command(), &numeric)
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    closed::install();
+    let parsed = grammar()
+        .try_get_matches()
+        .and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m));
+    let cli = match parsed {
+        Ok(cli) => cli,
+        // Help, version or a usage error: clap's text and status, or 141
+        // when the text could not be written for want of a reader.
+        Err(e) => {
+            if e.print().is_err() && closed::output_closed() {
+                return ExitCode::from(closed::STATUS);
+            }
+            return ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
+        }
+    };
     if let Err(e) = pushval::registry::use_engines_file(cli.engines.as_deref()) {
         eprintln!("error: {e}");
         return ExitCode::from(2);
@@ -741,6 +879,7 @@ fn main() -> ExitCode {
     pushval::registry::shutdown_sessions();
     match result {
         Ok(code) => code,
+        Err(e) if closed::is_closed_pipe(&e) => ExitCode::from(closed::STATUS),
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

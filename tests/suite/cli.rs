@@ -273,3 +273,197 @@ fn outputs_get_the_umask_mode() {
         assert_eq!(std::fs::read_dir(&out).unwrap().count(), 2);
     }
 }
+
+/// A standard output nobody reads any more: the writing end of a pipe
+/// whose reading end is closed (a `true` that has exited held it), so the
+/// first write fails however fast pushval is.
+fn closed_stdout() -> std::process::Stdio {
+    let mut reader = Command::new("true")
+        .stdin(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pipe = reader.stdin.take().unwrap();
+    reader.wait().unwrap();
+    pipe.into()
+}
+
+/// `pushval engines | head -1`: every command that prints ends quietly
+/// when its reader goes away, with the status a shell shows for a program
+/// SIGPIPE ended (141), never a panic (101).
+#[test]
+fn a_closed_standard_output_ends_pushval_quietly() {
+    let scenario = root().join("scenarios/paper-square-v1.0.toml");
+    let scenario = scenario.to_str().unwrap();
+    let commands: &[&[&str]] = &[
+        &["engines"],
+        &["laws"],
+        &["laws", "--json"],
+        &["problem", scenario],
+        &["validate", scenario],
+        &["--help"],
+        &["run", "--help"],
+        &["--version"],
+    ];
+    for args in commands {
+        let o = pushval()
+            .args(*args)
+            .stdout(closed_stdout())
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(141), "pushval {args:?}: {err}");
+        assert!(err.is_empty(), "pushval {args:?} said: {err}");
+    }
+}
+
+/// The commands whose arguments this file checks (plan, loop and
+/// control-study take theirs from the control module, checked with it).
+const COMMANDS: &[&str] = &[
+    "validate",
+    "compare",
+    "stress",
+    "report",
+    "study",
+    "engines",
+    "laws",
+    "fit",
+    "fit-study",
+    "track",
+    "track-study",
+    "power",
+    "problem",
+    "init",
+    "shipped",
+    "manifest",
+    "run",
+];
+
+/// The entries of a help's `Arguments:` and `Options:` sections: the
+/// argument as written (`--dt <H>`, `<FILE>`) and its description (a long
+/// description continues on lines indented past the argument).
+fn help_entries(help: &str) -> Vec<(String, String)> {
+    let mut entries: Vec<(String, String)> = Vec::new();
+    let mut in_section = false;
+    for line in help.lines() {
+        if line == "Arguments:" || line == "Options:" {
+            in_section = true;
+            continue;
+        }
+        if !line.starts_with(' ') {
+            in_section = false;
+            continue;
+        }
+        if !in_section {
+            continue;
+        }
+        let body = line.trim_start();
+        let indent = line.len() - body.len();
+        if indent <= 6 && (body.starts_with('-') || body.starts_with('<') || body.starts_with('['))
+        {
+            let (arg, about) = match body.find("  ") {
+                Some(i) => (&body[..i], body[i..].trim()),
+                None => (body, ""),
+            };
+            entries.push((arg.trim().to_string(), about.to_string()));
+        } else if let Some(last) = entries.last_mut() {
+            last.1.push(' ');
+            last.1.push_str(body);
+        }
+    }
+    entries
+}
+
+/// Every help says what each argument is, and every optional value gives
+/// its default (`[default: …]`, or the word "default" in its description):
+/// the arguments a command cannot run without are the only ones without.
+#[test]
+fn every_help_describes_each_argument_and_its_default() {
+    for command in COMMANDS {
+        let o = pushval().args([command, "--help"]).output().unwrap();
+        assert!(o.status.success(), "{command}");
+        let help = String::from_utf8(o.stdout).unwrap();
+        let usage = help
+            .lines()
+            .find(|l| l.starts_with("Usage:"))
+            .unwrap_or_else(|| panic!("{command}: no usage line: {help}"));
+        let entries = help_entries(&help);
+        assert!(!entries.is_empty(), "{command}: {help}");
+        for (arg, about) in &entries {
+            assert!(
+                !about.is_empty(),
+                "pushval {command}: `{arg}` is not described"
+            );
+            let takes_value = arg.contains('<') || arg.starts_with('[');
+            // Required: written in the usage line as is, outside brackets.
+            let flag = arg.split_whitespace().next().unwrap();
+            let required = usage.contains(&format!(" {arg}"))
+                || (arg.starts_with('<') && usage.contains(flag));
+            if takes_value && !required && arg != "--engines <FILE>" {
+                assert!(
+                    about.to_lowercase().contains("default"),
+                    "pushval {command}: optional `{arg}` gives no default: {about}"
+                );
+            }
+        }
+    }
+    // --engines: its default is found as cargo finds Cargo.toml.
+    let o = pushval().arg("--help").output().unwrap();
+    let help = String::from_utf8(o.stdout).unwrap();
+    let (_, engines) = help_entries(&help)
+        .into_iter()
+        .find(|(a, _)| a.starts_with("--engines"))
+        .unwrap();
+    assert!(
+        engines.contains("current folder") && engines.contains("parent"),
+        "{engines}"
+    );
+}
+
+/// A negative number is a value wherever a number is taken, written any
+/// way a number is (`-1`, `-1e-3`, `-.5`): it reaches the command, which
+/// refuses it naming the option (exit 2), instead of being taken for an
+/// unknown flag.
+#[test]
+fn negative_numbers_are_values_everywhere() {
+    let scenario = root().join("scenarios/paper-square-v1.0.toml");
+    for value in ["-1", "-1e-3", "-.5"] {
+        let o = pushval()
+            .arg("problem")
+            .arg(&scenario)
+            .args(["--dt", value])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--dt {value}: {err}");
+        assert!(
+            err.contains("--dt must be a finite number > 0"),
+            "--dt {value}: {err}"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let o = pushval()
+            .arg("track")
+            .arg(&scenario)
+            .args(["--trajectory", "missing.csv", "--out"])
+            .arg(dir.path().join("out"))
+            .args(["--sigma-theta", value])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--sigma-theta {value}: {err}");
+        assert!(
+            err.contains("--sigma-theta: must be a finite number > 0"),
+            "--sigma-theta {value}: {err}"
+        );
+    }
+    // A whole number too: refused by its range, as a value.
+    let o = pushval()
+        .arg("problem")
+        .arg(&scenario)
+        .args(["--protocol", "-1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("invalid value '-1' for '--protocol"), "{err}");
+}

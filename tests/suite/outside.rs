@@ -499,3 +499,64 @@ fn a_session_engine_serves_the_ladder_and_ends_with_pushval() {
         );
     }
 }
+
+/// An adapter that exits while a process it started still holds its
+/// standard output open (so no end of file comes) is noticed by its own
+/// exit, at once, and reported with its exit status and its standard
+/// error: one-shot, whole-document session and stepping session alike. The
+/// bound (10 s against a 30 s timeout) tells "noticed by the exit" from
+/// "noticed at the timeout"; it is not a speed measure. The process it
+/// left behind is ended with it.
+#[test]
+fn an_adapter_exiting_while_its_child_holds_stdout_is_noticed_at_once() {
+    for (how, extra) in [
+        ("one-shot", ""),
+        ("protocol 2 session", "session = true\nprotocol = 2\n"),
+        ("protocol 3 session", "session = true\n"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let held = dir.path().join("sleeper");
+        let script = format!(
+            "import subprocess, sys\n\
+             child = subprocess.Popen(['sleep', '1000'])\n\
+             open({:?}, 'w').write(str(child.pid))\n\
+             sys.stdin.readline()\n\
+             print('lost my licence server', file=sys.stderr, flush=True)\n\
+             sys.exit(3)\n",
+            held.display().to_string()
+        );
+        let sc = single_gate(dir.path());
+        let engines = engines_file(
+            dir.path(),
+            &["python3", "-c", &script],
+            &format!("timeout_s = 30\n{extra}"),
+        );
+        let start = std::time::Instant::now();
+        let o = pushval()
+            .arg("run")
+            .arg(&sc)
+            .arg("--out")
+            .arg(dir.path().join("out"))
+            .arg("--engines")
+            .arg(&engines)
+            .output()
+            .unwrap();
+        let elapsed = start.elapsed();
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{how}: {t}");
+        assert!(elapsed.as_secs_f64() < 10.0, "{how}: took {elapsed:?}: {t}");
+        assert!(t.contains("exited with status 3"), "{how}: {t}");
+        assert!(t.contains("lost my licence server"), "{how}: {t}");
+        assert!(!t.contains("timeout"), "{how}: not a timeout: {t}");
+        let sleeper: u32 = std::fs::read_to_string(&held)
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap();
+        let stat = std::fs::read_to_string(format!("/proc/{sleeper}/stat")).unwrap_or_default();
+        assert!(
+            stat.is_empty() || stat.contains(") Z "),
+            "{how}: the child {sleeper} holding the pipe outlived the run: {stat}"
+        );
+    }
+}

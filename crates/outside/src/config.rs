@@ -141,7 +141,11 @@ impl Spec {
         }
         let how = if self.command[0].starts_with("python") {
             "; install Python 3 (e.g. `apt-get install python3`)"
-        } else if self.command[0].contains(".venv-adapters") {
+        } else if self.command[0].contains(".venv-adapters")
+            // The project's own script (pushval's repository has one), never
+            // a path the user's project lacks.
+            && self.dir.join("scripts/setup-adapters.sh").is_file()
+        {
             "; create it with scripts/setup-adapters.sh"
         } else {
             ""

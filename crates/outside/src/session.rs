@@ -25,6 +25,7 @@
 //! [`shutdown_sessions`] ends them all; a dropped session ends its process
 //! too.
 
+use std::os::fd::{AsFd, OwnedFd};
 use std::path::PathBuf;
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::{Condvar, Mutex, MutexGuard};
@@ -42,6 +43,12 @@ const GRACE: Duration = Duration::from_secs(2);
 /// How long the end of standard error is waited for after an `#error`
 /// answer (the session goes on, so its standard error does not close).
 const ERROR_TAIL_WAIT: Duration = Duration::from_millis(20);
+/// How often a session without an exit watch ([`tree::exit_watch`]) is
+/// asked whether it has exited while an answer is awaited.
+const EXIT_POLL: Duration = Duration::from_millis(20);
+/// How long a session that closed its standard output mid-answer is given
+/// to exit on its own (so its own exit status is reported, not the kill's).
+const EXIT_WAIT: Duration = Duration::from_millis(500);
 
 /// Which process a session is: the engine's declaration.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -118,6 +125,9 @@ enum Fail {
     /// Gave no closing line within its timeout: the session must end, and
     /// so must whatever orphans it left.
     TimedOut(String),
+    /// Closed its standard output or exited mid-answer: the session must
+    /// end, once its process has had a moment to exit on its own.
+    Ended(String),
 }
 
 /// One adapter process serving problems.
@@ -131,6 +141,8 @@ struct Session {
     input: Option<Input>,
     /// Standard output, read by the thread waiting for an answer.
     out: Direct,
+    /// Readable once the process has exited (None: asked at intervals).
+    exit: Option<OwnedFd>,
     err: Tail,
     /// Bytes read after the last answer's closing line.
     carry: Vec<u8>,
@@ -149,7 +161,7 @@ const FIRST_ANSWER_HINT: Duration = Duration::from_secs(5);
 /// The likely cause of a session whose first document is never answered.
 fn never_answered_hint(spec_name: &str) -> String {
     format!(
-        "a process that never answers its first document is most likely a protocol 1 adapter (it reads one document to the end of its standard input, which a session never closes) declared with `session = true`: declare [engine.{spec_name}] session = false, or serve sessions (the adapter kit python/pushval/adapter.py does)"
+        "a process that never answers its first document is most likely a protocol 1 adapter (it reads one document to the end of its standard input, which a session never closes) declared with `session = true`: declare [engine.{spec_name}] session = false, or serve sessions (the adapter kit, the Python module `pushval.adapter`, does)"
     )
 }
 
@@ -176,12 +188,14 @@ impl Session {
         let input = Input::new(child.stdin.take().expect("piped"));
         let out = Direct::new(child.stdout.take().expect("piped"));
         let err = Tail::spawn(child.stderr.take().expect("piped"));
+        let exit = tree::exit_watch(&child);
         Ok(Self {
             key,
             child,
             mark,
             input: Some(input),
             out,
+            exit,
             err,
             carry: Vec::new(),
             answered: 0,
@@ -192,6 +206,44 @@ impl Session {
 
     fn alive(&mut self) -> bool {
         !self.ended && !tree::has_exited(&mut self.child)
+    }
+
+    /// Appends the process's output to `buf`, waiting until `until` at most
+    /// for the first byte; [`Filled::Exited`] as soon as the process has
+    /// exited with nothing left to read (a process it started may hold its
+    /// standard output open, so no end of file would come).
+    fn wait_output(&mut self, buf: &mut Vec<u8>, until: Instant) -> Filled {
+        if let Some(exit) = &self.exit {
+            return self.out.fill_or_exit(buf, until, Some(exit.as_fd()));
+        }
+        loop {
+            let slice = until.min(Instant::now() + EXIT_POLL);
+            match self.out.fill(buf, slice) {
+                Filled::Nothing if tree::has_exited(&mut self.child) => {
+                    // What it wrote before it exited comes first.
+                    return match self.out.fill(buf, Instant::now()) {
+                        Filled::Nothing => Filled::Exited,
+                        got => got,
+                    };
+                }
+                Filled::Nothing if Instant::now() < until => {}
+                got => return got,
+            }
+        }
+    }
+
+    /// Waits until `until` at most for the process to exit; whether it has.
+    fn exits_by(&mut self, until: Instant) -> bool {
+        let mut pause = Duration::from_micros(100);
+        while !tree::has_exited(&mut self.child) {
+            let now = Instant::now();
+            if now >= until {
+                return false;
+            }
+            std::thread::sleep(pause.min(until - now));
+            pause = (pause * 2).min(Duration::from_millis(5));
+        }
+        true
     }
 
     /// Writes `doc` (a JSON object) with the next request number; returns
@@ -304,11 +356,17 @@ impl Session {
             } else {
                 deadline.min(written + FIRST_ANSWER_HINT)
             };
-            match self.out.fill(&mut answer, wait_until) {
+            match self.wait_output(&mut answer, wait_until) {
                 Filled::Bytes => {}
                 Filled::End => {
-                    return Err(Fail::Broken(format!(
+                    return Err(Fail::Ended(format!(
                         "closed its standard output before the closing line of its answer to request {number} ({what}): the session ended mid-answer"
+                    )))
+                }
+                Filled::Exited => {
+                    return Err(Fail::Ended(format!(
+                        "exited before the closing line (`{} {number}`) of its answer to request {number} ({what}), its standard output still held open by a process it started",
+                        close.word()
                     )))
                 }
                 Filled::Nothing if Instant::now() < deadline => {
@@ -352,9 +410,7 @@ impl Session {
     /// then ends it and everything it started.
     fn close(&mut self, until: Instant) {
         self.input = None;
-        while !tree::has_exited(&mut self.child) && Instant::now() < until {
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        self.exits_by(until);
         self.end();
     }
 }
@@ -407,7 +463,7 @@ fn check_closing(
 ) -> Result<(), Fail> {
     match closing.number {
         None => Err(Fail::Broken(format!(
-            "closed its answer to request {number} ({what}) with `{}`, which carries no request number (in a session every answer closes with `#end N`, `#ok N` or `#error N MESSAGE`, N the document's \"request\"; the adapter kit python/pushval/adapter.py numbers its answers)",
+            "closed its answer to request {number} ({what}) with `{}`, which carries no request number (in a session every answer closes with `#end N`, `#ok N` or `#error N MESSAGE`, N the document's \"request\"; the adapter kit, the Python module `pushval.adapter`, numbers its answers)",
             clip(text)
         ))),
         Some(n) if n < number => Err(Fail::Broken(format!(
@@ -638,9 +694,10 @@ impl Lease {
     /// Ends a broken session (and, after a timeout, the orphans), and says
     /// how.
     fn broken(&mut self, fail: Fail, what: &str) -> ProcessError {
-        let (text, timed_out) = match fail {
-            Fail::TimedOut(t) => (t, true),
-            Fail::Broken(t) | Fail::Refused(t) => (t, false),
+        let (text, timed_out, ended) = match fail {
+            Fail::TimedOut(t) => (t, true, false),
+            Fail::Ended(t) => (t, false, true),
+            Fail::Broken(t) | Fail::Refused(t) => (t, false, false),
         };
         let Some(mut s) = self.session.take() else {
             return ProcessError {
@@ -649,6 +706,10 @@ impl Lease {
             };
         };
         let pid = s.child.id();
+        if ended {
+            // Its own exit status, not the kill's, says what happened.
+            s.exits_by(Instant::now() + EXIT_WAIT);
+        }
         let status = s.end();
         let stderr = s.err.get(Duration::from_millis(200));
         release(s);

@@ -159,6 +159,58 @@ fn wait_ready(fd: impl AsFd, flags: rustix::event::PollFlags, deadline: Option<I
     }
 }
 
+/// What [`wait_readable_or_exit`] saw first.
+#[cfg(target_os = "linux")]
+enum Ready {
+    /// The pipe has bytes, an end of file or an error to read.
+    Readable,
+    /// The pipe has nothing and the process has exited.
+    Exited,
+    /// Neither by the deadline.
+    Deadline,
+}
+
+/// Waits until `fd` is readable or `exit` (a process's pidfd) says the
+/// process exited, or `deadline` passes. Blocks in `poll(2)`: no spinning.
+/// A readable pipe wins over an exit: bytes written before the exit are
+/// read before it is reported.
+#[cfg(target_os = "linux")]
+fn wait_readable_or_exit(
+    fd: impl AsFd,
+    exit: std::os::fd::BorrowedFd<'_>,
+    deadline: Instant,
+) -> Ready {
+    use rustix::event::{poll, PollFd, PollFlags};
+    loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        let timeout = rustix::time::Timespec {
+            tv_sec: left.as_secs() as _,
+            tv_nsec: left.subsec_nanos() as _,
+        };
+        let mut fds = [
+            PollFd::new(&fd, PollFlags::IN),
+            PollFd::new(&exit, PollFlags::IN),
+        ];
+        match poll(&mut fds, Some(&timeout)) {
+            Ok(n) if n > 0 => {
+                return if fds[0].revents().is_empty() {
+                    Ready::Exited
+                } else {
+                    Ready::Readable
+                };
+            }
+            Ok(_) => {
+                if Instant::now() >= deadline {
+                    return Ready::Deadline;
+                }
+            }
+            Err(rustix::io::Errno::INTR) => {}
+            // poll itself failed (not expected): let the read say.
+            Err(_) => return Ready::Readable,
+        }
+    }
+}
+
 /// What [`Direct::fill`] got.
 pub(crate) enum Filled {
     /// Some bytes, appended.
@@ -167,6 +219,9 @@ pub(crate) enum Filled {
     End,
     /// Nothing by the deadline.
     Nothing,
+    /// Nothing to read, and the process has exited (a process it started
+    /// may still hold the pipe open, so no end of file comes).
+    Exited,
 }
 
 /// A session's standard output, read by the thread that waits for an
@@ -193,6 +248,19 @@ impl Direct {
     /// Appends to `buf` what is there, waiting until `deadline` at most for
     /// the first byte.
     pub(crate) fn fill(&mut self, buf: &mut Vec<u8>, deadline: Instant) -> Filled {
+        self.fill_or_exit(buf, deadline, None)
+    }
+
+    /// As [`Direct::fill`], and [`Filled::Exited`] as soon as `exit` (the
+    /// writer's pidfd, readable once it has exited) says the process is gone
+    /// while the pipe has nothing to read. What the process wrote before it
+    /// exited is read first.
+    pub(crate) fn fill_or_exit(
+        &mut self,
+        buf: &mut Vec<u8>,
+        deadline: Instant,
+        exit: Option<std::os::fd::BorrowedFd<'_>>,
+    ) -> Filled {
         loop {
             if self.ended {
                 return Filled::End;
@@ -208,7 +276,16 @@ impl Direct {
                 }
                 Err(e) if e.kind() == ErrorKind::Interrupted => {}
                 Err(e) if e.kind() == ErrorKind::WouldBlock => {
-                    if !wait_ready(&self.out, rustix::event::PollFlags::IN, Some(deadline)) {
+                    let ready = match exit {
+                        #[cfg(target_os = "linux")]
+                        Some(exit) => match wait_readable_or_exit(&self.out, exit, deadline) {
+                            Ready::Readable => true,
+                            Ready::Exited => return Filled::Exited,
+                            Ready::Deadline => false,
+                        },
+                        _ => wait_ready(&self.out, rustix::event::PollFlags::IN, Some(deadline)),
+                    };
+                    if !ready {
                         return Filled::Nothing;
                     }
                 }

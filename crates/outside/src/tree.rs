@@ -110,6 +110,23 @@ pub(crate) fn end_orphans() {
     }
 }
 
+/// A file descriptor that becomes readable once `child` has exited (a
+/// pidfd, Linux 5.3 and later), so a wait on its output can also wait on its
+/// exit in one `poll(2)`; None where there is none (then [`has_exited`] is
+/// asked at intervals).
+pub(crate) fn exit_watch(child: &Child) -> Option<std::os::fd::OwnedFd> {
+    #[cfg(target_os = "linux")]
+    {
+        use rustix::process::{pidfd_open, Pid, PidfdFlags};
+        pidfd_open(Pid::from_child(child), PidfdFlags::empty()).ok()
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = child;
+        None
+    }
+}
+
 /// Whether `child` has exited, without reaping it (its pid stays its own).
 pub(crate) fn has_exited(child: &mut Child) -> bool {
     #[cfg(target_os = "linux")]

@@ -58,7 +58,7 @@ impl MujocoModel {
             Ok(())
         } else {
             Err(
-                "build with --features mujoco (and run scripts/setup-mujoco.sh for libmujoco.so)"
+                "build with --features mujoco (it links MuJoCo 3.17's libmujoco.so: MUJOCO_DYNAMIC_LINK_DIR names its folder at build time, LD_LIBRARY_PATH at run time)"
                     .into(),
             )
         })

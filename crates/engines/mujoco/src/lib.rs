@@ -56,7 +56,7 @@ pub const AVAILABLE: bool = cfg!(feature = "mujoco");
 
 /// The message of the error a build without the `mujoco` feature returns.
 pub const UNAVAILABLE: &str =
-    "pushval was built without the `mujoco` feature; run scripts/setup-mujoco.sh";
+    "pushval was built without the `mujoco` feature (build with --features mujoco; it links MuJoCo 3.17's libmujoco.so)";
 
 /// MuJoCo's friction cone.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
