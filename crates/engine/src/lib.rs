@@ -39,7 +39,8 @@ pub use resample::{
     StepRecord,
 };
 pub use session::{
-    rigid_cm_velocity, run_via_session, with_pushes, EngineSession, EngineState, ReplaySession,
+    on_first_push, on_thread, rigid_cm_velocity, run_via_session, with_pushes, EngineSession,
+    EngineState, ReplaySession, Session,
 };
 
 /// What one engine run produced.
@@ -198,29 +199,33 @@ impl EngineInfo {
 /// One engine model: an engine, a scene and a friction law, runnable at any
 /// time step. Implemented by each engine crate; used through `dyn Engine`.
 ///
-/// Four methods: what the model is ([`EngineInfo`]), the settings of a run,
-/// the run, and the friction law it declares. The accessors on `dyn Engine`
-/// (`name()`, `order()`, …) read [`Engine::info`].
+/// What the model is ([`EngineInfo`]), the settings of a run, its session
+/// (the world, pushed one push at a time by the caller), the friction law it
+/// declares, and the run, which is its session driven through the schedule
+/// ([`run_via_session`], the default) unless the engine cannot keep a world
+/// between pushes. The accessors on `dyn Engine` (`name()`, `order()`, …)
+/// read [`Engine::info`].
 pub trait Engine: Send + Sync {
     /// What the model is (name, version, order, default step, options, …).
     fn info(&self) -> &EngineInfo;
     /// The settings that produce a run at `dt`, as JSON for the outputs
     /// (includes `"engine"`: the version, and `"dt"`).
     fn settings(&self, dt: f64) -> serde_json::Value;
-    /// Runs the problem at time step `dt` (s). An engine with its own
-    /// session implements this as [`run_via_session`]: `start`, one
-    /// `advance` per push, `finish`.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError>;
-    /// The engine's own session for `problem` at `dt`, where it can keep its
-    /// world between pushes; None (the default) when it cannot, and
-    /// [`start`](dyn Engine::start) falls back on a [`ReplaySession`].
-    fn session<'a>(
-        &'a self,
-        _problem: &Problem,
-        _dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        None
+    /// Runs the problem at time step `dt` (s): by default
+    /// [`run_via_session`], `start`, one `advance` per push, `finish`. Only
+    /// an engine whose session replays (it cannot keep its world between
+    /// pushes) runs a schedule otherwise.
+    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+        run_via_session(self, problem, dt)
     }
+    /// The engine's session for `problem` at `dt`: an owned, `Send` world
+    /// that borrows nothing from the engine. Called through
+    /// [`start`](dyn Engine::start), which checks `dt` and hands over the
+    /// problem without its schedule: the session's result depends only on
+    /// the pushes it is advanced by (an object that starts moving takes the
+    /// first push applied, [`on_first_push`]). An engine that cannot keep
+    /// its world between pushes returns a [`ReplaySession`].
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError>;
     /// The engine's own friction law in closed form, if it declares one
     /// ([`FrictionLaw`]; [`COULOMB`] for an engine that applies Coulomb
     /// friction at every support). None by default.
@@ -231,27 +236,13 @@ pub trait Engine: Send + Sync {
 
 /// Shorthands for the fields of [`Engine::info`], and the session.
 impl dyn Engine + '_ {
-    /// Builds the engine's world for `problem` (its schedule is not applied)
-    /// at time step `dt` (s), the only place the step is given, and hands the
-    /// loop to the caller ([`EngineSession`]): the engine's own session, or
-    /// a [`ReplaySession`] that re-runs the schedule applied so far at every
-    /// `advance`.
-    pub fn start<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Result<Box<dyn EngineSession + 'a>, ModelError> {
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(ModelError::Parameter {
-                name: "dt",
-                requirement: "finite and > 0",
-                value: dt,
-            });
-        }
-        match self.session(problem, dt) {
-            Some(session) => session,
-            None => Ok(Box::new(ReplaySession::new(self, problem, dt))),
-        }
+    /// Builds the engine's world for `problem` (its schedule is neither
+    /// applied nor read) at time step `dt` (s), the only place the step is
+    /// given, and hands the loop to the caller: an owned [`Session`], the
+    /// engine's own or a [`ReplaySession`] that re-runs the schedule applied
+    /// so far at every `advance`.
+    pub fn start(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
+        session::start(self, problem, dt)
     }
     /// [`EngineInfo::name`].
     pub fn name(&self) -> &str {

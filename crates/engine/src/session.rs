@@ -1,17 +1,31 @@
 //! The caller owns the loop: an engine run as a session.
 //!
 //! [`Engine::start`](crate::Engine::start) builds the engine's world for a
-//! problem and a time step and returns an [`EngineSession`]: the caller reads
-//! its [`state`](EngineSession::state), applies one piecewise-constant push
-//! at a time with [`advance`](EngineSession::advance) and ends it with
+//! problem and a time step and returns a [`Session`]: the caller reads its
+//! [`state`](EngineSession::state), applies one piecewise-constant push at a
+//! time with [`advance`](EngineSession::advance) and ends it with
 //! [`finish`](EngineSession::finish), which returns the [`EngineRun`] a whole
 //! run returns. `run(problem, dt)` is `start`, one `advance` per push of the
-//! schedule, then `finish`, bit for bit ([`run_via_session`]).
+//! schedule, then `finish` ([`run_via_session`]).
+//!
+//! A session answers only what it is asked: its result depends on the pushes
+//! it was advanced by, never on a schedule announced at `start` (the engine
+//! is handed the start's problem without its schedule; an object that does
+//! not start at rest is set moving with the first push applied,
+//! [`on_first_push`]).
+//!
+//! A session is owned and `Send`: it borrows nothing from its engine, so a
+//! loop, a thread or a binding can hold one. An engine whose world cannot
+//! leave the thread it was built on keeps it on a thread of the session's
+//! own ([`on_thread`]).
 //!
 //! An engine that cannot keep its world between pushes gets a
 //! [`ReplaySession`]: every `advance` re-runs the schedule applied so far
 //! from the start. That is correct (the engines are deterministic) at N
 //! times the cost for N pushes, and [`EngineSession::replays`] says so.
+
+use std::sync::{mpsc, Arc};
+use std::thread::JoinHandle;
 
 use pushval_model::{ModelError, Problem, Push};
 
@@ -96,6 +110,10 @@ pub trait EngineSession {
     fn steps_taken(&self) -> usize;
 }
 
+/// An owned engine session, as [`Engine::start`](crate::Engine::start)
+/// hands it out: no borrow of the engine, and `Send`.
+pub type Session = Box<dyn EngineSession + Send>;
+
 /// The problem with `pushes` as its schedule (the start's problem carries
 /// the schedule applied so far).
 pub fn with_pushes(problem: &Problem, pushes: Vec<Push>) -> Problem {
@@ -105,10 +123,212 @@ pub fn with_pushes(problem: &Problem, pushes: Vec<Push>) -> Problem {
     }
 }
 
+/// Builds an engine's session for `problem` (whose schedule is empty) with
+/// `build`, where the start can be built without a push: at once for an
+/// object at rest; for an object that starts moving (with the contact
+/// velocity of its first push), at the first `advance`, with that push as
+/// the schedule of the problem `build` receives. Until then the session's
+/// state is [`EngineState::initial`].
+pub fn on_first_push<F>(problem: &Problem, build: F) -> Result<Session, ModelError>
+where
+    F: FnOnce(&Problem) -> Result<Session, ModelError> + Send + 'static,
+{
+    if problem.initial.from_rest {
+        return build(&with_pushes(problem, Vec::new()));
+    }
+    Ok(Box::new(Deferred {
+        problem: with_pushes(problem, Vec::new()),
+        build: Some(Box::new(build)),
+        session: None,
+    }))
+}
+
+/// The builder a [`Deferred`] session keeps until its first push.
+type Build = Box<dyn FnOnce(&Problem) -> Result<Session, ModelError> + Send>;
+
+/// A session built at its first push ([`on_first_push`]).
+struct Deferred {
+    problem: Problem,
+    build: Option<Build>,
+    session: Option<Session>,
+}
+
+impl EngineSession for Deferred {
+    fn state(&self) -> EngineState {
+        match &self.session {
+            Some(s) => s.state(),
+            None => EngineState::initial(&self.problem),
+        }
+    }
+
+    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        if self.session.is_none() {
+            let build = self.build.take().ok_or_else(|| {
+                ModelError::Adapter("the session failed to start at its first push".into())
+            })?;
+            self.session = Some(build(&with_pushes(&self.problem, vec![*push]))?);
+        }
+        self.session.as_mut().expect("built above").advance(push)
+    }
+
+    fn finish(self: Box<Self>) -> Result<EngineRun, ModelError> {
+        self.session.ok_or(ModelError::EmptySchedule)?.finish()
+    }
+
+    fn replays(&self) -> bool {
+        self.session.as_ref().is_some_and(|s| s.replays())
+    }
+
+    fn steps_taken(&self) -> usize {
+        self.session.as_ref().map_or(0, |s| s.steps_taken())
+    }
+}
+
+/// What a [`Threaded`] session asks its thread.
+enum Ask {
+    Advance(Push),
+    Finish,
+}
+
+/// What the thread answers: the state and steps after an advance, or the
+/// run.
+enum Answer {
+    Advanced(Result<(EngineState, usize), ModelError>),
+    Finished(Result<EngineRun, ModelError>),
+}
+
+/// The session of an engine whose world cannot leave the thread that built
+/// it (a native library's handles): `build` runs on a thread the session
+/// owns, the world stays there, and `advance` and `finish` are requests to
+/// that thread (the state is kept on this side after every answer). The
+/// session is `Send` whatever the world is; the thread ends with the
+/// session (at `finish`, or when it is dropped).
+pub fn on_thread<F>(build: F) -> Result<Session, ModelError>
+where
+    F: FnOnce() -> Result<Box<dyn EngineSession>, ModelError> + Send + 'static,
+{
+    let (ask_tx, ask_rx) = mpsc::channel::<Ask>();
+    let (answer_tx, answer_rx) = mpsc::channel::<Answer>();
+    let thread = std::thread::Builder::new()
+        .name("pushval-engine-session".into())
+        .spawn(move || {
+            let mut session = match build() {
+                Ok(s) => {
+                    let first = Ok((s.state(), s.steps_taken()));
+                    if answer_tx.send(Answer::Advanced(first)).is_err() {
+                        return;
+                    }
+                    s
+                }
+                Err(e) => {
+                    let _ = answer_tx.send(Answer::Advanced(Err(e)));
+                    return;
+                }
+            };
+            while let Ok(ask) = ask_rx.recv() {
+                match ask {
+                    Ask::Advance(push) => {
+                        let r = session
+                            .advance(&push)
+                            .map(|()| (session.state(), session.steps_taken()));
+                        if answer_tx.send(Answer::Advanced(r)).is_err() {
+                            return;
+                        }
+                    }
+                    Ask::Finish => {
+                        let _ = answer_tx.send(Answer::Finished(session.finish()));
+                        return;
+                    }
+                }
+            }
+        })
+        .map_err(|e| {
+            ModelError::Adapter(format!("cannot start an engine session's thread: {e}"))
+        })?;
+    let mut s = Threaded {
+        ask: ask_tx,
+        answer: answer_rx,
+        thread: Some(thread),
+        state: EngineState::default(),
+        steps: 0,
+    };
+    let (state, steps) = s.advanced()?;
+    s.state = state;
+    s.steps = steps;
+    Ok(Box::new(s))
+}
+
+/// A session whose world lives on its own thread ([`on_thread`]).
+struct Threaded {
+    ask: mpsc::Sender<Ask>,
+    answer: mpsc::Receiver<Answer>,
+    thread: Option<JoinHandle<()>>,
+    state: EngineState,
+    steps: usize,
+}
+
+impl Threaded {
+    /// The thread ended without an answer: its panic, or that it is gone.
+    fn lost(&mut self) -> ModelError {
+        let why = match self.thread.take().map(JoinHandle::join) {
+            Some(Err(panic)) => panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "a panic".into()),
+            _ => "it ended".into(),
+        };
+        ModelError::Adapter(format!("the engine session's thread stopped: {why}"))
+    }
+
+    /// The answer to an advance (or to the start).
+    fn advanced(&mut self) -> Result<(EngineState, usize), ModelError> {
+        match self.answer.recv() {
+            Ok(Answer::Advanced(r)) => r,
+            Ok(Answer::Finished(_)) | Err(_) => Err(self.lost()),
+        }
+    }
+}
+
+impl EngineSession for Threaded {
+    fn state(&self) -> EngineState {
+        self.state
+    }
+
+    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        if self.ask.send(Ask::Advance(*push)).is_err() {
+            return Err(self.lost());
+        }
+        let (state, steps) = self.advanced()?;
+        self.state = state;
+        self.steps = steps;
+        Ok(())
+    }
+
+    fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {
+        if self.ask.send(Ask::Finish).is_err() {
+            return Err(self.lost());
+        }
+        let run = match self.answer.recv() {
+            Ok(Answer::Finished(r)) => r,
+            Ok(Answer::Advanced(_)) | Err(_) => Err(self.lost()),
+        };
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+        run
+    }
+
+    fn steps_taken(&self) -> usize {
+        self.steps
+    }
+}
+
 /// A session of an engine that cannot step: every `advance` re-runs the
-/// schedule applied so far with [`Engine::run`].
-pub struct ReplaySession<'a> {
-    engine: &'a dyn Engine,
+/// schedule applied so far with [`Engine::run`]. It owns (a share of) its
+/// engine.
+pub struct ReplaySession {
+    engine: Arc<dyn Engine>,
     problem: Problem,
     dt: f64,
     applied: Vec<Push>,
@@ -117,13 +337,13 @@ pub struct ReplaySession<'a> {
     steps: usize,
 }
 
-impl<'a> ReplaySession<'a> {
+impl ReplaySession {
     /// A session of `engine` on `problem` (its schedule is ignored) at `dt`.
-    pub fn new(engine: &'a dyn Engine, problem: &Problem, dt: f64) -> Self {
+    pub fn new(engine: Arc<dyn Engine>, problem: &Problem, dt: f64) -> Self {
         Self {
             engine,
             state: EngineState::initial(problem),
-            problem: problem.clone(),
+            problem: with_pushes(problem, Vec::new()),
             dt,
             applied: Vec::new(),
             last: None,
@@ -132,7 +352,7 @@ impl<'a> ReplaySession<'a> {
     }
 }
 
-impl EngineSession for ReplaySession<'_> {
+impl EngineSession for ReplaySession {
     fn state(&self) -> EngineState {
         self.state
     }
@@ -173,15 +393,33 @@ impl EngineSession for ReplaySession<'_> {
     }
 }
 
+/// Builds `engine`'s session for `problem` at `dt` (what
+/// [`Engine::start`](crate::Engine::start) does): the step is checked, and
+/// the engine is handed the problem without its schedule.
+pub fn start<E: Engine + ?Sized>(
+    engine: &E,
+    problem: &Problem,
+    dt: f64,
+) -> Result<Session, ModelError> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(ModelError::Parameter {
+            name: "dt",
+            requirement: "finite and > 0",
+            value: dt,
+        });
+    }
+    engine.session(&with_pushes(problem, Vec::new()), dt)
+}
+
 /// `run` as the contract defines it: `start`, one `advance` per push of the
-/// schedule, `finish`.
-pub fn run_via_session(
-    engine: &dyn Engine,
+/// schedule, `finish`. The one push loop of the engines.
+pub fn run_via_session<E: Engine + ?Sized>(
+    engine: &E,
     problem: &Problem,
     dt: f64,
 ) -> Result<EngineRun, ModelError> {
     problem.check()?;
-    let mut session = engine.start(problem, dt)?;
+    let mut session = start(engine, problem, dt)?;
     for push in &problem.pushes {
         session.advance(push)?;
     }

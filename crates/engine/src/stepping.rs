@@ -2,8 +2,9 @@
 //!
 //! An engine that puts the object on supports in a 3-D scene and drives it
 //! with a kinematic pusher builds its world, settles it and sets the start
-//! velocity itself; then [`run_pushes`] runs the push schedule through the
-//! small [`PlateWorld`] trait and gathers what every such engine reports:
+//! velocity itself; then [`Stepping`] runs the pushes the caller applies,
+//! one [`advance`](Stepping::advance) at a time, through the small
+//! [`PlateWorld`] trait and gathers what every such engine reports:
 //!
 //! * **Schedule.** Each segment of duration `T` is cut into
 //!   `n = ceil(T / dt)` equal steps of `h = T / n` (a relative `1e-12` off
@@ -136,15 +137,9 @@ pub trait PlateWorld {
 
     /// The steps of a segment of `push`, where the world lays them out
     /// itself; `n` steps of `h = duration / n` otherwise (None, the
-    /// default). `followed` says whether the start's schedule has a push
-    /// after this one (a switch follows).
-    fn segment_steps(
-        &mut self,
-        _push: &Push,
-        _n: usize,
-        _h: f64,
-        _followed: bool,
-    ) -> Option<StepLayout> {
+    /// default). The layout depends on the push alone: nothing tells the
+    /// world what follows it.
+    fn segment_steps(&mut self, _push: &Push, _n: usize, _h: f64) -> Option<StepLayout> {
         None
     }
 
@@ -251,7 +246,7 @@ pub enum StepClock {
     FromSegmentStart,
 }
 
-/// How [`run_pushes`] runs.
+/// How [`Stepping`] runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepLoop {
     /// Largest time step (s).
@@ -289,7 +284,7 @@ impl StepLoop {
     }
 }
 
-/// What [`run_pushes`] gathered.
+/// What [`Stepping`] gathered.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Stepped {
     /// Every step of the push, after an initial record at t = 0.
@@ -382,9 +377,6 @@ pub struct StepPlan {
     pub h: f64,
     /// The segment's nominal step `duration / n` (s), `n = ceil(duration / dt)`.
     pub nominal_h: f64,
-    /// Whether this is the segment's closing step (the last of a segment
-    /// that a switch follows, where the world's step layout has one).
-    pub closing: bool,
     /// The push of the segment.
     pub push: Push,
 }
@@ -401,15 +393,15 @@ struct StepLog {
     normal: Option<Vec<f64>>,
 }
 
-/// The loop of [`run_pushes`] one push at a time: the world keeps its state
+/// The loop one push at a time: the world keeps its state
 /// between pushes, so the caller decides the next push from the state the
 /// last one left (see the module docs for what a push does).
 ///
-/// The problem given to [`Stepping::new`] is the start's: its schedule is the
-/// pushes the caller announces, read only where the world looks ahead
-/// ([`PlateWorld::segment_steps`] is told whether a push follows). What
-/// depends on the whole run (the run's last fifth, the per-sample loads) is
-/// gathered at [`Stepping::finish`], on the pushes applied.
+/// The problem given to [`Stepping::new`] is the start's; its schedule is
+/// never read (a step depends on the pushes applied, not on any announced
+/// after them). What depends on the whole run (the run's last fifth, the
+/// per-sample loads) is gathered at [`Stepping::finish`], on the pushes
+/// applied.
 pub struct Stepping<W: PlateWorld> {
     world: W,
     problem: Problem,
@@ -496,13 +488,12 @@ impl<W: PlateWorld> Stepping<W> {
     /// Runs one push (see the module docs).
     pub fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
         let j = self.applied.len();
-        let followed = j + 1 < self.problem.pushes.len();
         let cfg = self.cfg;
         let n_sup = cfg.supports;
         let t_seg = self.t_seg;
         let n = (push.duration / cfg.dt * (1.0 - 1e-12)).ceil().max(1.0) as usize;
         let nominal_h = push.duration / n as f64;
-        let layout = self.world.segment_steps(push, n, nominal_h, followed);
+        let layout = self.world.segment_steps(push, n, nominal_h);
         let n_steps = match &layout {
             None => n,
             Some(StepLayout::Lengths(l)) => l.len(),
@@ -565,7 +556,6 @@ impl<W: PlateWorld> Stepping<W> {
                 t1,
                 h,
                 nominal_h,
-                closing: layout.is_some() && followed && k + 1 == n_steps,
                 push: *push,
             };
             let drift = self.world.drive_step(&self.state, &plan);
@@ -644,6 +634,17 @@ impl<W: PlateWorld> Stepping<W> {
         self.world.end_segment(acc_t, self.t_seg)
     }
 
+    /// Advances by every push of `pushes` in order, then ends the loop
+    /// ([`Stepping::finish`]): the one push loop behind an engine crate's
+    /// detailed view of a run (its session's `advance` and `finish`, with
+    /// what the engine records besides the [`EngineRun`](crate::EngineRun)).
+    pub fn run(mut self, pushes: &[Push]) -> Result<(W, Stepped, Problem), ModelError> {
+        for push in pushes {
+            self.advance(push)?;
+        }
+        Ok(self.finish())
+    }
+
     /// Ends the loop: the world, what the loop gathered (the run's last fifth
     /// and the per-sample loads over the pushes applied), and the start's
     /// problem with the pushes applied as its schedule (the one to resample
@@ -686,21 +687,6 @@ impl<W: PlateWorld> Stepping<W> {
     }
 }
 
-/// Runs the push schedule of `problem` from `start` (see the module docs):
-/// [`Stepping`] with one [`advance`](Stepping::advance) per push.
-pub fn run_pushes<W: PlateWorld>(
-    world: &mut W,
-    problem: &Problem,
-    cfg: &StepLoop,
-    start: W::State,
-) -> Result<Stepped, ModelError> {
-    let mut stepping = Stepping::new(world, problem, *cfg, start);
-    for push in &problem.pushes {
-        stepping.advance(push)?;
-    }
-    Ok(stepping.finish().1)
-}
-
 /// A world borrowed by the loop is a world.
 impl<W: PlateWorld + ?Sized> PlateWorld for &mut W {
     type State = W::State;
@@ -710,14 +696,8 @@ impl<W: PlateWorld + ?Sized> PlateWorld for &mut W {
     fn heading(&self, state: &Self::State, h: f64) -> f64 {
         (**self).heading(state, h)
     }
-    fn segment_steps(
-        &mut self,
-        push: &Push,
-        n: usize,
-        h: f64,
-        followed: bool,
-    ) -> Option<StepLayout> {
-        (**self).segment_steps(push, n, h, followed)
+    fn segment_steps(&mut self, push: &Push, n: usize, h: f64) -> Option<StepLayout> {
+        (**self).segment_steps(push, n, h)
     }
     fn drive_step(&mut self, state: &Self::State, plan: &StepPlan) -> f64 {
         (**self).drive_step(state, plan)
@@ -760,24 +740,26 @@ impl<W: PlateWorld + ?Sized> PlateWorld for &mut W {
 
 /// An engine's session over the shared loop: a [`Stepping`] and how the
 /// engine turns what it gathered into its [`EngineRun`](crate::EngineRun).
-pub struct PlateSession<'a, W: PlateWorld> {
+/// It owns its world: it is `Send` where the world and its state are.
+pub struct PlateSession<W: PlateWorld> {
     stepping: Stepping<W>,
-    finish: PlateFinish<'a, W>,
+    finish: PlateFinish<W>,
 }
 
 /// How a [`PlateSession`] ends: the world, what the loop gathered and the
-/// problem of the pushes applied in, the engine's run out.
-pub type PlateFinish<'a, W> =
-    Box<dyn FnOnce(W, Stepped, &Problem) -> Result<crate::EngineRun, ModelError> + 'a>;
+/// problem of the pushes applied in, the engine's run out. It owns what it
+/// needs (no borrow of the engine).
+pub type PlateFinish<W> =
+    Box<dyn FnOnce(W, Stepped, &Problem) -> Result<crate::EngineRun, ModelError> + Send>;
 
-impl<'a, W: PlateWorld> PlateSession<'a, W> {
+impl<W: PlateWorld> PlateSession<W> {
     /// The session of `stepping`, ended by `finish`.
-    pub fn new(stepping: Stepping<W>, finish: PlateFinish<'a, W>) -> Self {
+    pub fn new(stepping: Stepping<W>, finish: PlateFinish<W>) -> Self {
         Self { stepping, finish }
     }
 }
 
-impl<W: PlateWorld> crate::EngineSession for PlateSession<'_, W> {
+impl<W: PlateWorld> crate::EngineSession for PlateSession<W> {
     fn state(&self) -> crate::EngineState {
         self.stepping.engine_state()
     }
@@ -801,6 +783,19 @@ impl<W: PlateWorld> crate::EngineSession for PlateSession<'_, W> {
 mod tests {
     use super::*;
     use pushval_model::{Body, Initial, Push, Support, Switching, Vec2};
+
+    /// The push loop, as a session runs it: [`Stepping`] with one
+    /// [`advance`](Stepping::advance) per push.
+    fn run_pushes<W: PlateWorld>(
+        world: &mut W,
+        problem: &Problem,
+        cfg: &StepLoop,
+        start: W::State,
+    ) -> Result<Stepped, ModelError> {
+        Ok(Stepping::new(world, problem, *cfg, start)
+            .run(&problem.pushes)?
+            .1)
+    }
 
     /// An object carried rigidly by the pusher: it moves at the commanded
     /// velocity, turns at a constant rate `w` and rises linearly; every
@@ -1105,28 +1100,21 @@ mod tests {
         );
     }
 
-    /// The world is told whether the start's schedule has a push after the
-    /// one it lays out, and its own step lengths are kept, the last one
-    /// ending at the segment's end.
+    /// A world's own step lengths are kept, the last one ending at the
+    /// segment's end; the layout is asked once per push applied.
     #[test]
-    fn worlds_lay_out_their_steps_knowing_what_follows() {
+    fn worlds_lay_out_their_own_steps() {
         struct Laid {
             inner: Carried,
-            followed: Vec<bool>,
+            laid: usize,
         }
         impl PlateWorld for Laid {
             type State = Plate;
             fn plate(&self, s: &Plate) -> Plate {
                 *s
             }
-            fn segment_steps(
-                &mut self,
-                _: &Push,
-                n: usize,
-                h: f64,
-                followed: bool,
-            ) -> Option<StepLayout> {
-                self.followed.push(followed);
+            fn segment_steps(&mut self, _: &Push, n: usize, h: f64) -> Option<StepLayout> {
+                self.laid += 1;
                 let mut l = vec![0.25 * h, 0.75 * h];
                 l.extend(std::iter::repeat_n(h, n - 1));
                 Some(StepLayout::Lengths(l))
@@ -1156,11 +1144,11 @@ mod tests {
         let p = problem(vec![push, push]);
         let mut w = Laid {
             inner: carried(0.0, None),
-            followed: Vec::new(),
+            laid: 0,
         };
         let start = w.inner.state;
         let run = run_pushes(&mut w, &p, &CFG, start).unwrap();
-        assert_eq!(w.followed, vec![true, false]);
+        assert_eq!(w.laid, 2);
         // 3 steps of 0.1 each, the first cut in two: 4 per segment.
         assert_eq!(run.steps, 8);
         let h = &run.history;

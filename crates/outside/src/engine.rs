@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use pushval_engine::{
     rigid_cm_velocity, trajectory_from_steps, with_pushes, ContactRecord, Engine, EngineCrate,
     EngineInfo, EngineOptions, EngineRun, EngineSession, EngineState, FrictionLaw, LoadRecorder,
-    OptionKeys, StepRecord,
+    OptionKeys, ReplaySession, Session, StepRecord,
 };
 use pushval_model::{ModelError, Problem, Push};
 
@@ -24,8 +24,9 @@ const STDERR_LINES: usize = 8;
 /// An outside engine with a scenario's `[engine]` options: one process per
 /// run, or a session (see the crate docs). With protocol 3 it steps: its
 /// [`Engine::session`] keeps the adapter's world between pushes, and `run`
-/// is `start`, one `advance` per push, `finish`; with protocol 1 or 2,
-/// [`dyn Engine::start`] replays the schedule applied so far.
+/// is `start`, one `advance` per push, `finish` (the requests written at
+/// once, the answers read as a session reads them); with protocol 1 or 2,
+/// its session replays the schedule applied so far.
 #[derive(Clone)]
 pub struct OutsideEngine {
     spec: Arc<Spec>,
@@ -131,7 +132,7 @@ impl Engine for OutsideEngine {
     }
     fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
         if self.steps() {
-            return Stepping::run(self, problem, dt);
+            return Stepping::run(Arc::new(self.clone()), problem, dt);
         }
         let start = Instant::now();
         problem.check()?;
@@ -206,21 +207,22 @@ impl Engine for OutsideEngine {
         Ok(run)
     }
 
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
+    /// Protocol 3 in a session: the adapter's world, kept between pushes
+    /// (the `start` request carries no schedule); otherwise a
+    /// [`ReplaySession`] that re-runs the pushes applied so far. Either owns
+    /// a copy of the engine (its declaration is shared).
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
+        let engine = Arc::new(self.clone());
         if !self.steps() {
-            return None;
+            return Ok(Box::new(ReplaySession::new(engine, problem, dt)));
         }
-        Some(Stepping::start(self, problem, dt).map(|s| Box::new(s) as Box<dyn EngineSession + 'a>))
+        Stepping::start(engine, problem, dt).map(|s| Box::new(s) as Session)
     }
 }
 
 impl OutsideEngine {
     /// Whether the engine steps (protocol 3 in a session): its own
-    /// [`EngineSession`]; else [`dyn Engine::start`] replays.
+    /// [`EngineSession`]; else its session replays.
     fn steps(&self) -> bool {
         self.spec.session && self.spec.protocol >= 3
     }
@@ -268,9 +270,10 @@ impl OutsideEngine {
     }
 }
 
-/// A protocol 3 session: the adapter keeps its world between pushes.
-struct Stepping<'a> {
-    engine: &'a OutsideEngine,
+/// A protocol 3 session: the adapter keeps its world between pushes. It
+/// owns a share of its engine.
+struct Stepping {
+    engine: Arc<OutsideEngine>,
     /// The problem at `start` (its schedule replaced by the pushes applied).
     problem: Problem,
     dt: f64,
@@ -299,7 +302,7 @@ struct Stepping<'a> {
     failed: bool,
 }
 
-impl<'a> Stepping<'a> {
+impl Stepping {
     /// The cap of an answer that holds only its closing line.
     const SMALL: Limits = Limits {
         max_rows: 0,
@@ -352,13 +355,13 @@ impl<'a> Stepping<'a> {
         Duration::from_secs_f64(self.engine.spec.timeout_s)
     }
 
-    fn start(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<Self, ModelError> {
+    fn start(engine: Arc<OutsideEngine>, problem: &Problem, dt: f64) -> Result<Self, ModelError> {
         let started = Instant::now();
         let mut lease = Lease::take(&engine.spec).map_err(|e| engine.broken(e))?;
         let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
         let a = lease
             .request(
-                Self::start_doc(engine, problem, dt),
+                Self::start_doc(&engine, problem, dt),
                 "start",
                 Close::Ok,
                 Self::SMALL,
@@ -369,7 +372,7 @@ impl<'a> Stepping<'a> {
     }
 
     fn new(
-        engine: &'a OutsideEngine,
+        engine: Arc<OutsideEngine>,
         problem: &Problem,
         dt: f64,
         lease: Lease,
@@ -402,13 +405,17 @@ impl<'a> Stepping<'a> {
     /// written at once and the answers read in order (no wait between
     /// requests), each answer read as [`EngineSession::advance`] and
     /// [`EngineSession::finish`] read it.
-    fn run(engine: &'a OutsideEngine, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
+    fn run(
+        engine: Arc<OutsideEngine>,
+        problem: &Problem,
+        dt: f64,
+    ) -> Result<EngineRun, ModelError> {
         problem.check()?;
         let started = Instant::now();
         let mut lease = Lease::take(&engine.spec).map_err(|e| engine.broken(e))?;
         let timeout = Duration::from_secs_f64(engine.spec.timeout_s);
         let mut docs = vec![(
-            Self::start_doc(engine, problem, dt),
+            Self::start_doc(&engine, problem, dt),
             "start",
             Close::Ok,
             Self::SMALL,
@@ -428,7 +435,7 @@ impl<'a> Stepping<'a> {
             })
         };
         let a = next("start").map_err(|e| engine.broken(e))?;
-        let mut s = Self::new(engine, problem, dt, lease, &a, started);
+        let mut s = Self::new(Arc::clone(&engine), problem, dt, lease, &a, started);
         for push in &problem.pushes {
             let a = next("advance").map_err(|e| engine.broken(e))?;
             s.applied.push(*push);
@@ -562,10 +569,10 @@ impl<'a> Stepping<'a> {
     }
 }
 
-impl Stepping<'_> {
+impl Stepping {
     /// Reads an advance's answer for `push` (already in `applied`).
     fn absorb(&mut self, a: Answer, push: &Push) -> Result<(), ModelError> {
-        let engine = self.engine;
+        let engine = Arc::clone(&self.engine);
         self.failed = true;
         self.process_time += a.elapsed;
         self.output_bytes += a.stdout.len();
@@ -589,7 +596,7 @@ impl Stepping<'_> {
 
     /// Reads the finish's answer and returns the run.
     fn close(mut self, a: Answer) -> Result<EngineRun, ModelError> {
-        let engine = self.engine;
+        let engine = Arc::clone(&self.engine);
         if !a.stdout.iter().all(u8::is_ascii_whitespace) {
             return Err(engine.fail(
                 format!(
@@ -646,7 +653,7 @@ impl Stepping<'_> {
     }
 }
 
-impl EngineSession for Stepping<'_> {
+impl EngineSession for Stepping {
     fn state(&self) -> EngineState {
         self.state
     }
@@ -654,7 +661,7 @@ impl EngineSession for Stepping<'_> {
     fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
         self.usable()?;
         self.failed = true;
-        let engine = self.engine;
+        let engine = Arc::clone(&self.engine);
         let (doc, limits) = Self::advance_doc(&self.problem, self.dt, push);
         let timeout = self.timeout();
         let a = self
@@ -667,7 +674,7 @@ impl EngineSession for Stepping<'_> {
 
     fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {
         self.usable()?;
-        let engine = self.engine;
+        let engine = Arc::clone(&self.engine);
         let timeout = self.timeout();
         let a = self
             .lease

@@ -4,8 +4,8 @@
 //! are listed but not available.
 
 use pushval_engine::{
-    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
-    FrictionLaw, ModelEntry, OptionError, OptionKeys, COULOMB,
+    Engine, EngineCrate, EngineInfo, EngineOptions, FrictionLaw, ModelEntry, OptionError,
+    OptionKeys, Session, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -175,56 +175,51 @@ impl Engine for Avian2dModel {
     fn law(&self) -> Option<&dyn FrictionLaw> {
         Some(avian2d_law())
     }
-    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The scene through the shared stepping loop
     /// ([`pushval_engine::stepping`]) on Avian's clock; an object not
-    /// starting at rest starts with the first push of `problem`'s schedule.
+    /// starting at rest starts with the first push applied.
     /// Without the `avian` feature: [`ModelError::Integration`] with
     /// [`crate::UNAVAILABLE`].
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let started = std::time::Instant::now();
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let settings = Avian2dSettings {
             dt,
             ..self.settings
         };
-        if let Err(e) = settings.check() {
-            return Some(Err(e));
-        }
+        settings.check()?;
         #[cfg(feature = "avian")]
         {
             use pushval_engine::stepping::{PlateFinish, PlateSession};
-            let stepping = match crate::world2d::start(problem, &settings) {
-                Ok(s) => s,
-                Err(e) => return Some(Err(e)),
-            };
-            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
-                let r = crate::world2d::finish(&w, stepped, problem, &settings, started);
-                Ok(EngineRun {
-                    dt,
-                    steps: r.steps,
-                    wall_time: r.wall_time,
-                    diagnostics: serde_json::json!({
-                        "steps": r.steps,
-                        "max_joint_drift": r.max_joint_drift,
-                    }),
-                    trajectory: r.trajectory,
-                    contact: None,
+            use pushval_engine::EngineRun;
+            pushval_engine::on_first_push(problem, move |problem| {
+                let problem = problem.clone();
+                // Avian's world is a Bevy `App`, which is not `Send`: it
+                // stays on the session's own thread.
+                pushval_engine::on_thread(move || {
+                    let started = std::time::Instant::now();
+                    let stepping = crate::world2d::start(&problem, &settings)?;
+                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
+                        let r = crate::world2d::finish(&w, stepped, problem, &settings, started);
+                        Ok(EngineRun {
+                            dt,
+                            steps: r.steps,
+                            wall_time: r.wall_time,
+                            diagnostics: serde_json::json!({
+                                "steps": r.steps,
+                                "max_joint_drift": r.max_joint_drift,
+                            }),
+                            trajectory: r.trajectory,
+                            contact: None,
+                        })
+                    });
+                    Ok(Box::new(PlateSession::new(stepping, finish))
+                        as Box<dyn pushval_engine::EngineSession>)
                 })
-            });
-            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+            })
         }
         #[cfg(not(feature = "avian"))]
         {
-            let _ = (problem, started);
-            Some(Err(crate::unavailable()))
+            let _ = problem;
+            Err(crate::unavailable())
         }
     }
 }
@@ -251,60 +246,55 @@ impl Engine for Avian3dModel {
     fn law(&self) -> Option<&dyn FrictionLaw> {
         Some(&self.law)
     }
-    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The scene, settled and calibrated, through the shared stepping loop
     /// ([`pushval_engine::stepping`]) on Avian's clock; an object not
-    /// starting at rest starts with the first push of `problem`'s schedule.
+    /// starting at rest starts with the first push applied.
     /// Without the `avian` feature: [`ModelError::Integration`] with
     /// [`crate::UNAVAILABLE`].
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let started = std::time::Instant::now();
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let settings = Avian3dSettings {
             dt,
             ..self.settings
         };
-        if let Err(e) = settings.check() {
-            return Some(Err(e));
-        }
+        settings.check()?;
         #[cfg(feature = "avian")]
         {
             use pushval_engine::stepping::{PlateFinish, PlateSession};
-            let stepping = match crate::world3d::start(problem, &settings) {
-                Ok(s) => s,
-                Err(e) => return Some(Err(e)),
-            };
-            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
-                let r = crate::world3d::finish(w, stepped, problem, &settings, started);
-                Ok(EngineRun {
-                    dt,
-                    steps: r.steps,
-                    wall_time: r.wall_time,
-                    diagnostics: serde_json::json!({
-                        "steps": r.steps,
-                        "max_joint_drift": r.max_joint_drift,
-                        "max_tilt": r.max_tilt,
-                        "rest_loads": r.rest_loads,
-                        "mu": r.mu,
-                        "loads": r.loads,
-                    }),
-                    trajectory: r.trajectory,
-                    contact: r.contact,
+            use pushval_engine::EngineRun;
+            pushval_engine::on_first_push(problem, move |problem| {
+                let problem = problem.clone();
+                // Avian's world is a Bevy `App`, which is not `Send`: it
+                // stays on the session's own thread.
+                pushval_engine::on_thread(move || {
+                    let started = std::time::Instant::now();
+                    let stepping = crate::world3d::start(&problem, &settings)?;
+                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
+                        let r = crate::world3d::finish(w, stepped, problem, &settings, started);
+                        Ok(EngineRun {
+                            dt,
+                            steps: r.steps,
+                            wall_time: r.wall_time,
+                            diagnostics: serde_json::json!({
+                                "steps": r.steps,
+                                "max_joint_drift": r.max_joint_drift,
+                                "max_tilt": r.max_tilt,
+                                "rest_loads": r.rest_loads,
+                                "mu": r.mu,
+                                "loads": r.loads,
+                            }),
+                            trajectory: r.trajectory,
+                            contact: r.contact,
+                        })
+                    });
+                    Ok(Box::new(PlateSession::new(stepping, finish))
+                        as Box<dyn pushval_engine::EngineSession>)
                 })
-            });
-            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+            })
         }
         #[cfg(not(feature = "avian"))]
         {
-            let _ = (problem, started);
-            Some(Err(crate::unavailable()))
+            let _ = problem;
+            Err(crate::unavailable())
         }
     }
 }

@@ -235,7 +235,7 @@ impl PlateWorld for World2d {
     }
 
     /// The segment's steps in whole ticks (see [`Clock`]).
-    fn segment_steps(&mut self, push: &Push, _n: usize, _h: f64, _: bool) -> Option<StepLayout> {
+    fn segment_steps(&mut self, push: &Push, _n: usize, _h: f64) -> Option<StepLayout> {
         let c = self.clock;
         let (a, b) = (c.ticks(self.t_seg), c.ticks(self.t_seg + push.duration));
         self.spans = c.steps(a, b, push.duration, self.dt);
@@ -368,10 +368,6 @@ pub(crate) fn finish(
 /// [`finish`].
 pub(crate) fn run(problem: &Problem, s: &Avian2dSettings) -> Result<Avian2dRun, ModelError> {
     let started = Instant::now();
-    let mut stepping = start(problem, s)?;
-    for push in &problem.pushes {
-        stepping.advance(push)?;
-    }
-    let (world, run, applied) = stepping.finish();
+    let (world, run, applied) = start(problem, s)?.run(&problem.pushes)?;
     Ok(finish(&world, run, &applied, s, started))
 }

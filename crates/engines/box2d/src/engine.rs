@@ -4,8 +4,8 @@
 
 use pushval_engine::stepping::{PlateFinish, PlateSession};
 use pushval_engine::{
-    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
-    FrictionLaw, ModelEntry, OptionError, OptionKeys, COULOMB,
+    on_first_push, on_thread, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun,
+    EngineSession, FrictionLaw, ModelEntry, OptionError, OptionKeys, Session, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -134,46 +134,38 @@ impl Engine for Box2dModel {
             Friction::MotorJoint => Some(&Box2dMotorJoint),
         }
     }
-    /// [`run_via_session`]: the world of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The Box2D world through the shared stepping loop
-    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
-    /// with the first push of `problem`'s schedule.
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let started = std::time::Instant::now();
+    /// ([`pushval_engine::stepping`]), on a thread the session owns (the
+    /// Box2D world is a handle into a C library's memory: it stays on the
+    /// thread that created it); an object not starting at rest starts with
+    /// the first push applied.
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let sim = Box2dSimulator::new(Box2dSettings {
             dt,
             ..self.settings
         });
-        let stepping = match sim
-            .settings
-            .check()
-            .and_then(|()| crate::world::start(problem, &sim.settings))
-        {
-            Ok(s) => s,
-            Err(e) => return Some(Err(e)),
-        };
-        let finish: PlateFinish<'a, _> = Box::new(move |world, stepped, problem| {
-            let r = sim.box2d_run(problem, crate::world::raw_run(world, &stepped), started);
-            Ok(EngineRun {
-                contact: None,
-                dt,
-                steps: r.steps,
-                wall_time: r.wall_time,
-                diagnostics: serde_json::json!({
-                    "max_joint_drift": r.max_joint_drift,
-                    "steps": r.steps,
-                }),
-                trajectory: r.trajectory,
+        sim.settings.check()?;
+        on_first_push(problem, move |problem| {
+            let problem = problem.clone();
+            on_thread(move || {
+                let started = std::time::Instant::now();
+                let stepping = crate::world::start(&problem, &sim.settings)?;
+                let finish: PlateFinish<_> = Box::new(move |world, stepped, problem| {
+                    let r = sim.box2d_run(problem, crate::world::raw_run(world, &stepped), started);
+                    Ok(EngineRun {
+                        contact: None,
+                        dt,
+                        steps: r.steps,
+                        wall_time: r.wall_time,
+                        diagnostics: serde_json::json!({
+                            "max_joint_drift": r.max_joint_drift,
+                            "steps": r.steps,
+                        }),
+                        trajectory: r.trajectory,
+                    })
+                });
+                Ok(Box::new(PlateSession::new(stepping, finish)) as Box<dyn EngineSession>)
             })
-        });
-        Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+        })
     }
 }

@@ -204,11 +204,7 @@ impl Box2dSimulator {
         let start = std::time::Instant::now();
         problem.check()?;
         self.settings.check()?;
-        let mut stepping = world::start(problem, &self.settings)?;
-        for push in &problem.pushes {
-            stepping.advance(push)?;
-        }
-        let (w, stepped, _) = stepping.finish();
+        let (w, stepped, _) = world::start(problem, &self.settings)?.run(&problem.pushes)?;
         Ok(self.box2d_run(problem, world::raw_run(w, &stepped), start))
     }
 

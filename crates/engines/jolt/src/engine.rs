@@ -4,8 +4,8 @@
 //! listed but not available.
 
 use pushval_engine::{
-    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
-    FrictionLaw, ModelEntry, OptionError, OptionKeys,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys, Session,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -125,51 +125,45 @@ impl Engine for JoltModel {
             "label": s.label(),
         })
     }
-    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The scene, settled, through the shared stepping loop
     /// ([`pushval_engine::stepping`]); an object not starting at rest starts
-    /// with the first push of `problem`'s schedule. Without the `jolt`
+    /// with the first push applied. Without the `jolt`
     /// feature: [`ModelError::Integration`] with [`crate::UNAVAILABLE`].
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let started = std::time::Instant::now();
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let settings = JoltSettings {
             dt,
             ..self.settings
         };
-        if let Err(e) = settings.check() {
-            return Some(Err(e));
-        }
+        settings.check()?;
         #[cfg(feature = "jolt")]
         {
             use pushval_engine::stepping::{PlateFinish, PlateSession};
-            let stepping = match crate::world::start(problem, &settings) {
-                Ok(s) => s,
-                Err(e) => return Some(Err(e)),
-            };
-            let name = settings.scene.model_name().to_string();
-            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
-                let mut r = crate::world::finish(w, stepped, problem, &settings);
-                r.trajectory.model = name;
-                r.wall_time = started.elapsed();
-                Ok(engine_run(r, dt))
-            });
-            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+            pushval_engine::on_first_push(problem, move |problem| {
+                let problem = problem.clone();
+                // Jolt's world is raw pointers into the C API (joltc): it
+                // stays on the session's own thread.
+                pushval_engine::on_thread(move || {
+                    let started = std::time::Instant::now();
+                    let stepping = crate::world::start(&problem, &settings)?;
+                    let name = settings.scene.model_name().to_string();
+                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
+                        let mut r = crate::world::finish(w, stepped, problem, &settings);
+                        r.trajectory.model = name;
+                        r.wall_time = started.elapsed();
+                        Ok(engine_run(r, dt))
+                    });
+                    Ok(Box::new(PlateSession::new(stepping, finish))
+                        as Box<dyn pushval_engine::EngineSession>)
+                })
+            })
         }
         #[cfg(not(feature = "jolt"))]
         {
-            let _ = (problem, started);
-            Some(Err(ModelError::Integration {
+            let _ = problem;
+            Err(ModelError::Integration {
                 t: 0.0,
                 reason: crate::UNAVAILABLE.into(),
-            }))
+            })
         }
     }
 }

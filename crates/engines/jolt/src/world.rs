@@ -422,11 +422,7 @@ pub(crate) fn finish(w: Stepper, run: Stepped, problem: &Problem, s: &JoltSettin
 /// Runs the problem in Jolt (checked by the caller): [`start`], one push at
 /// a time, [`finish`].
 pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, ModelError> {
-    let mut stepping = start(problem, s)?;
-    for push in &problem.pushes {
-        stepping.advance(push)?;
-    }
-    let (w, run, applied) = stepping.finish();
+    let (w, run, applied) = start(problem, s)?.run(&problem.pushes)?;
     Ok(finish(w, run, &applied, s))
 }
 

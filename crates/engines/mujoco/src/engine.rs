@@ -4,8 +4,8 @@
 //! available.
 
 use pushval_engine::{
-    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
-    FrictionLaw, ModelEntry, OptionError, OptionKeys,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys, Session,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -125,49 +125,37 @@ impl Engine for MujocoModel {
             Cone::Pyramidal => None,
         }
     }
-    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The scene, settled and calibrated, through the shared stepping loop
     /// ([`pushval_engine::stepping`]); an object not starting at rest starts
-    /// with the first push of `problem`'s schedule. Without the `mujoco`
-    /// feature: [`ModelError::Integration`] with [`crate::UNAVAILABLE`].
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let started = std::time::Instant::now();
+    /// with the first push applied. Without the `mujoco` feature:
+    /// [`ModelError::Integration`] with [`crate::UNAVAILABLE`].
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let settings = MujocoSettings {
             timestep: dt,
             ..self.settings
         };
-        if let Err(e) = settings.check() {
-            return Some(Err(e));
-        }
+        settings.check()?;
         #[cfg(feature = "mujoco")]
         {
             use pushval_engine::stepping::{PlateFinish, PlateSession};
-            let stepping = match crate::sim::start(problem, &settings) {
-                Ok(s) => s,
-                Err(e) => return Some(Err(e)),
-            };
-            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
-                let mut r = crate::sim::finish(w, stepped, problem, &settings, started);
-                r.trajectory.model = format!("mujoco_{}", settings.cone.as_str());
-                Ok(engine_run(r, dt))
-            });
-            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+            pushval_engine::on_first_push(problem, move |problem| {
+                let started = std::time::Instant::now();
+                let stepping = crate::sim::start(problem, &settings)?;
+                let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
+                    let mut r = crate::sim::finish(w, stepped, problem, &settings, started);
+                    r.trajectory.model = format!("mujoco_{}", settings.cone.as_str());
+                    Ok(engine_run(r, dt))
+                });
+                Ok(Box::new(PlateSession::new(stepping, finish)) as Session)
+            })
         }
         #[cfg(not(feature = "mujoco"))]
         {
-            let _ = (problem, started);
-            Some(Err(ModelError::Integration {
+            let _ = problem;
+            Err(ModelError::Integration {
                 t: 0.0,
                 reason: crate::UNAVAILABLE.into(),
-            }))
+            })
         }
     }
 }

@@ -153,26 +153,34 @@ pub(crate) fn start(
     // 2. The start: the only time the object's state is written.
     let init = problem.initial;
     let s0 = read(&data);
-    let first = *problem.pushes.first().ok_or(ModelError::EmptySchedule)?;
+    // Moving with the first push (the first push applied: the session is
+    // started at it), or at rest with the carriage at rest (every step sets
+    // the carriage's velocity before it is taken).
+    let first = if init.from_rest {
+        None
+    } else {
+        Some(*problem.pushes.first().ok_or(ModelError::EmptySchedule)?)
+    };
     let command = |yaw: f64, push: &pushval_model::Push| -> [f64; 2] {
         let v = pushval_model::rotate(yaw, &push.velocity());
         [v.x, v.y]
     };
     {
         let yaw = s0.yaw;
-        let (lin, w) = if init.from_rest {
-            ([0.0, 0.0], 0.0)
-        } else {
-            let vc = first.velocity();
-            let local =
-                pushval_model::Vec2::new(vc.x + init.omega * pc.y, vc.y - init.omega * pc.x);
-            let v = pushval_model::rotate(yaw, &local);
-            ([v.x, v.y], init.omega)
+        let (lin, w) = match &first {
+            None => ([0.0, 0.0], 0.0),
+            Some(first) => {
+                let vc = first.velocity();
+                let local =
+                    pushval_model::Vec2::new(vc.x + init.omega * pc.y, vc.y - init.omega * pc.x);
+                let v = pushval_model::rotate(yaw, &local);
+                ([v.x, v.y], init.omega)
+            }
         };
         let mat = s0.mat;
         // ω_local = Rᵀ (0, 0, w)
         let wl = [mat[6] * w, mat[7] * w, mat[8] * w];
-        let c = command(yaw, &first);
+        let c = first.map_or([0.0, 0.0], |p| command(yaw, &p));
         let qv = data.qvel_mut();
         qv[0] = lin[0];
         qv[1] = lin[1];
@@ -271,11 +279,7 @@ pub(crate) fn finish(
 /// scene): [`start`], one push at a time, [`finish`].
 pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<MujocoRun, ModelError> {
     let started = Instant::now();
-    let mut stepping = start(problem, settings)?;
-    for push in &problem.pushes {
-        stepping.advance(push)?;
-    }
-    let (w, run, applied) = stepping.finish();
+    let (w, run, applied) = start(problem, settings)?.run(&problem.pushes)?;
     Ok(finish(w, run, &applied, settings, started))
 }
 

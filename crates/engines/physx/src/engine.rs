@@ -4,8 +4,8 @@
 //! `physx` feature they are listed but not available.
 
 use pushval_engine::{
-    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
-    FrictionLaw, ModelEntry, OptionError, OptionKeys,
+    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
+    OptionError, OptionKeys, Session,
 };
 use pushval_model::{ModelError, Problem};
 
@@ -138,52 +138,48 @@ impl Engine for PhysxModel {
             "label": s.label(),
         })
     }
-    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The scene, settled, through the shared stepping loop
     /// ([`pushval_engine::stepping`]); an object not starting at rest starts
-    /// with the first push of `problem`'s schedule. The session holds
+    /// with the first push applied. The session holds
     /// PhysX's turn (one foundation per process) until it ends. Without the
     /// `physx` feature: [`ModelError::Integration`] with
     /// [`crate::UNAVAILABLE`].
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let started = std::time::Instant::now();
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let settings = PhysxSettings {
             dt,
             ..self.settings
         };
-        if let Err(e) = settings.check() {
-            return Some(Err(e));
-        }
+        settings.check()?;
         #[cfg(feature = "physx")]
         {
             use pushval_engine::stepping::{PlateFinish, PlateSession};
-            let stepping = match crate::world::start(problem, &settings) {
-                Ok(s) => s,
-                Err(e) => return Some(Err(e)),
-            };
-            let finish: PlateFinish<'a, _> = Box::new(move |w, stepped, problem| {
-                let mut r = crate::world::finish(w, stepped, problem, &settings);
-                r.trajectory.model = settings.friction.model_name().to_string();
-                r.wall_time = started.elapsed();
-                Ok(engine_run(r, dt))
-            });
-            Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+            pushval_engine::on_first_push(problem, move |problem| {
+                let problem = problem.clone();
+                // PhysX's objects are raw pointers into the SDK, and the
+                // session holds PhysX's turn (a `MutexGuard`, released on
+                // the thread that took it): the world stays on the
+                // session's own thread.
+                pushval_engine::on_thread(move || {
+                    let started = std::time::Instant::now();
+                    let stepping = crate::world::start(&problem, &settings)?;
+                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
+                        let mut r = crate::world::finish(w, stepped, problem, &settings);
+                        r.trajectory.model = settings.friction.model_name().to_string();
+                        r.wall_time = started.elapsed();
+                        Ok(engine_run(r, dt))
+                    });
+                    Ok(Box::new(PlateSession::new(stepping, finish))
+                        as Box<dyn pushval_engine::EngineSession>)
+                })
+            })
         }
         #[cfg(not(feature = "physx"))]
         {
-            let _ = (problem, started);
-            Some(Err(ModelError::Integration {
+            let _ = problem;
+            Err(ModelError::Integration {
                 t: 0.0,
                 reason: crate::UNAVAILABLE.into(),
-            }))
+            })
         }
     }
 }

@@ -5,8 +5,8 @@ use std::time::Instant;
 
 use pushval_engine::stepping::{PlateSession, PlateWorld, Stepped, Stepping};
 use pushval_engine::{
-    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
-    FrictionLaw, ModelEntry, OptionError, OptionKeys, COULOMB,
+    on_first_push, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw,
+    ModelEntry, OptionError, OptionKeys, Session, COULOMB,
 };
 use pushval_laws::idioms::{
     ImpulseBox, ImpulseDisk, RegularisedLinear, RegularisedTanh, RowsDisk, DEFAULT_SLIP_SPEED,
@@ -232,71 +232,61 @@ impl Engine for Rapier2dModel {
             _ => Some(&self.settings.friction_model),
         }
     }
-    /// [`run_via_session`]: the world of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The rapier world through the shared stepping loop
-    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
-    /// with the first push of `problem`'s schedule, and in leapfrog mode a
-    /// segment closes with a half kick when that schedule has a push after
-    /// it.
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let start = Instant::now();
+    /// ([`pushval_engine::stepping`]), owned by the session; an object not
+    /// starting at rest starts with the first push applied, and in leapfrog
+    /// mode every segment closes with a half kick.
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let sim = RapierSimulator::new(EngineSettings {
             dt,
             ..self.settings
         });
-        if let Err(e) = sim.settings.check() {
-            return Some(Err(e));
-        }
-        Some(match sim.settings.precision {
-            Precision::F64 => crate::f64_engine::world::start(problem, &sim.settings, &[])
-                .map(|s| self.session_of(sim, s, crate::f64_engine::world::raw_run, start)),
-            Precision::F32 => crate::f32_engine::world::start(problem, &sim.settings, &[])
-                .map(|s| self.session_of(sim, s, crate::f32_engine::world::raw_run, start)),
+        sim.settings.check()?;
+        let name = self.info.name.clone();
+        on_first_push(problem, move |problem| {
+            let start = Instant::now();
+            match sim.settings.precision {
+                Precision::F64 => crate::f64_engine::world::start(problem, &sim.settings, &[])
+                    .map(|s| session_of(name, sim, s, crate::f64_engine::world::raw_run, start)),
+                Precision::F32 => crate::f32_engine::world::start(problem, &sim.settings, &[])
+                    .map(|s| session_of(name, sim, s, crate::f32_engine::world::raw_run, start)),
+            }
         })
     }
 }
 
-impl Rapier2dModel {
-    /// The session over `stepping`, whose world `raw` reads once it is done.
-    fn session_of<'a, W>(
-        &'a self,
-        sim: RapierSimulator,
-        stepping: Stepping<W>,
-        raw: fn(W, &Stepped) -> RawRun,
-        start: Instant,
-    ) -> Box<dyn EngineSession + 'a>
-    where
-        W: PlateWorld + 'a,
-        W::State: 'a,
-    {
-        Box::new(PlateSession::new(
-            stepping,
-            Box::new(move |world, stepped, problem| {
-                let r = sim.rapier_run(problem, raw(world, &stepped), start);
-                let mut trajectory = r.trajectory;
-                trajectory.model = self.info.name.clone();
-                Ok(EngineRun {
-                    contact: None,
-                    trajectory,
-                    dt: sim.settings.dt,
-                    steps: r.steps,
-                    wall_time: start.elapsed(),
-                    diagnostics: serde_json::json!({
-                        "max_joint_drift": r.max_joint_drift,
-                        "steps": r.steps,
-                    }),
-                })
-            }),
-        ))
-    }
+/// The session over `stepping`, whose world `raw` reads once it is done;
+/// the run is named `name`.
+fn session_of<W>(
+    name: String,
+    sim: RapierSimulator,
+    stepping: Stepping<W>,
+    raw: fn(W, &Stepped) -> RawRun,
+    start: Instant,
+) -> Session
+where
+    W: PlateWorld + Send + 'static,
+    W::State: Send,
+{
+    Box::new(PlateSession::new(
+        stepping,
+        Box::new(move |world, stepped, problem| {
+            let r = sim.rapier_run(problem, raw(world, &stepped), start);
+            let mut trajectory = r.trajectory;
+            trajectory.model = name;
+            Ok(EngineRun {
+                contact: None,
+                trajectory,
+                dt: sim.settings.dt,
+                steps: r.steps,
+                wall_time: start.elapsed(),
+                diagnostics: serde_json::json!({
+                    "max_joint_drift": r.max_joint_drift,
+                    "steps": r.steps,
+                }),
+            })
+        }),
+    ))
 }
 
 /// The idioms' laws by name, with the idioms' default slip speed: the

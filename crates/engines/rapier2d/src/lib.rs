@@ -117,11 +117,14 @@ pub enum FrictionVelocity {
     ///   body moves with exactly the velocity the joint solved for (the bias
     ///   would otherwise push it off the chord by `h ω² p_c / 2`);
     /// * each segment opens with a half kick (the first full step after the
-    ///   switch step applies half the friction impulse) and, when a switch
-    ///   follows, closes with one (an extra step of the switch-step length,
-    ///   taken off the last step, with the pusher velocity at the switch
-    ///   and the friction impulse of half a step), so the switch impulse
-    ///   acts on the velocity at the switch, not on a mid-step one.
+    ///   switch step applies half the friction impulse) and closes with one
+    ///   (an extra step of the switch-step length, taken off the last step,
+    ///   with the pusher velocity at the segment's end and the friction
+    ///   impulse of half a step), so a switch impulse acts on the velocity
+    ///   at the switch, not on a mid-step one, and the state a segment
+    ///   leaves holds the velocity at its end time. Every segment closes,
+    ///   whether or not a push follows: a segment's steps depend on its
+    ///   push alone.
     ///
     /// Requires `switch_step_fraction > 0` for the closing half kick. The
     /// joint still produces every switch and start impulse: ω is never set.
@@ -177,9 +180,9 @@ pub struct EngineSettings {
     /// full step are evaluated; that step's length is taken off the next one,
     /// so steps still land on the switch times. `0` turns this off (the
     /// friction of the first step then sees the angular velocity from before
-    /// the switch). In [`FrictionVelocity::Leapfrog`] mode a segment that
-    /// is followed by a switch also ends with a closing step of the same
-    /// length (taken off the step before it). Dimensionless, in `[0, 0.5)`;
+    /// the switch). In [`FrictionVelocity::Leapfrog`] mode every segment
+    /// also ends with a closing step of the same length (taken off the step
+    /// before it). Dimensionless, in `[0, 0.5)`;
     /// default `1e-3`.
     pub switch_step_fraction: f64,
     /// The support-friction law; default [`FrictionModel::Coulomb`] (the
@@ -327,19 +330,15 @@ impl RapierSimulator {
         self.settings.check()?;
         let raw = match self.settings.precision {
             Precision::F64 => {
-                let mut s = f64_engine::world::start(problem, &self.settings, outline)?;
-                for push in &problem.pushes {
-                    s.advance(push)?;
-                }
-                let (world, stepped, _) = s.finish();
+                let (world, stepped, _) =
+                    f64_engine::world::start(problem, &self.settings, outline)?
+                        .run(&problem.pushes)?;
                 f64_engine::world::raw_run(world, &stepped)
             }
             Precision::F32 => {
-                let mut s = f32_engine::world::start(problem, &self.settings, outline)?;
-                for push in &problem.pushes {
-                    s.advance(push)?;
-                }
-                let (world, stepped, _) = s.finish();
+                let (world, stepped, _) =
+                    f32_engine::world::start(problem, &self.settings, outline)?
+                        .run(&problem.pushes)?;
                 f32_engine::world::raw_run(world, &stepped)
             }
         };

@@ -108,7 +108,7 @@ pub(crate) struct World2d {
     /// nominal step).
     law: LawContext,
     /// Whether the segment ends with a closing step (leapfrog, a switch
-    /// follows).
+    /// step length above zero).
     closing: bool,
     /// The segment's switch-step length (s).
     eps: f64,
@@ -128,7 +128,8 @@ pub(crate) struct World2d {
 /// Builds the world of `problem` in this precision's rapier build and hands
 /// it to the shared loop; `outline` is the object's outline for its collider
 /// (see `RapierSimulator::run_with_outline`). An object not starting at rest
-/// starts with the first push of `problem`'s schedule.
+/// starts with the first push of `problem`'s schedule (the first push
+/// applied: see `pushval_engine::on_first_push`).
 pub(crate) fn start(
     problem: &Problem,
     settings: &EngineSettings,
@@ -277,19 +278,14 @@ impl PlateWorld for World2d {
     }
 
     /// An optional switch step, then `n` steps whose first one is shortened
-    /// by the switch step's length. In leapfrog mode, a segment followed by
-    /// a switch also ends with a closing step of the same length, taken off
-    /// the step before it.
-    fn segment_steps(
-        &mut self,
-        _push: &Push,
-        n: usize,
-        h: f64,
-        followed: bool,
-    ) -> Option<StepLayout> {
+    /// by the switch step's length. In leapfrog mode every segment also ends
+    /// with a closing step of the same length, taken off the step before it,
+    /// whether or not a switch follows (the world is not told), so that
+    /// the velocity at the segment's end is the one at its end time.
+    fn segment_steps(&mut self, _push: &Push, n: usize, h: f64) -> Option<StepLayout> {
         let leapfrog = self.friction_velocity == FrictionVelocity::Leapfrog;
         let eps = self.switch_step_fraction * h;
-        let closing = leapfrog && eps > 0.0 && followed;
+        let closing = leapfrog && eps > 0.0;
         let mut lengths: Vec<f64> = Vec::with_capacity(n + 2);
         if eps > 0.0 {
             lengths.push(eps);

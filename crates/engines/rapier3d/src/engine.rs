@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use pushval_engine::stepping::{PlateFinish, PlateSession};
 use pushval_engine::{
-    run_via_session, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
-    FrictionLaw, ModelEntry, OptionError, OptionKeys,
+    on_first_push, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw,
+    ModelEntry, OptionError, OptionKeys, Session,
 };
 use pushval_model::{ModelError, Problem, Simulator};
 
@@ -119,51 +119,38 @@ impl Engine for Rapier3dModel {
             "label": s.label(),
         })
     }
-    /// [`run_via_session`]: the scene of [`Engine::session`], one push at a
-    /// time.
-    fn run(&self, problem: &Problem, dt: f64) -> Result<EngineRun, ModelError> {
-        run_via_session(self, problem, dt)
-    }
     /// The scene, settled, through the shared stepping loop
-    /// ([`pushval_engine::stepping`]); an object not starting at rest starts
-    /// with the first push of `problem`'s schedule.
-    fn session<'a>(
-        &'a self,
-        problem: &Problem,
-        dt: f64,
-    ) -> Option<Result<Box<dyn EngineSession + 'a>, ModelError>> {
-        let started = Instant::now();
+    /// ([`pushval_engine::stepping`]), owned by the session; an object not
+    /// starting at rest starts with the first push applied.
+    fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
         let sim = Rapier3dSimulator::new(Rapier3dSettings {
             dt,
             ..self.settings
         });
-        let (stepping, set_up) = match sim
-            .settings
-            .check()
-            .and_then(|()| crate::world::start(problem, &sim.settings))
-        {
-            Ok(s) => s,
-            Err(e) => return Some(Err(e)),
-        };
-        let finish: PlateFinish<'a, _> = Box::new(move |_, stepped, problem| {
-            let mut r = crate::world::finish(set_up, stepped, problem);
-            r.trajectory.model = sim.name();
-            Ok(EngineRun {
-                dt,
-                steps: r.steps,
-                wall_time: started.elapsed(),
-                diagnostics: serde_json::json!({
-                    "steps": r.steps,
-                    "max_joint_drift": r.max_joint_drift,
-                    "max_tilt": r.max_tilt,
-                    "max_lift": r.max_lift,
-                    "loads": r.loads,
-                }),
-                trajectory: r.trajectory,
-                contact: r.contact,
-            })
-        });
-        Some(Ok(Box::new(PlateSession::new(stepping, finish))))
+        sim.settings.check()?;
+        on_first_push(problem, move |problem| {
+            let started = Instant::now();
+            let (stepping, set_up) = crate::world::start(problem, &sim.settings)?;
+            let finish: PlateFinish<_> = Box::new(move |_, stepped, problem| {
+                let mut r = crate::world::finish(set_up, stepped, problem);
+                r.trajectory.model = sim.name();
+                Ok(EngineRun {
+                    dt,
+                    steps: r.steps,
+                    wall_time: started.elapsed(),
+                    diagnostics: serde_json::json!({
+                        "steps": r.steps,
+                        "max_joint_drift": r.max_joint_drift,
+                        "max_tilt": r.max_tilt,
+                        "max_lift": r.max_lift,
+                        "loads": r.loads,
+                    }),
+                    trajectory: r.trajectory,
+                    contact: r.contact,
+                })
+            });
+            Ok(Box::new(PlateSession::new(stepping, finish)) as Session)
+        })
     }
 }
 

@@ -206,11 +206,8 @@ pub(crate) struct SetUp {
 
 /// Runs the problem.
 pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier3dRun, ModelError> {
-    let (mut stepping, set_up) = start(problem, s)?;
-    for push in &problem.pushes {
-        stepping.advance(push)?;
-    }
-    let (_, run, problem) = stepping.finish();
+    let (stepping, set_up) = start(problem, s)?;
+    let (_, run, problem) = stepping.run(&problem.pushes)?;
     Ok(finish(set_up, run, &problem))
 }
 
