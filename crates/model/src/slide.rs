@@ -223,6 +223,11 @@ struct Plate<'b> {
     mass: f64,
     inertia: f64,
     rho: f64,
+    /// 1/m, 1/ρ and ρ/I: the right-hand side multiplies (a division would
+    /// sit on the stages' serial chain).
+    inv_mass: f64,
+    inv_rho: f64,
+    rho_over_inertia: f64,
 }
 
 /// A pivot about one support at one ω: its deceleration and reaction.
@@ -246,13 +251,17 @@ impl PivotDyn {
 impl<'b> Plate<'b> {
     fn new(body: &'b Body) -> Self {
         let (sx, sy, f) = body.arrays();
+        let rho = (body.inertia_cm() / body.mass()).sqrt();
         Self {
             sx,
             sy,
             f,
             mass: body.mass(),
             inertia: body.inertia_cm(),
-            rho: (body.inertia_cm() / body.mass()).sqrt(),
+            rho,
+            inv_mass: 1.0 / body.mass(),
+            inv_rho: 1.0 / rho,
+            rho_over_inertia: rho / body.inertia_cm(),
         }
     }
 
@@ -260,7 +269,7 @@ impl<'b> Plate<'b> {
     #[inline]
     fn rhs(&self, y: &Y) -> Y {
         let (vx, vy) = (y[VX], y[VY]);
-        let w = y[W] / self.rho;
+        let w = y[W] * self.inv_rho;
         let (mut fx, mut fy, mut mz, mut p) = (0.0, 0.0, 0.0, 0.0);
         for i in 0..self.f.len() {
             let (rx, ry) = (self.sx[i], self.sy[i]);
@@ -282,9 +291,9 @@ impl<'b> Plate<'b> {
         let g = self.mass * s2 / p;
         let (ex, ey) = (y[EX], y[EY]);
         [
-            g * (-fx / self.mass + w * vy),
-            g * (-fy / self.mass - w * vx),
-            -g * self.rho * mz / self.inertia,
+            g * (w * vy - fx * self.inv_mass),
+            g * (-fy * self.inv_mass - w * vx),
+            -g * self.rho_over_inertia * mz,
             g,
             g * w,
             g * (ex * vx - ey * vy),
