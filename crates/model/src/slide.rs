@@ -715,17 +715,38 @@ impl Run<'_, '_, '_> {
                 }
                 let du = plate.slip(i, &k1);
                 let dd = du.norm_squared();
-                if dd == 0.0 {
-                    continue;
-                }
-                let delta = -u.dot(&du) / dd;
-                // Only a support heading for zero within the next steps.
-                if delta <= 0.0 || delta > 3.0 * h || (u + du * delta).norm() > 0.5 * u.norm() {
-                    continue;
-                }
+                let delta = if dd > 0.0 { -u.dot(&du) / dd } else { 0.0 };
+                // Where the support can stick, the true motion stops its
+                // slip within τ ≈ |uᵢ| / (margin fᵢ/m) (margin = 1 − |R|/fᵢ,
+                // the share of the cone left), moving the pose by about
+                // |uᵢ| τ: once that is below a hundredth of the tolerance the
+                // support is stuck at once, by the impulse that stops it
+                // ([`Run::pivot`]). Near the cone's edge the approach is
+                // slow and stiff (the slip's direction relaxes far faster
+                // than it shrinks) and would otherwise hover at the
+                // integration's resolution.
+                let stick_now = |ratio: f64| {
+                    let margin = 1.0 - ratio;
+                    margin > 0.0
+                        && u.norm_squared() * plate.mass <= 1e-2 * tol * margin * plate.f[i]
+                };
+                // Otherwise only a support heading for zero within the next
+                // steps.
                 let omega = y[W] / plate.rho;
+                let heading =
+                    delta > 0.0 && delta <= 3.0 * h && (u + du * delta).norm() <= 0.5 * u.norm();
+                if !heading && rel > 1e-3 {
+                    continue;
+                }
                 let pd = plate.pivot(i, omega);
-                if pd.reaction(plate.mass, omega).norm() > pd.cap {
+                let ratio = pd.reaction(plate.mass, omega).norm() / pd.cap;
+                if ratio > 1.0 {
+                    continue;
+                }
+                if stick_now(ratio) {
+                    return Ok(Phase::Pivot(i, y));
+                }
+                if !heading {
                     continue;
                 }
                 if delta <= snap {
@@ -758,12 +779,27 @@ impl Run<'_, '_, '_> {
     fn pivot(&mut self, i: usize, y: Y) -> (PivotEnd, SlideState) {
         let plate = self.plate;
         let st0 = plate.state_of(&y);
-        let (t0, w0, th0) = (st0.t, st0.omega, st0.theta);
+        // The support's residual slip u (object frame) is stopped by the
+        // impulse J that stops it in the rigid body, J = −W⁻¹ u with the
+        // support's mobility W = 1/m + (D r)(D r)ᵀ/I: ω changes by r × J / I
+        // and the velocity follows from the pivot.
+        let r = Vec2::new(plate.sx[i], plate.sy[i]);
+        let u = plate.slip(i, &y);
+        let dr = crate::perp(&r);
+        let (im, ii) = (plate.inv_mass, 1.0 / plate.inertia);
+        let (w11, w12, w22) = (
+            im + dr.x * dr.x * ii,
+            dr.x * dr.y * ii,
+            im + dr.y * dr.y * ii,
+        );
+        let det = w11 * w22 - w12 * w12;
+        let j = -Vec2::new(w22 * u.x - w12 * u.y, -w12 * u.x + w11 * u.y) / det;
+        let w0 = st0.omega + crate::cross(&r, &j) * ii;
+        let (t0, th0) = (st0.t, st0.theta);
         let pd = plate.pivot(i, w0);
         let sgn = w0.signum();
         // The pivot's world position: the centre of mass plus R(θ) rᵢ.
         let (sn, cs) = th0.sin_cos();
-        let r = pd.r;
         let p = Vec2::new(st0.x, st0.y) + Vec2::new(cs * r.x - sn * r.y, sn * r.x + cs * r.y);
         let t_rest = if pd.alpha > 0.0 {
             w0.abs() / pd.alpha
