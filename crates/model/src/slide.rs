@@ -223,6 +223,11 @@ struct Plate<'b> {
     mass: f64,
     inertia: f64,
     rho: f64,
+    /// 1/m, 1/ρ and ρ/I: the right-hand side multiplies (a division would
+    /// sit on the stages' serial chain).
+    inv_mass: f64,
+    inv_rho: f64,
+    rho_over_inertia: f64,
 }
 
 /// A pivot about one support at one ω: its deceleration and reaction.
@@ -246,13 +251,17 @@ impl PivotDyn {
 impl<'b> Plate<'b> {
     fn new(body: &'b Body) -> Self {
         let (sx, sy, f) = body.arrays();
+        let rho = (body.inertia_cm() / body.mass()).sqrt();
         Self {
             sx,
             sy,
             f,
             mass: body.mass(),
             inertia: body.inertia_cm(),
-            rho: (body.inertia_cm() / body.mass()).sqrt(),
+            rho,
+            inv_mass: 1.0 / body.mass(),
+            inv_rho: 1.0 / rho,
+            rho_over_inertia: rho / body.inertia_cm(),
         }
     }
 
@@ -260,7 +269,7 @@ impl<'b> Plate<'b> {
     #[inline]
     fn rhs(&self, y: &Y) -> Y {
         let (vx, vy) = (y[VX], y[VY]);
-        let w = y[W] / self.rho;
+        let w = y[W] * self.inv_rho;
         let (mut fx, mut fy, mut mz, mut p) = (0.0, 0.0, 0.0, 0.0);
         for i in 0..self.f.len() {
             let (rx, ry) = (self.sx[i], self.sy[i]);
@@ -282,9 +291,9 @@ impl<'b> Plate<'b> {
         let g = self.mass * s2 / p;
         let (ex, ey) = (y[EX], y[EY]);
         [
-            g * (-fx / self.mass + w * vy),
-            g * (-fy / self.mass - w * vx),
-            -g * self.rho * mz / self.inertia,
+            g * (w * vy - fx * self.inv_mass),
+            g * (-fy * self.inv_mass - w * vx),
+            -g * self.rho_over_inertia * mz,
             g,
             g * w,
             g * (ex * vx - ey * vy),
@@ -706,17 +715,38 @@ impl Run<'_, '_, '_> {
                 }
                 let du = plate.slip(i, &k1);
                 let dd = du.norm_squared();
-                if dd == 0.0 {
-                    continue;
-                }
-                let delta = -u.dot(&du) / dd;
-                // Only a support heading for zero within the next steps.
-                if delta <= 0.0 || delta > 3.0 * h || (u + du * delta).norm() > 0.5 * u.norm() {
-                    continue;
-                }
+                let delta = if dd > 0.0 { -u.dot(&du) / dd } else { 0.0 };
+                // Where the support can stick, the true motion stops its
+                // slip within τ ≈ |uᵢ| / (margin fᵢ/m) (margin = 1 − |R|/fᵢ,
+                // the share of the cone left), moving the pose by about
+                // |uᵢ| τ: once that is below a hundredth of the tolerance the
+                // support is stuck at once, by the impulse that stops it
+                // ([`Run::pivot`]). Near the cone's edge the approach is
+                // slow and stiff (the slip's direction relaxes far faster
+                // than it shrinks) and would otherwise hover at the
+                // integration's resolution.
+                let stick_now = |ratio: f64| {
+                    let margin = 1.0 - ratio;
+                    margin > 0.0
+                        && u.norm_squared() * plate.mass <= 1e-2 * tol * margin * plate.f[i]
+                };
+                // Otherwise only a support heading for zero within the next
+                // steps.
                 let omega = y[W] / plate.rho;
+                let heading =
+                    delta > 0.0 && delta <= 3.0 * h && (u + du * delta).norm() <= 0.5 * u.norm();
+                if !heading && rel > 1e-3 {
+                    continue;
+                }
                 let pd = plate.pivot(i, omega);
-                if pd.reaction(plate.mass, omega).norm() > pd.cap {
+                let ratio = pd.reaction(plate.mass, omega).norm() / pd.cap;
+                if ratio > 1.0 {
+                    continue;
+                }
+                if stick_now(ratio) {
+                    return Ok(Phase::Pivot(i, y));
+                }
+                if !heading {
                     continue;
                 }
                 if delta <= snap {
@@ -749,12 +779,27 @@ impl Run<'_, '_, '_> {
     fn pivot(&mut self, i: usize, y: Y) -> (PivotEnd, SlideState) {
         let plate = self.plate;
         let st0 = plate.state_of(&y);
-        let (t0, w0, th0) = (st0.t, st0.omega, st0.theta);
+        // The support's residual slip u (object frame) is stopped by the
+        // impulse J that stops it in the rigid body, J = −W⁻¹ u with the
+        // support's mobility W = 1/m + (D r)(D r)ᵀ/I: ω changes by r × J / I
+        // and the velocity follows from the pivot.
+        let r = Vec2::new(plate.sx[i], plate.sy[i]);
+        let u = plate.slip(i, &y);
+        let dr = crate::perp(&r);
+        let (im, ii) = (plate.inv_mass, 1.0 / plate.inertia);
+        let (w11, w12, w22) = (
+            im + dr.x * dr.x * ii,
+            dr.x * dr.y * ii,
+            im + dr.y * dr.y * ii,
+        );
+        let det = w11 * w22 - w12 * w12;
+        let j = -Vec2::new(w22 * u.x - w12 * u.y, -w12 * u.x + w11 * u.y) / det;
+        let w0 = st0.omega + crate::cross(&r, &j) * ii;
+        let (t0, th0) = (st0.t, st0.theta);
         let pd = plate.pivot(i, w0);
         let sgn = w0.signum();
         // The pivot's world position: the centre of mass plus R(θ) rᵢ.
         let (sn, cs) = th0.sin_cos();
-        let r = pd.r;
         let p = Vec2::new(st0.x, st0.y) + Vec2::new(cs * r.x - sn * r.y, sn * r.x + cs * r.y);
         let t_rest = if pd.alpha > 0.0 {
             w0.abs() / pd.alpha
