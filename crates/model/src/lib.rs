@@ -52,7 +52,7 @@ pub use kappa::{kappa_exact, kappa_series, KappaSeries};
 pub use problem::{ContactLimits, Initial, Problem, Simulator, Switching};
 pub use rotor::Rotor;
 pub use trajectory::{
-    Assumptions, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel, Sample,
+    Assumptions, DynamicModel, FinalState, Integrator, KinematicModel, LimitSurfaceModel, Sample,
     SegmentReport, SolverStats, Trajectory, Violation,
 };
 

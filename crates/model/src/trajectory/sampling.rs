@@ -13,10 +13,21 @@ pub(super) struct Sampler {
 
 impl Sampler {
     pub(super) fn new(problem: &Problem) -> Self {
+        Self::at(problem.sample_times(), 1e-9 * problem.sample_dt)
+    }
+
+    /// No sample at all (allocates nothing).
+    pub(super) fn none() -> Self {
+        Self::at(Vec::new(), 0.0)
+    }
+
+    /// The sample times `times` (s, increasing); times within `eps` (s) of
+    /// a switch belong to the segment that starts there.
+    pub(super) fn at(times: Vec<f64>, eps: f64) -> Self {
         Self {
-            times: problem.sample_times(),
+            times,
             next: 0,
-            eps: 1e-9 * problem.sample_dt,
+            eps,
         }
     }
 
