@@ -465,8 +465,10 @@ impl TailCursor {
         }
     }
 
-    /// The pose at time `t` (s), `t` not before the last evaluation.
-    #[inline(always)]
+    /// The pose at time `t` (s), `t` not before the last evaluation, by
+    /// the phasors advanced as [`TailCursor::fill`] advances them (what the
+    /// tests check `fill` and [`TailCursor::end`] against).
+    #[cfg(test)]
     pub fn eval(&mut self, t: f64) -> TailPose {
         self.advance(t);
         let (mut wa, mut ba, mut ka) = (0.0, 0.0, C::new(0.0, 0.0));
@@ -476,6 +478,29 @@ impl TailCursor {
             ka = (ka + self.kappa[k]) * self.e;
         }
         self.pose(self.s, self.p, wa, ba, ka)
+    }
+
+    /// The pose at time `t` (s) from phasors taken afresh at `t`, not
+    /// advanced through the evaluations before it: a segment's end state
+    /// that does not depend on which samples were taken on the way (the
+    /// products that advance the phasors round differently for different
+    /// sample times), so a run asked for fewer samples takes the same steps.
+    pub fn end(&self, t: f64) -> TailPose {
+        let tl = &self.tail;
+        let s = t - tl.t;
+        let (sn, cs) = (tl.omega * s).sin_cos();
+        let e = if self.n == 0 {
+            0.0
+        } else {
+            (-s / tl.tau).exp()
+        };
+        let (mut wa, mut ba, mut ka) = (0.0, 0.0, C::new(0.0, 0.0));
+        for k in (0..self.n).rev() {
+            wa = (wa + self.tail.alpha[k]) * e;
+            ba = (ba + self.beta[k]) * e;
+            ka = (ka + self.kappa[k]) * e;
+        }
+        self.pose(s, C::new(cs, sn), wa, ba, ka)
     }
 
     /// Samples the tail at `times` (increasing, not before the last
@@ -846,6 +871,36 @@ mod tests {
     /// phasor steps and poses, terms cut per block), across block
     /// boundaries, for a relaxing tail and for a steady arc with ω* = 0 (the
     /// series branch of `A₀`).
+    #[test]
+    fn the_end_state_does_not_depend_on_the_samples() {
+        // A fresh cursor's `end` is its first `eval` (phasors taken at once
+        // either way); after 1,000 samples of advanced phasors the two differ
+        // by rounding only, and `end` is the same before and after them.
+        for (omega, delta) in [(-0.65, 0.2), (0.0, 0.0), (0.3, -0.05)] {
+            let tail = tail_for(0.8, -2.0, omega, delta);
+            let t1 = tail.t + 10.0;
+            let fresh = TailCursor::new(tail).end(t1);
+            let once = TailCursor::new(tail).eval(t1);
+            assert_eq!(
+                (fresh.c, fresh.theta, fresh.omega),
+                (once.c, once.theta, once.omega)
+            );
+            let mut cur = TailCursor::new(tail);
+            let times: Vec<f64> = (0..1000).map(|k| tail.t + 0.01 * k as f64).collect();
+            cur.fill(&times, Vec2::new(-0.125, -0.125), &mut Vec::new());
+            let after = cur.end(t1);
+            assert_eq!(
+                (after.c, after.theta, after.omega),
+                (fresh.c, fresh.theta, fresh.omega)
+            );
+            let advanced = cur.eval(t1);
+            assert!(
+                (advanced.c - fresh.c).norm() < 1e-12
+                    && (advanced.theta - fresh.theta).abs() < 1e-12
+            );
+        }
+    }
+
     #[test]
     fn fill_matches_eval() {
         for (omega, delta) in [(-0.65, 0.2), (0.0, 0.0), (0.3, -0.05)] {

@@ -63,7 +63,8 @@ pub(super) fn pose_sample(
 
 /// Samples a closed-form tail at the sample times due up to `t1` (the end of
 /// its segment; `last` for the last segment, which owns its end time) and
-/// returns its pose at `t1`.
+/// returns its pose at `t1`, evaluated afresh there: the same whatever
+/// samples came before.
 pub(super) fn sample_tail(
     tail: Tail,
     sampler: &mut Sampler,
@@ -80,5 +81,5 @@ pub(super) fn sample_tail(
     if sampler.next > first {
         cursor.fill(&sampler.times[first..sampler.next], pc, out);
     }
-    cursor.eval(t1)
+    cursor.end(t1)
 }
