@@ -93,14 +93,41 @@ pub(crate) fn linearising_map(
     reach: f64,
     small: f64,
 ) -> ([f64; ORDER], usize) {
+    POWERS.with_borrow_mut(|pw| linearising_map_in(pw, g, reach, small))
+}
+
+/// Columns of a row of the table of powers in [`linearising_map`]: `ORDER`
+/// and a chunk of four beyond, so chunks need no remainder.
+const ROW: usize = ORDER + 4;
+
+/// The table of `[h^j]_k` of [`linearising_map`], kept per thread instead
+/// of zeroing 4 KB per call. A call's step `k` writes row `k`, always at the
+/// same columns, before any later step reads it; the columns no step writes
+/// (all with `j > k`) keep the zeros they started as. So a call never sees
+/// another's values, and the result is the one a fresh table gives.
+type Powers = [[f64; ROW]; ORDER + 1];
+
+thread_local! {
+    static POWERS: std::cell::RefCell<Powers> = const {
+        std::cell::RefCell::new({
+            let mut pw = [[0.0; ROW]; ORDER + 1];
+            pw[1][1] = 1.0;
+            pw
+        })
+    };
+}
+
+/// [`linearising_map`] in the table `pw` (row 1 is `[h]_1 = a_1 = 1`).
+fn linearising_map_in(
+    pw: &mut Powers,
+    g: &[f64; ORDER + 1],
+    reach: f64,
+    small: f64,
+) -> ([f64; ORDER], usize) {
     let tau = -1.0 / g[1];
     let mut a = [0.0; ORDER + 1];
     a[1] = 1.0;
-    // pw[k][j] = [h^j]_k, zero for j > k (rows padded with zeros, so chunks
-    // of four need no remainder).
-    const ROW: usize = ORDER + 4;
-    let mut pw = [[0.0; ROW]; ORDER + 1];
-    pw[1][1] = 1.0;
+    // pw[k][j] = [h^j]_k, zero for j > k.
     let gp: [f64; ROW] = std::array::from_fn(|j| if j <= ORDER { g[j] } else { 0.0 });
     // reach^(k−1), kept as a running product for the stopping test.
     let mut reach_km1 = reach;
