@@ -1,4 +1,5 @@
-//! Unit tests of [`SegmentDynamics`]: the friction sum, its reuse, the roots, the transient and the Taylor series.
+//! Unit tests of [`SegmentDynamics`]: the friction sum, its reuse, the
+//! roots, the transient and the Taylor series.
 
 use super::*;
 use crate::Support;
