@@ -311,6 +311,7 @@ fn main() {
         if quick { 21 } else { 61 },
     );
     target.push_str(&short_horizon_line(root, if quick { 201 } else { 2001 }));
+    target.push_str(&load_line());
     if model_only {
         eprintln!();
         print!("{target}");
@@ -569,6 +570,24 @@ fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
         end9.stats.rhs_evals
     ));
     out
+}
+
+/// The machine's load averages (1, 5, 15 min, from `/proc/loadavg`) when
+/// the timings end, as a comment line: thread CPU time leaves out waiting,
+/// but cores shared with other work still slow every method, so the
+/// absolute medians read with it (the ratios, timed alternately, less so).
+fn load_line() -> String {
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    let avg: Vec<&str> = load.split_whitespace().take(3).collect();
+    format!(
+        "# load averages at the end of the timings (1, 5, 15 min; {} cores): {}\n",
+        std::thread::available_parallelism().map_or(0, |n| n.get()),
+        if avg.len() == 3 {
+            avg.join(", ")
+        } else {
+            "unknown".into()
+        }
+    )
 }
 
 /// Log–log work–precision figure: error against median run time, one line per
