@@ -1,7 +1,9 @@
 //! `model_short_horizon`: one dynamic-model run of the model-predictive
-//! controller's horizon (6 segments from rest, two samples, assumption checks
-//! off; `short_horizon/mod.rs`), the fixed cost every control period pays per
-//! prediction.
+//! controller's horizon (6 segments from rest, assumption checks off;
+//! `short_horizon/mod.rs`), the fixed cost every control period pays per
+//! prediction: sampled at its start and end (`model_short_horizon`), asked
+//! for the final state alone (`model_short_horizon/final_state`), and that
+//! at the predictor's tolerance (`model_short_horizon/final_state_predictor_tol`).
 //!
 //! `cargo bench --bench model_short_horizon`
 
@@ -22,6 +24,13 @@ fn model_short_horizon(c: &mut Criterion) {
     assert_eq!(tr.segments.len(), short_horizon::SEGMENTS);
     c.bench_function("model_short_horizon", |b| {
         b.iter(|| black_box(model.simulate(black_box(&problem)).unwrap()))
+    });
+    c.bench_function("model_short_horizon/final_state", |b| {
+        b.iter(|| black_box(model.final_state(black_box(&problem)).unwrap()))
+    });
+    let predictor = short_horizon::predictor();
+    c.bench_function("model_short_horizon/final_state_predictor_tol", |b| {
+        b.iter(|| black_box(predictor.final_state(black_box(&problem)).unwrap()))
     });
 }
 

@@ -23,7 +23,7 @@
 use std::cell::Cell;
 use std::time::Duration;
 
-use ode_solvers::{Dop853, Dopri5, System, Vector4};
+use ode_solvers::{Dop853, Dopri5, OutputType, System, Vector4};
 use pushval::harness::{analyse_segments, rel_err, tail_omega, SegmentInfo};
 use pushval_model::{
     DynamicModel, Integrator, Problem, Rotor, SegmentDynamics, Simulator, Switching, Trajectory,
@@ -188,6 +188,61 @@ fn peer(problem: &Problem, tol: f64, eighth: bool) -> (Trajectory, usize) {
     (tr, evals)
 }
 
+/// The peer asked only for the state at the end, as a predictor asks:
+/// ode_solvers' Dop853 with `OutputType::Sparse` (the state after each step,
+/// no dense output; otherwise `Dop853::new`'s settings), the same switches.
+/// Returns the centre of mass's final (x, y, θ) and the evaluations.
+fn peer_final(problem: &Problem, tol: f64) -> ([f64; 3], usize) {
+    let body = &problem.body;
+    let pc = body.contact();
+    let mut theta = problem.initial.theta;
+    let mut c = problem.initial.position + pushval_model::rotate(theta, &pc);
+    let mut omega = problem.initial.omega;
+    let mut evals = 0usize;
+    for (j, (push, (t0, t1))) in problem
+        .pushes
+        .iter()
+        .zip(problem.segment_times())
+        .enumerate()
+    {
+        if j > 0 {
+            omega = problem.omega_after_switch(Some(&problem.pushes[j - 1]), push, omega);
+        }
+        let seg = SegmentDynamics::new(body, push);
+        let sys = Peer {
+            seg: &seg,
+            vel: push.velocity(),
+            rotor: Cell::new(Rotor::new()),
+        };
+        let y0 = Vector4::new(theta, omega, c.x, c.y);
+        let span = t1 - t0;
+        let mut s = Dop853::from_param(
+            sys,
+            t0,
+            t1,
+            span,
+            y0,
+            tol,
+            tol,
+            0.9,
+            0.0,
+            0.333,
+            6.0,
+            span,
+            0.0,
+            100_000,
+            1000,
+            OutputType::Sparse,
+        );
+        let st = s.integrate().expect("peer integration");
+        evals += st.num_eval as usize;
+        let last = s.y_out().last().expect("at least the end point");
+        (theta, omega, c) = (last[0], last[1], Vec2::new(last[2], last[3]));
+    }
+    let p = c - pushval_model::rotate(theta, &pc);
+    ([p.x, p.y, theta], evals)
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     // `--model-only`: the adaptive methods and the peer only, printed, no files.
@@ -256,6 +311,7 @@ fn main() {
         if quick { 21 } else { 61 },
     );
     target.push_str(&short_horizon_line(root, if quick { 201 } else { 2001 }));
+    target.push_str(&load_line());
     if model_only {
         eprintln!();
         print!("{target}");
@@ -430,12 +486,51 @@ fn target_comparison(
         ));
     }
     out.push_str(&format!("# speed-up at the target: {:.2}x\n", mb / ma));
+    // Asked for the final state alone, as a predictor asks, at the same
+    // tolerances: pushval's `final_state` against the peer without dense
+    // output. Error: the distance from the reference's final position.
+    let end = reference.samples.last().expect("the reference ends");
+    let model = DynamicModel {
+        integrator: Integrator::Dop853 { tol: a.0 },
+        check_assumptions: false,
+        ..Default::default()
+    };
+    let ours_final = || model.final_state(problem).unwrap();
+    let theirs_final = || peer_final(problem, b.0);
+    let fa = ours_final();
+    let (fb, nb) = theirs_final();
+    let (ea, eb) = (
+        (fa.x - end.x).hypot(fa.y - end.y),
+        (fb[0] - end.x).hypot(fb[1] - end.y),
+    );
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        ta.push(time(1, ours_final).0);
+        tb.push(time(1, theirs_final).0);
+    }
+    ta.sort();
+    tb.sort();
+    let (fma, fmb) = (ta[runs / 2].as_secs_f64(), tb[runs / 2].as_secs_f64());
+    out.push_str(&format!(
+        "{TARGET_ERR:e},pushval DOP853 final state,{:.3e},{},{ea:.3e},{fma:.6e}\n",
+        a.0, fa.stats.rhs_evals
+    ));
+    out.push_str(&format!(
+        "{TARGET_ERR:e},ode_solvers Dop853 final state,{:.3e},{nb},{eb:.3e},{fmb:.6e}\n",
+        b.0
+    ));
+    out.push_str(&format!(
+        "# speed-up at the target, final state only (the same tolerances, no samples, the peer without dense output): {:.2}x\n",
+        fmb / fma
+    ));
     out
 }
 
 /// The median thread CPU time of `runs` dynamic-model runs of the
-/// short horizon (`short_horizon/mod.rs`), as a comment line of
-/// `work_precision_target.csv`.
+/// short horizon (`short_horizon/mod.rs`), as comment lines of
+/// `work_precision_target.csv`: the sampled run (two samples) at the
+/// bench's tolerance, then the final state alone at that tolerance and at
+/// the predictor's ([`short_horizon::PREDICTOR_TOL`]), timed alternately.
 fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
     let problem = short_horizon::problem(root);
     let model = short_horizon::model();
@@ -443,14 +538,55 @@ fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
         Integrator::Dop853 { tol } => tol,
         other => panic!("the short horizon runs DOP853, not {other:?}"),
     };
-    let (d, tr) = time(runs, || model.simulate(&problem).unwrap());
-    format!(
-        "# model_short_horizon ({} segments from rest, {:.2} s, {} samples, checks off, DOP853 tol {tol:e}): median {:.6e} s, {} RHS evaluations\n",
+    let predictor = short_horizon::predictor();
+    let tr = model.simulate(&problem).unwrap();
+    let end = model.final_state(&problem).unwrap();
+    let end9 = predictor.final_state(&problem).unwrap();
+    let (mut ts, mut tf, mut tp) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..runs {
+        ts.push(time(1, || model.simulate(&problem).unwrap()).0);
+        tf.push(time(1, || model.final_state(&problem).unwrap()).0);
+        tp.push(time(1, || predictor.final_state(&problem).unwrap()).0);
+    }
+    let median = |v: &mut Vec<Duration>| {
+        v.sort();
+        v[v.len() / 2].as_secs_f64()
+    };
+    let (ms, mf, mp) = (median(&mut ts), median(&mut tf), median(&mut tp));
+    let mut out = format!(
+        "# model_short_horizon ({} segments from rest, {:.2} s, {} samples, checks off, DOP853 tol {tol:e}): median {ms:.6e} s, {} RHS evaluations\n",
         short_horizon::SEGMENTS,
         problem.duration(),
         tr.samples.len(),
-        d.as_secs_f64(),
         tr.stats.rhs_evals
+    );
+    out.push_str(&format!(
+        "# model_short_horizon final state only (DOP853 tol {tol:e}): median {mf:.6e} s, {} RHS evaluations\n",
+        end.stats.rhs_evals
+    ));
+    out.push_str(&format!(
+        "# model_short_horizon final state only at the predictor's tolerance (DOP853 tol {:e}): median {mp:.6e} s, {} RHS evaluations\n",
+        short_horizon::PREDICTOR_TOL,
+        end9.stats.rhs_evals
+    ));
+    out
+}
+
+/// The machine's load averages (1, 5, 15 min, from `/proc/loadavg`) when
+/// the timings end, as a comment line: thread CPU time leaves out waiting,
+/// but cores shared with other work still slow every method, so the
+/// absolute medians read with it (the ratios, timed alternately, less so).
+fn load_line() -> String {
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    let avg: Vec<&str> = load.split_whitespace().take(3).collect();
+    format!(
+        "# load averages at the end of the timings (1, 5, 15 min; {} cores): {}\n",
+        std::thread::available_parallelism().map_or(0, |n| n.get()),
+        if avg.len() == 3 {
+            avg.join(", ")
+        } else {
+            "unknown".into()
+        }
     )
 }
 

@@ -1,9 +1,10 @@
 //! The model-predictive controller's unit of work, shared by the
 //! `model_short_horizon` criterion bench and `work_precision`: one run of the
 //! dynamic model over a 6-segment horizon from rest on the paper plate, with
-//! two samples (its start and end) and the assumption checks off.
+//! two samples (its start and end) or the final state alone, and the
+//! assumption checks off.
 
-use pushval_model::{DynamicModel, Initial, Problem, Push};
+use pushval_model::{DynamicModel, Initial, Integrator, Problem, Push};
 use pushval_scenario::Scenario;
 
 /// Segments of the horizon.
@@ -33,11 +34,24 @@ pub fn problem(root: &std::path::Path) -> Problem {
     p
 }
 
-/// The predictor: the dynamic model's default integrator (DOP853 at 1e-10),
-/// assumption checks off.
+/// The horizon's model: the dynamic model's default integrator (DOP853 at
+/// 1e-10), assumption checks off.
 pub fn model() -> DynamicModel {
     DynamicModel {
         check_assumptions: false,
         ..Default::default()
+    }
+}
+
+/// The tolerance the planner's predictor runs DOP853 at (`Predict::new` in
+/// the control code: 1e-9 per step).
+pub const PREDICTOR_TOL: f64 = 1e-9;
+
+/// The predictor's model: DOP853 at [`PREDICTOR_TOL`], the settled-arc
+/// shortcut on, assumption checks off (it asks for the final state).
+pub fn predictor() -> DynamicModel {
+    DynamicModel {
+        integrator: Integrator::Dop853 { tol: PREDICTOR_TOL },
+        ..model()
     }
 }

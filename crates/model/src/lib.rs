@@ -58,7 +58,7 @@ pub use slide::{
     slide_to_rest, PivotEnd, PivotPhase, Slide, SlideOptions, SlideReport, SlideState,
 };
 pub use trajectory::{
-    Assumptions, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel, Sample,
+    Assumptions, DynamicModel, FinalState, Integrator, KinematicModel, LimitSurfaceModel, Sample,
     SegmentReport, SolverStats, Trajectory, Violation,
 };
 

@@ -4,16 +4,20 @@
 //! The dynamic model's run is split by stage: `dynamic_model` walks the
 //! segments (switch, analysis of ω̇, closed forms), `adaptive` and `rk4`
 //! integrate a segment where there is no closed form, `checker` accumulates
-//! the assumption checks and `sampling` hands out the sample times.
+//! the assumption checks and `sampling` hands out the sample times;
+//! `final_state` asks the same run for its end state alone, or for samples
+//! at the caller's times.
 
 mod adaptive;
 mod checker;
 mod dynamic_model;
+mod final_state;
 mod rk4;
 mod sampling;
 mod segment;
 
 pub use dynamic_model::{DynamicModel, Integrator};
+pub use final_state::FinalState;
 
 use crate::tail::Tail;
 use crate::{kinematic, limit_surface, rotate, Body, ModelError, Problem, Push, Simulator};

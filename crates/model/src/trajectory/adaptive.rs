@@ -115,13 +115,14 @@ pub(super) fn integrate<F: FnMut(&State) -> State>(
                 let t_new = if landing { t1 } else { t + hh };
                 // DOP853's interpolant costs three evaluations: build it only for
                 // steps that hold a sample.
+                // Neither interpolant is built for a step that holds no sample.
                 let dense = match &attempt {
+                    _ if !rec.sample_due(seg, t_new) => AnyDense::None,
                     Attempt::Five(a) => AnyDense::Five(a.dense(t, &y, hh)),
-                    Attempt::Eight(a) if rec.sample_due(seg, t_new) => {
+                    Attempt::Eight(a) => {
                         rec.out.stats.rhs_evals += 3;
                         AnyDense::Eight(a.dense(rhs, t, &y, hh))
                     }
-                    Attempt::Eight(_) => AnyDense::None,
                 };
                 rec.samples_until(seg, t_new, |ts| pose_of(&dense.eval(ts)));
                 let w_before = y[1];

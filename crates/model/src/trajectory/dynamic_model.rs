@@ -64,7 +64,7 @@ impl Default for DynamicModel {
 
 impl DynamicModel {
     /// The integrator's tolerance or step must be finite and > 0.
-    fn check_integrator(&self) -> Result<(), ModelError> {
+    pub(super) fn check_integrator(&self) -> Result<(), ModelError> {
         if let Integrator::Adaptive { tol } | Integrator::Dop853 { tol } = self.integrator {
             if !(tol.is_finite() && tol > 0.0) {
                 return Err(ModelError::Parameter {
@@ -245,17 +245,30 @@ fn hold(
     (th, w, stopped)
 }
 
-impl Simulator for DynamicModel {
-    fn name(&self) -> String {
-        "dynamic".into()
-    }
+/// Where a run of the dynamic model ended: the contact point (world, m),
+/// θ (rad) and ω (rad/s) at the end of the schedule, and the contact
+/// velocity of the last push (object frame, m/s).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RunEnd {
+    pub(super) c: Vec2,
+    pub(super) theta: f64,
+    pub(super) omega: f64,
+    pub(super) vel: Vec2,
+}
 
-    fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
-        problem.check()?;
-        self.check_integrator()?;
+impl DynamicModel {
+    /// Walks `problem`'s segments (switch, analysis of ω̇, closed form or
+    /// integrator), recording into `rec` the samples its sampler hands out
+    /// and, with `reports`, one [`SegmentReport`] per segment. `problem`
+    /// and the integrator have been checked.
+    pub(super) fn run(
+        &self,
+        problem: &Problem,
+        rec: &mut Recorder,
+        reports: bool,
+    ) -> Result<RunEnd, ModelError> {
         let body = &problem.body;
         let pc = body.contact();
-        let mut rec = Recorder::new(problem, self.name(), self.check_assumptions);
         let init = problem.initial;
         let mut theta = init.theta;
         let mut c = init.position + rotate(theta, &pc);
@@ -271,9 +284,12 @@ impl Simulator for DynamicModel {
             .filter(|r| *r > 0.0)
             .fold(f64::INFINITY, f64::min);
         let n_seg = problem.pushes.len();
-        rec.out.segments.reserve_exact(n_seg);
+        if reports {
+            rec.out.segments.reserve_exact(n_seg);
+        }
         // One set of per-support arrays for the whole run.
         let mut spare: Option<SegmentDynamics> = None;
+        let mut vel = Vec2::zeros();
         // Segment spans as `Problem::segment_times` gives them (the same
         // running sum), without collecting them.
         let mut t_end = 0.0;
@@ -281,7 +297,7 @@ impl Simulator for DynamicModel {
             let span = (t_end, t_end + push.duration);
             t_end = span.1;
             let dir = push.direction();
-            let vel = dir * push.speed;
+            vel = dir * push.speed;
             if j > 0 || init.from_rest {
                 let w1 = problem.omega_after_switch_at(prev_vel, vel, omega);
                 rec.checker
@@ -313,10 +329,10 @@ impl Simulator for DynamicModel {
             rec.samples_until(&seg, seg.t0, |_| (c, theta, omega));
             let mut closed_form = seg.closed_form_at_start(c, theta, omega);
             if push.speed == 0.0 {
-                (theta, omega, report.settled_at) = hold(&seg, &mut rec, c, theta, omega);
+                (theta, omega, report.settled_at) = hold(&seg, rec, c, theta, omega);
             } else if closed_form.is_none() {
                 let (y, tail) =
-                    self.integrate(&seg, &mut rec, &mut h_carry, [theta, omega, c.x, c.y])?;
+                    self.integrate(&seg, rec, &mut h_carry, [theta, omega, c.x, c.y])?;
                 (c, theta, omega) = pose_of(&y);
                 closed_form = tail;
             }
@@ -325,9 +341,30 @@ impl Simulator for DynamicModel {
                 (c, theta, omega) = rec.samples_of_tail(&seg, tail);
             }
             report.omega_end = omega;
-            rec.out.segments.push(report);
+            if reports {
+                rec.out.segments.push(report);
+            }
             spare = Some(seg.dynamics);
         }
+        Ok(RunEnd {
+            c,
+            theta,
+            omega,
+            vel,
+        })
+    }
+}
+
+impl Simulator for DynamicModel {
+    fn name(&self) -> String {
+        "dynamic".into()
+    }
+
+    fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
+        problem.check()?;
+        self.check_integrator()?;
+        let mut rec = Recorder::new(problem, self.name(), self.check_assumptions);
+        self.run(problem, &mut rec, true)?;
         rec.out.assumptions = rec.checker.finish();
         if let Some(release) = &problem.release {
             let start = crate::slide::release_state(problem, c, theta, omega, prev_vel);

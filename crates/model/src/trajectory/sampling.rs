@@ -13,10 +13,21 @@ pub(super) struct Sampler {
 
 impl Sampler {
     pub(super) fn new(problem: &Problem) -> Self {
+        Self::at(problem.sample_times(), 1e-9 * problem.sample_dt)
+    }
+
+    /// No sample at all (allocates nothing).
+    pub(super) fn none() -> Self {
+        Self::at(Vec::new(), 0.0)
+    }
+
+    /// The sample times `times` (s, increasing); times within `eps` (s) of
+    /// a switch belong to the segment that starts there.
+    pub(super) fn at(times: Vec<f64>, eps: f64) -> Self {
         Self {
-            times: problem.sample_times(),
+            times,
             next: 0,
-            eps: 1e-9 * problem.sample_dt,
+            eps,
         }
     }
 
@@ -52,7 +63,8 @@ pub(super) fn pose_sample(
 
 /// Samples a closed-form tail at the sample times due up to `t1` (the end of
 /// its segment; `last` for the last segment, which owns its end time) and
-/// returns its pose at `t1`.
+/// returns its pose at `t1`, evaluated afresh there: the same whatever
+/// samples came before.
 pub(super) fn sample_tail(
     tail: Tail,
     sampler: &mut Sampler,
@@ -69,5 +81,5 @@ pub(super) fn sample_tail(
     if sampler.next > first {
         cursor.fill(&sampler.times[first..sampler.next], pc, out);
     }
-    cursor.eval(t1)
+    cursor.end(t1)
 }

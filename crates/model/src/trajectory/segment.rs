@@ -24,7 +24,17 @@ pub(super) struct Recorder<'p> {
 
 impl<'p> Recorder<'p> {
     pub(super) fn new(problem: &'p Problem, model: String, check_assumptions: bool) -> Self {
-        let sampler = Sampler::new(problem);
+        Self::with_sampler(problem, model, check_assumptions, Sampler::new(problem))
+    }
+
+    /// A record of the samples `sampler` hands out (none: only the segment
+    /// reports and the solver work).
+    pub(super) fn with_sampler(
+        problem: &'p Problem,
+        model: String,
+        check_assumptions: bool,
+        sampler: Sampler,
+    ) -> Self {
         Self {
             out: Trajectory {
                 model,

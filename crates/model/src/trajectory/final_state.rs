@@ -1,0 +1,100 @@
+//! The dynamic model asked only for what the caller needs: the state at
+//! the end of the schedule ([`DynamicModel::final_state`]), or samples at
+//! the caller's own times ([`DynamicModel::sample_at`]). Both take the
+//! same path as [`Simulator::simulate`] (the same steps, switches and
+//! closed forms), so their states are the full run's at those times.
+
+use super::dynamic_model::DynamicModel;
+use super::sampling::Sampler;
+use super::segment::Recorder;
+use super::{SolverStats, Trajectory};
+use crate::{perp, ModelError, Problem, Simulator, Vec2};
+
+/// The state of the object at the end of a push schedule: what a predictor
+/// needs to score a plan or to start the next one from.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FinalState {
+    /// End time (s): the schedule's duration.
+    pub t: f64,
+    /// World x of the centre of mass (m).
+    pub x: f64,
+    /// World y of the centre of mass (m).
+    pub y: f64,
+    /// Object angle, unwrapped (rad).
+    pub theta: f64,
+    /// Angular velocity (rad/s).
+    pub omega: f64,
+    /// World x velocity of the centre of mass (m/s) at the end of the last
+    /// push, the pusher still in contact.
+    pub vx: f64,
+    /// World y velocity of the centre of mass (m/s), as `vx`.
+    pub vy: f64,
+    /// Integrator work.
+    pub stats: SolverStats,
+}
+
+impl DynamicModel {
+    /// Runs the dynamic model to the end of `problem`'s push schedule and
+    /// returns only the final state: the pose, ω and the centre of mass's
+    /// velocity at `problem.duration()`, at the integrator's tolerance.
+    ///
+    /// `problem.sample_dt` is not read: no sample is taken, stored or
+    /// interpolated, no segment report is kept, and an integrated step
+    /// builds no dense output. The state equals the last sample of
+    /// [`Simulator::simulate`] on the same problem (the same steps and
+    /// closed forms; only the evaluation of the final pose may differ, by
+    /// rounding). The assumption checks are made at samples, so none is
+    /// made here whatever `check_assumptions` says: run `simulate` for them.
+    pub fn final_state(&self, problem: &Problem) -> Result<FinalState, ModelError> {
+        problem.check()?;
+        self.check_integrator()?;
+        let mut rec = Recorder::with_sampler(problem, String::new(), false, Sampler::none());
+        let end = self.run(problem, &mut rec, false)?;
+        let pc = problem.body.contact();
+        let (s, c) = end.theta.sin_cos();
+        let turn = |a: Vec2| Vec2::new(c * a.x - s * a.y, s * a.x + c * a.y);
+        let p = end.c - turn(pc);
+        // v_cm = R(θ) (v_c − ω D p_c): the contact point's velocity plus
+        // the turn about it.
+        let v = turn(end.vel - perp(&pc) * end.omega);
+        Ok(FinalState {
+            t: problem.duration(),
+            x: p.x,
+            y: p.y,
+            theta: end.theta,
+            omega: end.omega,
+            vx: v.x,
+            vy: v.y,
+            stats: rec.out.stats,
+        })
+    }
+
+    /// Runs the dynamic model over `problem` sampling only at `times` (s,
+    /// increasing, within `[0, problem.duration()]`) instead of every
+    /// `problem.sample_dt`: a sample at a switch time is the state just
+    /// after the switch, as in [`Simulator::simulate`], whose trajectory
+    /// this is in every other respect (segment reports, assumption checks
+    /// at the samples, solver work).
+    pub fn sample_at(&self, problem: &Problem, times: &[f64]) -> Result<Trajectory, ModelError> {
+        problem.check()?;
+        self.check_integrator()?;
+        let end = problem.duration();
+        let mut prev = 0.0;
+        for &t in times {
+            if !(t.is_finite() && t >= prev && t <= end * (1.0 + 1e-12)) {
+                return Err(ModelError::Parameter {
+                    name: "sample time",
+                    requirement: "finite, not decreasing, within [0, the schedule's duration]",
+                    value: t,
+                });
+            }
+            prev = t;
+        }
+        // Within a relative 1e-12 of the run a time counts as a switch's.
+        let sampler = Sampler::at(times.to_vec(), 1e-12 * end);
+        let mut rec = Recorder::with_sampler(problem, self.name(), self.check_assumptions, sampler);
+        self.run(problem, &mut rec, true)?;
+        rec.out.assumptions = rec.checker.finish();
+        Ok(rec.out)
+    }
+}
