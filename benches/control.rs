@@ -34,6 +34,7 @@ fn control(c: &mut Criterion) {
                 segments: 6,
                 speed: v,
                 predictor: Predictor::Dynamic,
+                at: pushval::control::At::Release,
             };
             let planner =
                 Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
@@ -61,6 +62,7 @@ fn control(c: &mut Criterion) {
                 segments: 6,
                 speed: v,
                 predictor: Predictor::Dynamic,
+                at: pushval::control::At::Release,
             };
             let mut planner =
                 Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
@@ -142,6 +144,7 @@ fn cost_table() {
                 segments: 6,
                 speed: v,
                 predictor: Predictor::Dynamic,
+                at: pushval::control::At::Release,
             };
             let planner =
                 Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
@@ -167,6 +170,7 @@ fn cost_table() {
                 segments: 6,
                 speed: 1.0,
                 predictor: Predictor::Dynamic,
+                at: pushval::control::At::Release,
             },
             period: 0.02,
             reach,

@@ -590,6 +590,7 @@ fn main() {
                 segments: 6,
                 speed: 1.0,
                 predictor: Predictor::Dynamic,
+                at: pushval::control::At::Release,
             },
             period: PERIOD,
             reach: Reach::default(),

@@ -380,6 +380,11 @@ struct GoalArgs {
     /// [default: 0.02,0.0872664626 (20 mm, 5°)].
     #[arg(long, value_name = "POS,ANGLE")]
     tolerance: Option<String>,
+    /// When success is judged: `rest` (the pusher lets go after the last
+    /// push and the plate slides to a stop; the plan aims for that pose) or
+    /// `release` (when the last push ends, the plate still moving).
+    #[arg(long, default_value = "rest", value_name = "RULE")]
+    at: String,
     /// Output folder: written whole into a fresh folder and renamed into
     /// place (what was there before is replaced).
     #[arg(long, value_name = "DIR")]
@@ -395,6 +400,7 @@ impl GoalArgs {
             segments: self.segments,
             predictor: self.predictor,
             tolerance: self.tolerance,
+            at: self.at,
             out: self.out,
         }
     }

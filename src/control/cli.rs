@@ -13,7 +13,7 @@ use anyhow::Context;
 use pushval_control::mpc::{push_at, run_loop, LoopOutcome, LoopSpec, PlantScale};
 use pushval_control::plan::{describe_attempts, make_plan, Bounds, PlanSpec};
 use pushval_control::stats::median_p99;
-use pushval_control::{ControlError, Goal, Reach};
+use pushval_control::{At, ControlError, Goal, Reach};
 use pushval_engine::Engine;
 use pushval_model::Push;
 use serde_json::json;
@@ -36,6 +36,8 @@ pub struct Common {
     pub predictor: String,
     /// `--tolerance POS,ANGLE`.
     pub tolerance: Option<String>,
+    /// `--at rest|release`.
+    pub at: String,
     /// `--out DIR`.
     pub out: PathBuf,
 }
@@ -70,10 +72,13 @@ fn parse(c: &Common) -> anyhow::Result<Parsed> {
         Some(t) => parse_reach(t)?,
         None => Reach::default(),
     };
+    let at = At::from_name(&c.at)
+        .with_context(|| format!("--at: `{}` is not one of rest, release", c.at))?;
     let spec = PlanSpec {
         segments: c.segments,
         speed,
         predictor,
+        at,
     };
     // Refused here, before any work: speeds, goals and plan lengths out of
     // range.
@@ -133,6 +138,7 @@ pub fn with_schedule(
     file: &std::path::Path,
     pushes: &[Push],
     note: &str,
+    release: Option<pushval_model::Release>,
 ) -> anyhow::Result<toml::Table> {
     let mut doc: toml::Table =
         toml::from_str(text).with_context(|| format!("{}: not TOML", file.display()))?;
@@ -156,7 +162,35 @@ pub fn with_schedule(
     if let Some(toml::Value::String(d)) = doc.get_mut("description") {
         *d = format!("{d} | {note}");
     }
+    // Judged at rest: the pusher lets go after the last push and the plate
+    // slides to a stop; judged at the release, the run ends there.
+    match release {
+        Some(r) => {
+            let mut t = toml::Table::new();
+            t.insert("max_duration".into(), toml::Value::Float(r.max_duration));
+            doc.insert("release".into(), toml::Value::Table(t));
+        }
+        None => {
+            doc.remove("release");
+        }
+    }
     Ok(doc)
+}
+
+/// The `[release]` a written scenario carries: judged at rest, the file's
+/// own (or the default); judged at the release, none.
+fn release_of(p: &Parsed) -> Option<pushval_model::Release> {
+    match p.spec.at {
+        At::Rest => Some(p.problem.release.unwrap_or_default()),
+        At::Release => None,
+    }
+}
+
+fn pose_json(v: Option<[f64; 4]>) -> serde_json::Value {
+    match v {
+        Some([t, x, y, theta]) => json!({"t": t, "x": x, "y": y, "theta": theta}),
+        None => serde_json::Value::Null,
+    }
 }
 
 /// `pushval plan`.
@@ -192,7 +226,15 @@ pub fn plan(c: &Common) -> anyhow::Result<ExitCode> {
         "tolerance": {"position_m": p.reach.position, "angle_rad": p.reach.angle},
         "predictor": p.spec.predictor.as_str(),
         "speed": p.spec.speed,
+        "at": p.spec.at.as_str(),
         "reached": outcome.reached,
+        "release_pose": pose_json(Some(outcome.release_pose)),
+        "rest_pose": pose_json(outcome.rest_pose),
+        "slide": outcome.slide.as_ref().map(|sl| json!({
+            "t_release": sl.t_release,
+            "t_stop": sl.t_stop,
+            "pivots": sl.pivots.iter().map(|pv| json!({"support": pv.support, "t_start": pv.t_start, "t_end": pv.t_end})).collect::<Vec<_>>(),
+        })),
         "converged": s.converged,
         "position_error_m": json_num(s.position_error),
         "angle_error_rad": json_num(s.angle_error),
@@ -227,7 +269,7 @@ pub fn plan(c: &Common) -> anyhow::Result<ExitCode> {
             p.goal,
             p.spec.predictor.as_str()
         );
-        let doc = with_schedule(&p.text, &c.file, &s.pushes, &note)?;
+        let doc = with_schedule(&p.text, &c.file, &s.pushes, &note, release_of(&p))?;
         let toml_text = format!(
             "# Written by `pushval plan`: the goal {} ({} predictor).\n{}",
             p.goal,
@@ -332,7 +374,7 @@ fn applied_toml(
     pushes: &[Push],
 ) -> anyhow::Result<String> {
     let note = format!("what `pushval loop` applied to {engine} (goal {})", p.goal);
-    let mut doc = with_schedule(&p.text, file, pushes, &note)?;
+    let mut doc = with_schedule(&p.text, file, pushes, &note, release_of(p))?;
     let table = |doc: &mut toml::Table, key: &str| -> anyhow::Result<toml::Table> {
         match doc.remove(key) {
             Some(toml::Value::Table(t)) => Ok(t),
@@ -421,6 +463,7 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         "dt": dt,
         "predictor": p.spec.predictor.as_str(),
         "speed": p.spec.speed,
+        "at": p.spec.at.as_str(),
         "plant": plant,
     });
     let outcome = (|| -> anyhow::Result<(LoopOutcome, pushval_engine::EngineRun)> {
@@ -451,16 +494,18 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
     let timing = median_p99(&out.predictor_us);
     let cpu = median_p99(&out.predictor_cpu_us);
     let pushes: Vec<Push> = out.applied.iter().map(|a| a.push).collect();
-    let l = &out.last;
+    let l = &out.release;
+    let judged = out.rest.unwrap_or(out.release);
     let mut doc = base;
     let extra = json!({
         "period_s": out.period,
         "success": out.success,
         "position_error_m": json_num(out.position_error),
         "angle_error_rad": json_num(out.angle_error),
-        "final_pose": {"t": l.t, "x": l.x, "y": l.y, "theta": l.theta},
+        "final_pose": {"t": judged.t, "x": judged.x, "y": judged.y, "theta": judged.theta},
         "release_pose": {"t": l.t, "x": l.x, "y": l.y, "theta": l.theta},
         "release_state": {"t": l.t, "x": l.x, "y": l.y, "theta": l.theta, "omega": l.omega, "vx": l.v_cm[0], "vy": l.v_cm[1]},
+        "rest_pose": out.rest.map(|r| json!({"t": r.t, "x": r.x, "y": r.y, "theta": r.theta})),
         "steps": out.steps,
         "gave_up_at_twice_the_plan": out.gave_up,
         "predictor_us_median": timing.map(|t| t.0),
@@ -496,10 +541,11 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         None => "no re-plan (the plan lasted one period)".into(),
     };
     println!(
-        "loop ({} predictor, {} plant, period {} s): {} after {} periods: {:.4} m and {:.4} rad from the goal; {}{}",
+        "loop ({} predictor, {} plant, period {} s, judged at {}): {} after {} periods: {:.4} m and {:.4} rad from the goal; {}{}",
         p.spec.predictor.as_str(),
         engine.name(),
         out.period,
+        p.spec.at.as_str(),
         if out.success { "reached" } else { "MISSED" },
         out.steps,
         out.position_error,

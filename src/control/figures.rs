@@ -141,6 +141,7 @@ pub(crate) fn paths_figure(
         segments: SEGMENTS,
         speed: v,
         predictor: ModelKind::Dynamic,
+        at: pushval_control::At::Release,
     };
     let mut planner = Planner::new(
         problem,

@@ -11,7 +11,7 @@ pub mod study;
 use anyhow::{bail, Context};
 use pushval_control::mpc::PlantScale;
 pub use pushval_control::{
-    gyration_length, mpc, plan, pose_errors, predict, push_cone, stats, ControlError, Goal,
+    gyration_length, mpc, plan, pose_errors, predict, push_cone, stats, At, ControlError, Goal,
     ModelKind, Reach,
 };
 

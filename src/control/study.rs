@@ -45,6 +45,8 @@ pub const QUICK_GOALS: usize = 3;
 pub const SEGMENTS: usize = 6;
 /// The MPC's control period (s).
 pub const PERIOD: f64 = 0.02;
+/// When the study judges a run: at rest, after the slide.
+pub const AT: pushval_control::At = pushval_control::At::Rest;
 
 /// Open loop or MPC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -162,6 +164,7 @@ pub fn goals(problem: &Problem, speeds: &[f64], count: usize) -> Vec<Goal> {
                 segments: SEGMENTS,
                 speed: v,
                 predictor: Predictor::Dynamic,
+                at: AT,
             };
             let mut planner =
                 Planner::new(problem, goal, spec, straight_time(&start, &goal, v), reach);
@@ -267,6 +270,7 @@ fn plans(problem: &Problem, speeds: &[f64], goals: &[Goal]) -> Plans {
                     segments: SEGMENTS,
                     speed: v,
                     predictor,
+                    at: AT,
                 };
                 let mut planner = Planner::new(
                     problem,
@@ -299,6 +303,7 @@ fn run_task(
         segments: SEGMENTS,
         speed: t.speed,
         predictor: t.predictor,
+        at: AT,
     };
     let result: anyhow::Result<Vec<f64>> = (|| {
         let plant = t.plant().apply(problem)?;

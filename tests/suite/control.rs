@@ -44,6 +44,7 @@ fn spec(speed: f64, predictor: Predictor) -> PlanSpec {
         segments: 6,
         speed,
         predictor,
+        at: pushval::control::At::Release,
     }
 }
 

@@ -26,6 +26,35 @@ pub use error::ControlError;
 pub use predict::{ModelKind, ModelPredictor, Predictor};
 use pushval_model::{Problem, Vec2};
 
+/// When a plan or a loop is judged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum At {
+    /// When the plate has stopped after the pusher let go (the slide to rest
+    /// in the prediction and in the plant).
+    #[default]
+    Rest,
+    /// When the last push ends, the plate still moving.
+    Release,
+}
+
+impl At {
+    /// `rest` or `release`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            At::Rest => "rest",
+            At::Release => "release",
+        }
+    }
+
+    /// The rule named `name` ([`At::as_str`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [At::Rest, At::Release]
+            .into_iter()
+            .find(|a| a.as_str() == name)
+    }
+}
+
 /// The goal of a push: the centre of mass's world position and the angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Goal {

@@ -22,7 +22,7 @@ use pushval_model::{Body, ModelError, Problem, Push, Support, Vec2};
 
 use crate::plan::{nearest, resample, straight_time, PlanSpec, Planner, Solution, GUESSES};
 use crate::predict::{Motion, Start};
-use crate::{pose_errors, ControlError, Goal, Reach};
+use crate::{pose_errors, At, ControlError, Goal, Reach};
 
 /// How the plant differs from the predictor's scene.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -131,11 +131,15 @@ impl Observer for () {
 pub struct LoopOutcome {
     /// The pushes applied, in order (each a whole number of plant steps).
     pub applied: Vec<Applied>,
-    /// The plant's state when the last push ended.
-    pub last: EngineState,
-    /// Final distance from the goal (m).
+    /// When the loop was judged.
+    pub at: At,
+    /// The plant's state when the last push ended (the release).
+    pub release: EngineState,
+    /// The plant's state at rest after the release (judged at rest only).
+    pub rest: Option<EngineState>,
+    /// Distance of the judged pose from the goal (m).
     pub position_error: f64,
-    /// Final angle error (rad).
+    /// Angle error of the judged pose (rad).
     pub angle_error: f64,
     /// Whether the goal was reached.
     pub success: bool,
@@ -365,11 +369,26 @@ pub fn run_loop(
             predictor_cpu_us: cpu_us,
         });
     }
-    let last = plant.state();
-    let (pe, ae) = pose_errors(last.x, last.y, last.theta, &goal);
+    let release = plant.state();
+    let rest = match spec.plan.at {
+        At::Release => None,
+        At::Rest => {
+            // The pusher lets go; the plant slides until it stops.
+            let max = problem.release.unwrap_or_default().max_duration;
+            plant.release(max).map_err(|source| ControlError::Plant {
+                t: release.t,
+                source,
+            })?;
+            Some(plant.state())
+        }
+    };
+    let judged = rest.unwrap_or(release);
+    let (pe, ae) = pose_errors(judged.x, judged.y, judged.theta, &goal);
     Ok(LoopOutcome {
         applied,
-        last,
+        at: spec.plan.at,
+        release,
+        rest,
         position_error: pe,
         angle_error: ae,
         success: spec.reach.holds(pe, ae),

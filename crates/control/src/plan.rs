@@ -33,7 +33,7 @@ use pushval_model::{
 };
 
 use crate::predict::{ModelKind, ModelPredictor, Motion, Predictor, Start};
-use crate::{gyration_length, pose_errors, push_cone, ControlError, Goal, Reach};
+use crate::{gyration_length, pose_errors, push_cone, At, ControlError, Goal, Reach};
 
 /// What the plan is asked for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,6 +44,8 @@ pub struct PlanSpec {
     pub speed: f64,
     /// The model the plan is made on.
     pub predictor: ModelKind,
+    /// When the plan is judged: at rest after the slide, or at the release.
+    pub at: At,
 }
 
 /// The longest plan, in straight-line times.
@@ -127,7 +129,7 @@ impl Planner {
     /// the speed.
     pub fn new(problem: &Problem, goal: Goal, spec: PlanSpec, t_ref: f64, reach: Reach) -> Self {
         Self::with_predictor(
-            Box::new(ModelPredictor::new(problem, spec.predictor)),
+            Box::new(ModelPredictor::new(problem, spec.predictor).judged_at(spec.at)),
             goal,
             spec,
             t_ref,
@@ -710,6 +712,13 @@ pub struct PlanOutcome {
     pub assumptions: pushval_model::Assumptions,
     /// Each switch's impulse against the friction cone.
     pub switches: Vec<SwitchCheck>,
+    /// The dynamic model's slide after the release (judged at rest): when
+    /// it stops, its pivots.
+    pub slide: Option<pushval_model::SlideReport>,
+    /// The dynamic model's pose at the release (t, x, y, θ).
+    pub release_pose: [f64; 4],
+    /// The dynamic model's pose at rest (t, x, y, θ; judged at rest).
+    pub rest_pose: Option<[f64; 4]>,
     /// Why it misses (None when it reaches the goal).
     pub why: Option<String>,
 }
@@ -720,8 +729,13 @@ fn checked(
     problem: &Problem,
     start: &Start,
     pushes: &[Push],
+    at: At,
 ) -> Result<(Trajectory, Vec<SwitchCheck>), ControlError> {
     let mut p = crate::predict::problem_of(problem, start, pushes, None);
+    p.release = match at {
+        At::Rest => Some(problem.release.unwrap_or_default()),
+        At::Release => None,
+    };
     let total = p.duration();
     p.sample_dt = problem.sample_dt.max(total / 10_000.0).min(total);
     let traj = DynamicModel::default().simulate(&p)?;
@@ -783,7 +797,7 @@ pub fn make_plan(
                     .best_residual_m
                     .map_or(s.residual, |r: f64| r.min(s.residual)),
             );
-            let (traj, switches) = checked(problem, &start, &s.pushes)?;
+            let (traj, switches) = checked(problem, &start, &s.pushes, spec.at)?;
             let pulls = traj.assumptions.pulling_impulse.is_some();
             let hit = s.converged || reach.holds(s.position_error, s.angle_error);
             if hit && pulls {
@@ -848,6 +862,18 @@ pub fn make_plan(
         }
         format!("{why} (tried {})", describe_attempts(&attempts))
     });
+    let t_release: f64 = solution.pushes.iter().map(|p| p.duration).sum();
+    let pose = |s: &pushval_model::Sample| [s.t, s.x, s.y, s.theta];
+    let release_pose = traj
+        .samples
+        .iter()
+        .rfind(|s| s.t <= t_release + 1e-9)
+        .map(pose)
+        .unwrap_or([f64::NAN; 4]);
+    let rest_pose = match spec.at {
+        At::Rest => traj.samples.last().map(pose),
+        At::Release => None,
+    };
     Ok(PlanOutcome {
         solution,
         reached,
@@ -856,6 +882,9 @@ pub fn make_plan(
         attempts,
         assumptions: traj.assumptions,
         switches,
+        slide: traj.slide,
+        release_pose,
+        rest_pose,
         why,
     })
 }

@@ -11,6 +11,8 @@ use pushval_model::{
     Switching, Trajectory, Vec2,
 };
 
+use crate::At;
+
 /// Which of pushval's models predicts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, PartialOrd, Ord)]
 pub enum ModelKind {
@@ -160,6 +162,19 @@ impl ModelPredictor {
         self.kind
     }
 
+    /// The predictor judged `at` the release or at rest. At rest the
+    /// dynamic model slides on after the last push until the plate stops
+    /// (the scene's own `[release]`, else 10 s at most); the quasi-static
+    /// models do not slide: in them the plate stops when the pusher does,
+    /// so their rest is their release pose.
+    pub fn judged_at(mut self, at: At) -> Self {
+        self.problem.release = match (at, self.kind) {
+            (At::Rest, ModelKind::Dynamic) => Some(self.problem.release.unwrap_or_default()),
+            _ => None,
+        };
+        self
+    }
+
     /// The problem of `pushes` from `start`, sampled at its start and end
     /// only (or every `sample_dt` s when given).
     pub fn problem_of(&self, start: &Start, pushes: &[Push], sample_dt: Option<f64>) -> Problem {
@@ -191,18 +206,25 @@ impl Predictor for ModelPredictor {
     fn final_pose(&mut self, start: &Start, pushes: &[Push]) -> Result<[f64; 3], ModelError> {
         let mut p = std::mem::replace(&mut self.problem, placeholder());
         set_start(&mut p, start, pushes, None);
-        let out = self.simulate(&p);
+        // The dynamic model's end state alone (no samples; through the
+        // slide when judged at rest); the quasi-static ones sample their
+        // closed-form arcs at the end.
+        let out = match self.kind {
+            ModelKind::Dynamic => self.model.final_state(&p).map(|f| [f.t, f.x, f.y, f.theta]),
+            _ => self.simulate(&p).and_then(|tr| {
+                tr.samples
+                    .last()
+                    .map(|s| [s.t, s.x, s.y, s.theta])
+                    .ok_or(ModelError::EmptySchedule)
+            }),
+        };
         self.problem = p;
         self.runs += 1;
-        let s = out?
-            .samples
-            .last()
-            .copied()
-            .ok_or(ModelError::EmptySchedule)?;
-        if !(s.x.is_finite() && s.y.is_finite() && s.theta.is_finite()) {
-            return Err(ModelError::NonFinite { t: s.t, step: 0 });
+        let [t, x, y, theta] = out?;
+        if !(x.is_finite() && y.is_finite() && theta.is_finite()) {
+            return Err(ModelError::NonFinite { t, step: 0 });
         }
-        Ok([s.x, s.y, s.theta])
+        Ok([x, y, theta])
     }
 
     fn trajectory(

@@ -108,6 +108,14 @@ pub trait EngineSession {
     }
     /// Engine steps taken so far, replays included (the cost of the session).
     fn steps_taken(&self) -> usize;
+    /// Lets go: the pusher withdraws and the engine steps until the plate is
+    /// at rest, or `max_duration` s pass. An engine that cannot release
+    /// refuses (this default), naming the release.
+    fn release(&mut self, _max_duration: f64) -> Result<(), ModelError> {
+        Err(ModelError::Adapter(
+            "this engine cannot release the plate (no free slide after the last push)".into(),
+        ))
+    }
 }
 
 /// An owned engine session, as [`Engine::start`](crate::Engine::start)

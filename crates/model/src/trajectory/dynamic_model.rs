@@ -364,10 +364,11 @@ impl Simulator for DynamicModel {
         problem.check()?;
         self.check_integrator()?;
         let mut rec = Recorder::new(problem, self.name(), self.check_assumptions);
-        self.run(problem, &mut rec, true)?;
+        let end = self.run(problem, &mut rec, true)?;
         rec.out.assumptions = rec.checker.finish();
         if let Some(release) = &problem.release {
-            let start = crate::slide::release_state(problem, c, theta, omega, prev_vel);
+            let vel = (!problem.pushes.is_empty()).then_some(end.vel);
+            let start = crate::slide::release_state(problem, end.c, end.theta, end.omega, vel);
             crate::slide::continue_run(problem, release, start, &mut rec.out)?;
         }
         Ok(rec.out)

@@ -45,11 +45,41 @@ impl DynamicModel {
     /// closed forms; only the evaluation of the final pose may differ, by
     /// rounding). The assumption checks are made at samples, so none is
     /// made here whatever `check_assumptions` says: run `simulate` for them.
+    /// With a `[release]`, the state is the slide's end: at rest, or at
+    /// `max_duration` when the plate has not stopped.
     pub fn final_state(&self, problem: &Problem) -> Result<FinalState, ModelError> {
         problem.check()?;
         self.check_integrator()?;
         let mut rec = Recorder::with_sampler(problem, String::new(), false, Sampler::none());
         let end = self.run(problem, &mut rec, false)?;
+        if let Some(release) = &problem.release {
+            // Through the free slide to rest, with no sample taken.
+            let vel = (!problem.pushes.is_empty()).then_some(end.vel);
+            let start = crate::slide::release_state(problem, end.c, end.theta, end.omega, vel);
+            let slide = crate::slide::slide_to_rest(
+                &problem.body,
+                &start,
+                &crate::slide::SlideOptions {
+                    max_duration: release.max_duration,
+                    ..Default::default()
+                },
+            )?;
+            let mut stats = rec.out.stats;
+            stats.steps += slide.steps;
+            stats.rejected += slide.rejected;
+            stats.rhs_evals += slide.rhs_evals;
+            let e = slide.end;
+            return Ok(FinalState {
+                t: e.t,
+                x: e.x,
+                y: e.y,
+                theta: e.theta,
+                omega: e.omega,
+                vx: e.vx,
+                vy: e.vy,
+                stats,
+            });
+        }
         let pc = problem.body.contact();
         let (s, c) = end.theta.sin_cos();
         let turn = |a: Vec2| Vec2::new(c * a.x - s * a.y, s * a.x + c * a.y);
