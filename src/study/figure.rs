@@ -10,7 +10,7 @@
 use plotters::style::RGBColor;
 
 use super::plate::{err, froude};
-use super::records::{num, parse};
+use crate::outdir::{field_num as num, records};
 use crate::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, GREY, PURPLE};
 
 /// The error classes' lower bounds (dimensionless): class k is
@@ -47,7 +47,7 @@ fn grid(mut v: Vec<f64>) -> Vec<f64> {
 /// omega_coulomb, omega_law, class). Errors as in the README: relative with
 /// the gate's floor, or |ω|/|ω*| where the reference is a lock.
 pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
-    let rows = parse(csv);
+    let rows = records(csv)?;
     anyhow::ensure!(!rows.is_empty(), "map.csv of {model} has no rows");
     let frs = grid(rows.iter().map(|r| num(r, "froude")).collect());
     let phis = grid(rows.iter().map(|r| num(r, "phi")).collect());

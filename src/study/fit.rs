@@ -36,7 +36,23 @@ pub const THRESHOLD_FACTOR: f64 = 10.0;
 /// Above this (m, rad) a threshold no longer decides.
 pub const THRESHOLD_CAP: f64 = 1e-3;
 /// The columns of `coulomb_fit.csv` after `schedule`.
-pub const COLUMNS: &str = "dt,mu_scale,mu_scale_std,cof_x,cof_y,inertia_cm,inertia_cm_std,start_position_rms,start_theta_rms,position_rms,theta_rms,engine_error_position,engine_error_theta,converged,fitted";
+pub const COLUMNS: [&str; 15] = [
+    "dt",
+    "mu_scale",
+    "mu_scale_std",
+    "cof_x",
+    "cof_y",
+    "inertia_cm",
+    "inertia_cm_std",
+    "start_position_rms",
+    "start_theta_rms",
+    "position_rms",
+    "theta_rms",
+    "engine_error_position",
+    "engine_error_theta",
+    "converged",
+    "fitted",
+];
 /// Values in a fit's row (the columns above less `fitted`, plus three
 /// flags: centre of friction fitted, I_cm fitted, and which parameters are
 /// near zero: 1 the μ scale, 2 I_cm, 3 both, 0 none).

@@ -24,13 +24,11 @@
 //! array's variables; `--merge` rebuilds exactly the single run's files
 //! ([`crate::shard`]).
 
-pub mod creep_law;
 pub mod figure;
 pub mod fit;
 mod plan;
 pub mod plate;
 pub mod readme;
-pub mod records;
 pub mod spec;
 
 use std::path::{Path, PathBuf};

@@ -779,7 +779,7 @@ fn creep_law_section_comes_from_its_csv() {
     let dir = root().join("results/friction_models/mujoco");
     let csv = std::fs::read_to_string(dir.join("creep_law.csv")).unwrap();
     let md = std::fs::read_to_string(dir.join("creep_law.md")).unwrap();
-    assert_eq!(pushval::study::creep_law::markdown(&csv).unwrap(), md);
+    assert_eq!(pushval::report::creep_law::markdown(&csv).unwrap(), md);
 }
 
 /// Engines whose declared law misses most of their turning cells on the
@@ -969,4 +969,54 @@ fn the_law_integrated_on_a_runs_loads_follows_its_transient() {
         quasi > 1e3 * rms,
         "quasi-static {quasi} vs integrated {rms}"
     );
+}
+
+/// Issue 45, item 7: a project made by `pushval init` holds every shipped
+/// study file, also those of engines its registry does not run (Drake,
+/// PyBullet, …); `study` passes over those in silence, and still notes a
+/// study file the user wrote for a model the registry lacks.
+#[test]
+fn study_is_quiet_about_shipped_files_a_project_does_not_use() {
+    let (dir, tmp, cache) = (
+        tempfile::tempdir().unwrap(),
+        tempfile::tempdir().unwrap(),
+        tempfile::tempdir().unwrap(),
+    );
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_pushval"))
+            .current_dir(dir.path())
+            .args(args)
+            .env("CI", "1")
+            .env("TMPDIR", tmp.path())
+            .env("XDG_CACHE_HOME", cache.path())
+            .env_remove("SLURM_ARRAY_TASK_ID")
+            .output()
+            .unwrap()
+    };
+    ok(run(&["init"]));
+    let studies = dir.path().join("studies");
+    // The premise: the project holds shipped study files of models its
+    // registry does not list.
+    let models = String::from_utf8_lossy(&run(&["engines"]).stdout).to_string();
+    let unused: Vec<String> = std::fs::read_dir(&studies)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .map(|p| p.file_stem().unwrap().to_string_lossy().to_string())
+        .filter(|m| !models.contains(m.as_str()))
+        .collect();
+    assert!(!unused.is_empty(), "every shipped study is used: {models}");
+    std::fs::write(studies.join("my_own_engine.toml"), "t_run = 2.0\n").unwrap();
+    let out = run(&["study", "index", "--quick", "--out", "out"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let skipped: Vec<&str> = err.lines().filter(|l| l.contains("skipping")).collect();
+    assert_eq!(skipped.len(), 1, "{err}");
+    assert!(skipped[0].contains("my_own_engine.toml"), "{err}");
+    // A shipped file the user changed is theirs: noted like any other.
+    let changed = studies.join(format!("{}.toml", unused[0]));
+    let text = std::fs::read_to_string(&changed).unwrap();
+    std::fs::write(&changed, format!("{text}\n# mine now\n")).unwrap();
+    let err = String::from_utf8_lossy(&run(&["study", "index", "--quick", "--out", "out"]).stderr)
+        .to_string();
+    assert!(err.contains(&format!("{}.toml", unused[0])), "{err}");
 }

@@ -27,13 +27,19 @@
 //! sample adds a positive semi-definite term), so bisection over whole
 //! sample steps finds the shortest duration exactly.
 //!
-//! Why one file of about 1,060 lines: the grid, the Fisher analysis per
-//! point, the repeated noisy fits that check it and the `fit.md` writer share
-//! one row type and one check list; split, every piece would import the
-//! others' types, and the answer `fit.md` gives would be spread over files.
+//! This module holds the grid, the Fisher analysis per point and the
+//! repeated noisy fits that check it (one row type, one check list);
+//! [`figure`] draws `identifiability.svg` and [`text`] writes `fit.md`, both
+//! from the rows alone.
 
 use std::f64::consts::FRAC_PI_4;
 use std::path::{Path, PathBuf};
+
+mod figure;
+mod text;
+
+use figure::figure;
+use text::text;
 
 use anyhow::Context;
 use pushval_model::{Push, Simulator};
@@ -41,6 +47,7 @@ use pushval_scenario::Scenario;
 
 use super::{fisher_at, fit, noise, Param, Parametrised, Settings};
 use crate::atomic::write_atomic;
+use crate::outdir::Csv;
 use crate::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
 /// The stated noise of the study on x and y (m).
@@ -446,7 +453,8 @@ impl Row {
         };
         Some(SIGMAS * self.relative_std() <= target)
     }
-    fn csv(&self) -> String {
+    /// The fields of its `identifiability.csv` record ([`HEADER`]).
+    fn csv(&self) -> [String; 19] {
         let p = &self.point;
         let opt = |v: f64| {
             if v.is_finite() {
@@ -459,26 +467,26 @@ impl Row {
             Some((e, n)) => (format!("{e}"), format!("{n}"), opt(e / self.fisher_std)),
             None => (String::new(), String::new(), String::new()),
         };
-        format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            p.sweep,
-            p.speed,
-            p.duration,
-            p.segments,
-            p.phi,
+        [
+            p.sweep.to_string(),
+            p.speed.to_string(),
+            p.duration.to_string(),
+            p.segments.to_string(),
+            p.phi.to_string(),
             set_name(&sets()[self.set]),
-            self.param.name(),
+            self.param.name().to_string(),
             if self.param.dim() == 2 {
                 ["x", "y"][self.component]
             } else {
                 ""
-            },
-            self.truth,
-            self.scale,
+            }
+            .to_string(),
+            self.truth.to_string(),
+            self.scale.to_string(),
             opt(self.fisher_std),
             opt(self.relative_std()),
-            self.fisher_std.is_finite(),
-            self.set_identifiable,
+            self.fisher_std.is_finite().to_string(),
+            self.set_identifiable.to_string(),
             emp,
             fits,
             ratio,
@@ -489,11 +497,32 @@ impl Row {
             } else {
                 self.violated.join(";")
             },
-        )
+        ]
     }
 }
 
-const HEADER: &str = "sweep,speed_m_s,duration_s,segments,phi_rad,set,parameter,component,truth,scale,fisher_std,relative_std,identifiable,set_identifiable,empirical_std,fits,ratio,within_target,assumptions\n";
+/// The columns of `identifiability.csv`.
+const HEADER: [&str; 19] = [
+    "sweep",
+    "speed_m_s",
+    "duration_s",
+    "segments",
+    "phi_rad",
+    "set",
+    "parameter",
+    "component",
+    "truth",
+    "scale",
+    "fisher_std",
+    "relative_std",
+    "identifiable",
+    "set_identifiable",
+    "empirical_std",
+    "fits",
+    "ratio",
+    "within_target",
+    "assumptions",
+];
 
 impl Study {
     /// The names of the model's assumption checks that fail on `point`'s
@@ -661,12 +690,11 @@ pub fn run(scenarios: &Path, out: &Path, quick: bool) -> anyhow::Result<Outcome>
         files: Vec::new(),
     };
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let csv: String = std::iter::once(HEADER.to_string())
-        .chain(o.rows.iter().map(Row::csv))
-        .collect();
+    let mut csv = Csv::new(&HEADER);
+    o.rows.iter().for_each(|r| csv.row(&r.csv()));
     let svg = plot::render(&figure(&o)).context("drawing identifiability.svg")?;
     for (name, bytes) in [
-        ("identifiability.csv", csv.into_bytes()),
+        ("identifiability.csv", csv.as_bytes().to_vec()),
         ("identifiability.svg", svg.into_bytes()),
         ("fit.md", text(&study, &o, quick).into_bytes()),
     ] {
@@ -675,344 +703,6 @@ pub fn run(scenarios: &Path, out: &Path, quick: bool) -> anyhow::Result<Outcome>
         o.files.push(path);
     }
     Ok(o)
-}
-
-fn sweep_x(sweep: &str, p: &Point) -> f64 {
-    match sweep {
-        "speed" => p.speed,
-        "duration" => p.duration,
-        _ => p.segments as f64,
-    }
-}
-
-/// Whether `p` (a check point) lies on `sweep`'s line through the base push.
-fn on_sweep(sweep: &str, p: &Point) -> bool {
-    match sweep {
-        "speed" => p.duration == 2.0 && p.segments == 1,
-        "duration" => p.speed == 1.0 && p.segments == 1,
-        _ => p.speed == 1.0 && p.duration == 2.0,
-    }
-}
-
-fn figure(o: &Outcome) -> Figure {
-    let sweeps = [
-        ("speed", Axis::lin("push speed v_c (m/s); 2 s, one segment")),
-        (
-            "duration",
-            Axis::log("push duration (s); 1 m/s, one segment"),
-        ),
-        ("segments", Axis::lin("segments in 2 s at 1 m/s")),
-    ];
-    let color = |p: Param, k: usize| match (p, k) {
-        (Param::MuScale, _) => plot::BLUE_,
-        (Param::InertiaCm, _) => plot::RED_,
-        (_, 0) => plot::GREEN_,
-        _ => plot::PURPLE,
-    };
-    let mut top = Vec::new();
-    let mut bottom = Vec::new();
-    for (sweep, axis) in &sweeps {
-        let on: Vec<&Row> = o.rows.iter().filter(|r| r.point.sweep == *sweep).collect();
-        let (xlo, xhi) = on
-            .iter()
-            .map(|r| sweep_x(sweep, &r.point))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-                (a.min(x), b.max(x))
-            });
-        // The segment panels' curves are flat: room above them for the legend.
-        let (rel_axis, pos_axis) = if *sweep == "segments" {
-            (
-                Axis::log("Fisher std / value").range(1e-4, 1.0),
-                Axis::log("Fisher std (mm)").range(0.05, 10.0),
-            )
-        } else {
-            (
-                Axis::log("Fisher std / value"),
-                Axis::log("Fisher std (mm)"),
-            )
-        };
-        let mut rel = Panel::new(
-            format!("μ and I_cm: relative 1σ against {sweep}"),
-            axis.clone(),
-            rel_axis,
-        )
-        .legend(Legend::UpperRight);
-        let mut pos = Panel::new(
-            format!("contact / centre of friction: 1σ against {sweep}"),
-            axis.clone(),
-            pos_axis,
-        )
-        .legend(Legend::UpperRight);
-        // Curves: μ and I of the sets without and with the contact; the
-        // contact's and the centre of friction's components.
-        for (set, stroke, label) in [
-            (0usize, Stroke::Solid, "μ, I"),
-            (1, Stroke::Dashed, "μ, I, contact"),
-            (2, Stroke::Dashed, "μ, I, c.o.f."),
-        ] {
-            for (param, k) in Parametrised::slots_of(&sets()[set]) {
-                let vector = param.dim() == 2;
-                if !vector && set == 2 {
-                    continue;
-                }
-                let pts: Vec<(f64, f64)> = on
-                    .iter()
-                    .filter(|r| r.set == set && r.param == param && r.component == k)
-                    .filter(|r| r.set_identifiable)
-                    .map(|r| {
-                        let y = if vector {
-                            r.fisher_std * 1e3
-                        } else {
-                            r.relative_std()
-                        };
-                        (sweep_x(sweep, &r.point), y)
-                    })
-                    .collect();
-                if pts.is_empty() {
-                    continue;
-                }
-                let stroke = if vector && set == 1 {
-                    Stroke::Solid
-                } else {
-                    stroke
-                };
-                let s = Series::new(
-                    format!("{} ({label})", component_name(param, k)),
-                    color(param, k),
-                    stroke,
-                )
-                .points(pts);
-                if vector {
-                    pos = pos.series(s);
-                } else {
-                    rel = rel.series(s);
-                }
-            }
-        }
-        rel = rel
-            .series(
-                Series::new("μ target: 2σ ≤ 1 %", plot::BLUE_, Stroke::Dashed)
-                    .width(1)
-                    .points(vec![(xlo, MU_TARGET / SIGMAS), (xhi, MU_TARGET / SIGMAS)]),
-            )
-            .series(
-                Series::new("I target: 2σ ≤ 2 %", plot::RED_, Stroke::Dashed)
-                    .width(1)
-                    .points(vec![
-                        (xlo, INERTIA_TARGET / SIGMAS),
-                        (xhi, INERTIA_TARGET / SIGMAS),
-                    ]),
-            );
-        let checks: Vec<&Row> = o
-            .rows
-            .iter()
-            .filter(|r| r.point.sweep == "check" && on_sweep(sweep, &r.point))
-            .collect();
-        let emp = |vector: bool| -> Vec<(f64, f64)> {
-            checks
-                .iter()
-                .filter(|r| (r.param.dim() == 2) == vector)
-                .filter_map(|r| {
-                    let (e, _) = r.empirical?;
-                    let y = if vector { e * 1e3 } else { e / r.scale };
-                    Some((sweep_x(sweep, &r.point), y))
-                })
-                .collect()
-        };
-        for (vector, panel) in [(false, &mut rel), (true, &mut pos)] {
-            let pts = emp(vector);
-            if !pts.is_empty() {
-                *panel = panel.clone().series(
-                    Series::new(
-                        format!("std of {FITS} noisy fits"),
-                        plot::DARK,
-                        Stroke::Dots,
-                    )
-                    .points(pts),
-                );
-            }
-        }
-        top.push(rel);
-        bottom.push(pos);
-    }
-    let mut panels = top;
-    panels.extend(bottom);
-    Figure {
-        size: (1650, 1000),
-        cols: 3,
-        panels,
-        key: None,
-    }
-}
-
-/// `fit.md`: the settings, the answer, where each set is unidentifiable and
-/// the checks, every number from the rows.
-fn text(study: &Study, o: &Outcome, quick: bool) -> String {
-    let sc = &study.base;
-    let mut s = String::from(
-        "# Fitting μ, I_cm, the contact and the centre of friction: identifiability\n\n",
-    );
-    s += "Written by `pushval fit-study`";
-    if quick {
-        s += " (`--quick`: reduced grids)";
-    }
-    s += " from the numbers in `identifiability.csv`; the figure is `identifiability.svg`.\n\n";
-    s += &format!(
-        "Scene: `{}` ({} kg, I_cm = {:.6} kg m², μ = {}, {} supports, contact at ({}, {}) m), started moving with the pusher at ω = 0. \
-         Noise: {} mm on x and y, {} mrad on θ, every {} s sample. \
-         Fisher std: the diagonal of (JᵀJ)⁻¹ of the whitened residuals at the truth (the file's values), \
-         J by central differences (step {:e} of each parameter's scale), the model's DOP853 trajectory at tolerance {:e}. \
-         Relative std: std / value for μ (scale 1) and I_cm.\n\n",
-        sc.name,
-        sc.mass,
-        sc.inertia_cm,
-        sc.supports[0].mu,
-        sc.supports.len(),
-        sc.contact.x,
-        sc.contact.y,
-        SIGMA_POSITION * 1e3,
-        SIGMA_THETA * 1e3,
-        sc.sample_dt,
-        study.settings.fd_step,
-        study.settings.tolerance
-    );
-    s += "## The shortest push\n\n";
-    s += &format!(
-        "Question: the shortest single push (from the paper's start) that gives μ within {} % and I_cm within {} % at {}σ (Fisher std at the stated noise, fitting mu_scale and inertia_cm together).\n\n",
-        MU_TARGET * 100.0,
-        INERTIA_TARGET * 100.0,
-        SIGMAS
-    );
-    let answer = |(v, phi, d): (f64, f64, f64)| {
-        let mut rel = String::new();
-        for r in o
-            .rows
-            .iter()
-            .filter(|r| r.point.sweep == "shortest" && r.point.speed == v && r.point.phi == phi)
-        {
-            rel += &format!(
-                ", {} 2σ = {:.2} %",
-                r.param.name(),
-                100.0 * SIGMAS * r.relative_std()
-            );
-        }
-        format!(
-            "{d:.2} s at {v} m/s and φ = {phi:.4} rad (φ − π/4 = {:+.2} rad){rel}",
-            phi - FRAC_PI_4
-        )
-    };
-    match o.best(true) {
-        Some(b) => {
-            s += &format!(
-                "**Answer: {}**, the shortest of the pushes on which the model's assumptions hold (pushing only, no contact slip at the file's contact μ, every support sliding); searched over the speeds and angles below in steps of one sample ({} s).\n\n",
-                answer(b),
-                sc.sample_dt
-            );
-        }
-        None => s += "**Answer: none of the candidates on which the model's assumptions hold reaches both targets within the longest duration searched.**\n\n",
-    }
-    if let Some(b) = o.best(false).filter(|b| Some(*b) != o.best(true)) {
-        s += &format!(
-            "Ignoring the assumption checks, the shortest would be {} — but there the model itself is not to be trusted.\n\n",
-            answer(b)
-        );
-    }
-    s += "| speed (m/s) | φ (rad) | shortest duration (s) | failing assumption checks on it |\n|---|---|---|---|\n";
-    for c in &o.shortest {
-        let d = c
-            .duration
-            .map_or("> longest searched".to_string(), |d| format!("{d:.2}"));
-        let v = if c.duration.is_none() {
-            "".to_string()
-        } else if c.violated.is_empty() {
-            "none".to_string()
-        } else {
-            c.violated.join(", ")
-        };
-        s += &format!("| {} | {:.4} | {d} | {v} |\n", c.speed, c.phi);
-    }
-    s += "\n## Where a set is unidentifiable\n\n";
-    s += "By the rules of `pushval fit` (information below 1e-10 of the largest, a direction with eigenvalue below 1e-10 of the largest, or a Fisher std above 1e3 × the scale):\n\n";
-    for (set, params) in sets().iter().enumerate() {
-        for sweep in ["speed", "duration", "segments"] {
-            let mut xs: Vec<f64> = Vec::new();
-            let mut names: Vec<&str> = Vec::new();
-            for r in o
-                .rows
-                .iter()
-                .filter(|r| r.point.sweep == sweep && r.set == set)
-            {
-                if !r.fisher_std.is_finite() {
-                    let x = sweep_x(sweep, &r.point);
-                    if !xs.contains(&x) {
-                        xs.push(x);
-                    }
-                    if !names.contains(&r.param.name()) {
-                        names.push(r.param.name());
-                    }
-                }
-            }
-            let what = if xs.is_empty() {
-                "identifiable everywhere".to_string()
-            } else {
-                format!(
-                    "{} unidentifiable at {sweep} = {}",
-                    names.join(", "),
-                    xs.iter()
-                        .map(|x| format!("{x}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            };
-            s += &format!("- {} against {sweep}: {what}\n", set_name(params));
-        }
-    }
-    s += "\n## Fisher std against repeated noisy fits\n\n";
-    s += &format!(
-        "At each check point, {FITS} fits to the exact trajectory plus fresh noise (fixed seeds), started off the truth (μ × 0.9, I × 1.15, vector parameters + 5 mm in x and y). \
-         The empirical std of the estimates (about their mean) must lie within a factor {AGREEMENT} of the Fisher std either way: with {FITS} fits a normal estimate's sample std falls outside that about 0.1 % of the time.\n\n"
-    );
-    s += "| push | parameters | component | Fisher std | empirical std | ratio | within |\n|---|---|---|---|---|---|---|\n";
-    for c in &o.checks {
-        let push = format!(
-            "{} m/s, {} s, {} segment(s), φ₁ = {:.4}",
-            c.point.speed, c.point.duration, c.point.segments, c.point.phi
-        );
-        let mut j = 0;
-        for p in &c.set {
-            for k in 0..p.dim() {
-                let r = c.empirical[j] / c.fisher[j];
-                s += &format!(
-                    "| {push} | {} | {} | {:.3e} | {:.3e} | {:.2} | {} |\n",
-                    set_name(&c.set),
-                    component_name(*p, k),
-                    c.fisher[j],
-                    c.empirical[j],
-                    r,
-                    if (1.0 / AGREEMENT..=AGREEMENT).contains(&r) {
-                        "yes"
-                    } else {
-                        "NO"
-                    }
-                );
-                j += 1;
-            }
-        }
-        if c.failed > 0 {
-            s += &format!(
-                "| {push} | {} | {} of {} fits did not converge | | | | NO |\n",
-                set_name(&c.set),
-                c.failed,
-                c.fits
-            );
-        }
-    }
-    s += &format!(
-        "\n{} of {} checks pass.\n",
-        o.checks.iter().filter(|c| c.pass()).count(),
-        o.checks.len()
-    );
-    s
 }
 
 /// `pushval fit-study`: runs the study on the shipped scenarios, prints the
