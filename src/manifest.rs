@@ -465,7 +465,10 @@ pub fn csv(rows: &[Row]) -> String {
 /// Reads a manifest's rows; errors name the file and the line.
 pub fn parse(text: &str, file: &Path) -> anyhow::Result<Vec<Row>> {
     let mut reader = csv::Reader::from_reader(text.as_bytes());
-    if !reader.headers().is_ok_and(|h| h.iter().eq(["path", "command"])) {
+    if !reader
+        .headers()
+        .is_ok_and(|h| h.iter().eq(["path", "command"]))
+    {
         bail!(
             "{}: line 1: expected the header `path,command`",
             file.display()

@@ -71,7 +71,6 @@ pub fn num(row: &Row, key: &str) -> f64 {
     cell(row, key).parse().unwrap_or(f64::NAN)
 }
 
-
 fn fmt_e(v: f64, digits: usize) -> String {
     if v.is_finite() {
         format!("{v:.digits$e}")

@@ -6,9 +6,10 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::fit;
-use super::plan::{class_name, law_integrates, Plan, Task, LAW_RUN, LOADS};
+use super::plan::{class_name, Plan, Task, LAW_RUN, LOADS};
 use super::plate::{err, froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
+use crate::fit::engine as fit;
+use crate::harness::law::law_integrates;
 use crate::outdir::{field_num as num, records, Csv, Records, Writer};
 
 /// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
@@ -17,22 +18,12 @@ use crate::outdir::{field_num as num, records, Csv, Records, Writer};
 pub fn map_stats(map: &Records) -> [usize; 9] {
     let mut s = [0; 9];
     for r in map {
-        let (we, wc, wl) = (
-            num(r, "omega_engine"),
-            num(r, "omega_coulomb"),
-            num(r, "omega_law"),
-        );
-        let speed = (num(r, "froude") / froude(1.0)).sqrt();
+        let [ec, el, er] = cell_errors(r);
         s[0] += 1;
-        s[1] += usize::from(err(we, wc, wc, speed) <= 1e-2);
-        if wl.is_finite() {
-            s[2] += 1;
-            s[3] += usize::from(err(we, wl, wc, speed) <= 1e-2);
-        }
-        let wr = num(r, "omega_law_run");
-        if wr.is_finite() {
-            s[7] += 1;
-            s[8] += usize::from(err(we, wr, wc, speed) <= 1e-2);
+        s[1] += usize::from(ec.is_some_and(|e| e <= 1e-2));
+        for (e, k) in [(el, 2), (er, 7)] {
+            s[k] += usize::from(e.is_some());
+            s[k + 1] += usize::from(e.is_some_and(|e| e <= 1e-2));
         }
         match r.get("class").map(String::as_str) {
             Some("turns") => s[4] += 1,
@@ -42,6 +33,19 @@ pub fn map_stats(map: &Records) -> [usize; 9] {
         }
     }
     s
+}
+
+/// A map cell's errors against Coulomb, the law with the problem's loads
+/// and the law on the run's own loads (None where the file has no law ω,
+/// an absent column or a blank cell): relative with the gate's floor, or
+/// |ω|/|ω*| where the reference locks (NaN where the engine's ω is).
+pub fn cell_errors(r: &std::collections::BTreeMap<String, String>) -> [Option<f64>; 3] {
+    let speed = (num(r, "froude") / froude(1.0)).sqrt();
+    let (we, wc) = (num(r, "omega_engine"), num(r, "omega_coulomb"));
+    ["omega_coulomb", "omega_law", "omega_law_run"].map(|k| match num(r, k) {
+        w if w.is_finite() || k == "omega_coulomb" => Some(err(we, w, wc, speed)),
+        _ => None,
+    })
 }
 
 fn pct(a: usize, b: usize) -> String {
@@ -146,13 +150,23 @@ fn law_run_fields(r: &[f64]) -> impl Iterator<Item = String> + '_ {
 
 fn map_csv(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], setup: usize) -> Csv {
     let mut csv = Csv::new(&head(
-        &["froude", "phi", "omega_engine", "omega_coulomb", "omega_law", "class"],
+        &[
+            "froude",
+            "phi",
+            "omega_engine",
+            "omega_coulomb",
+            "omega_law",
+            "class",
+        ],
         &LAW_RUN_HEAD,
     ));
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Map { s: k, i, j } = *t {
             if k == setup {
-                let mut f = vec![frs(plan.quick)[i].to_string(), phis(plan.quick)[j].to_string()];
+                let mut f = vec![
+                    frs(plan.quick)[i].to_string(),
+                    phis(plan.quick)[j].to_string(),
+                ];
                 f.extend(run_fields(r));
                 f.push(class_name(r[3]).into());
                 f.extend(law_run_fields(r));
@@ -184,16 +198,24 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     w.file("paper_plate.csv", paper.as_bytes())?;
     let map = map_csv(plan, tasks, rows, 0);
     w.file("map.csv", map.as_bytes())?;
-    w.figure("map.svg", &super::figure::map_figure(&plan.model, map.text())?)?;
+    w.figure(
+        "map.svg",
+        &super::figure::map_figure(&plan.model, map.text())?,
+    )?;
 
     // The step ladder: change from the next coarser step, the observed
     // order from three steps, Richardson at the declared order.
     let p = plan.setups[0].engine.order();
     // The ladder's step ratio (2 for the default ladders).
     let ratio = plan.ladder[0] / plan.ladder[1];
-    let ladder_csv = |sel: &dyn Fn(&Task) -> bool, lead: &dyn Fn(&Task) -> Vec<String>, first: &[&'static str]| {
+    let ladder_csv = |sel: &dyn Fn(&Task) -> bool,
+                      lead: &dyn Fn(&Task) -> Vec<String>,
+                      first: &[&'static str]| {
         let tail = ["change", "observed_order", "richardson"];
-        let mut csv = Csv::new(&head(&head(&head(first, &["dt"]), &RUN_HEAD), &head(&["class"], &tail)));
+        let mut csv = Csv::new(&head(
+            &head(&head(first, &["dt"]), &RUN_HEAD),
+            &head(&["class"], &tail),
+        ));
         let rs = rows_of(sel);
         for (n, (t, r)) in rs.iter().enumerate() {
             let same = |m: usize| n >= m && lead(&rs[n - m].0) == lead(t);
@@ -446,7 +468,9 @@ fn rest_moments(
     rows: &[Vec<f64>],
     w: &mut Writer,
 ) -> anyhow::Result<String> {
-    let mut csv = Csv::new(&["variant", "froude", "phi", "class", "moment", "lock", "hold"]);
+    let mut csv = Csv::new(&[
+        "variant", "froude", "phi", "class", "moment", "lock", "hold",
+    ]);
     let (mut semi, mut cells) = (0usize, 0usize);
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Map { s, i, j } = *t {
@@ -527,9 +551,7 @@ fn readme(
     }
     // A law with dynamics is integrated along the run's loads where the
     // engine measured them (the rows' rise), else taken quasi-statically.
-    let integrated = paper
-        .iter()
-        .any(|r| num(r, "max_rise_m").is_finite())
+    let integrated = paper.iter().any(|r| num(r, "max_rise_m").is_finite())
         && e.law().is_some_and(|l| {
             let p = super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None);
             law_integrates(l, &p, 0, plan.dt)
@@ -602,7 +624,11 @@ fn readme(
     };
     map_section("", "map.csv", &map);
     for (n, t) in variant_maps {
-        map_section(&format!(", variant {n}"), &format!("map_{n}.csv"), &records(t)?);
+        map_section(
+            &format!(", variant {n}"),
+            &format!("map_{n}.csv"),
+            &records(t)?,
+        );
     }
     let ladder_table = |s: &mut String, rows: &Records| {
         s.push_str("| v_c | Δt (s) | ω engine | change | observed order | Richardson |\n|---|---|---|---|---|---|\n");

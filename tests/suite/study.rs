@@ -891,7 +891,8 @@ fn whole_period_tails_give_the_period_mean() {
     let p = problem(0.5, 1.0, 10.0, None);
     let exact = c * (1.0 - a * a).sqrt();
     let whole =
-        pushval::study::whole_period_omega(&p, &traj, 0.75, std::f64::consts::FRAC_PI_2).unwrap();
+        pushval::harness::law::whole_period_omega(&p, &traj, 0.75, std::f64::consts::FRAC_PI_2)
+            .unwrap();
     assert!((whole - exact).abs() < 1e-4 * exact, "{whole} vs {exact}");
     let plain = pushval_engine::tail_mean_omega(&p, &traj, 0.75)[0].unwrap();
     assert!(
@@ -899,7 +900,7 @@ fn whole_period_tails_give_the_period_mean() {
         "plain {plain}, whole {whole}, exact {exact}"
     );
     // Less than one period in the tail: no whole-period mean.
-    assert!(pushval::study::whole_period_omega(&p, &traj, 0.05, 2.0).is_none());
+    assert!(pushval::harness::law::whole_period_omega(&p, &traj, 0.05, 2.0).is_none());
 }
 
 /// The law on a run's loads, integrated in time: fed the analytic model's
@@ -944,7 +945,7 @@ fn the_law_integrated_on_a_runs_loads_follows_its_transient() {
             diagnostics: serde_json::json!({}),
             contact: Some(contact.clone()),
         };
-        pushval::study::law_on_run_loads(law, &p, 0, 1e-3, 1.0, &run, &contact)
+        pushval::harness::law::law_on_run_loads(law, &p, 0, 1e-3, 1.0, &run, &contact)
     };
     let traj = crate::common::run(&model, &p);
     let w_star = coulomb(&p).abs();

@@ -51,9 +51,23 @@ pub(super) fn cost(grid: &Grid) -> anyhow::Result<Csv> {
         let plain = times(false);
         let full = times(true);
         let q = |v: &[f64], f: f64| v[((v.len() - 1) as f64 * f).round() as usize] * 1e6;
-        let mut f = vec![method.name().to_string(), rate.to_string(), plain.len().to_string()];
-        let us = [q(&plain, 0.5), q(&plain, 0.99), q(&plain, 1.0), q(&full, 0.5), q(&full, 0.99)];
-        f.extend(us.into_iter().chain([overhead * 1e6]).map(|v| format!("{v:.3}")));
+        let mut f = vec![
+            method.name().to_string(),
+            rate.to_string(),
+            plain.len().to_string(),
+        ];
+        let us = [
+            q(&plain, 0.5),
+            q(&plain, 0.99),
+            q(&plain, 1.0),
+            q(&full, 0.5),
+            q(&full, 0.99),
+        ];
+        f.extend(
+            us.into_iter()
+                .chain([overhead * 1e6])
+                .map(|v| format!("{v:.3}")),
+        );
         csv.row(&f);
     }
     Ok(csv)
@@ -162,7 +176,13 @@ pub(super) fn convergence(grid: &Grid) -> anyhow::Result<(Vec<ConvRow>, Csv)> {
             r.times.len().to_string(),
         ];
         fields.extend((0..4).map(|k| f(col(k))));
-        fields.push(r.times.iter().filter(|t| t[3].is_some()).count().to_string());
+        fields.push(
+            r.times
+                .iter()
+                .filter(|t| t[3].is_some())
+                .count()
+                .to_string(),
+        );
         fields.extend((0..3).map(|k| format!("{:.3e}", rms(k))));
         csv.row(&fields);
     }

@@ -52,8 +52,8 @@ use rayon::prelude::*;
 
 use super::{thread_cpu_time, track_model};
 use crate::atomic::write_atomic;
-use crate::outdir::{records, Csv};
 use crate::fit::{fisher_at, noise, Param, Parametrised, Settings};
+use crate::outdir::{records, Csv};
 use crate::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
 /// The broad prior of [`Method::EkfBroadPrior`].
@@ -279,7 +279,6 @@ fn settled(hist: &[(f64, [f64; 4], [f64; 4])], f: impl Fn(&[f64; 4]) -> bool) ->
     }
     at
 }
-
 
 /// `pushval track-study`.
 pub fn cli(out: &Path, quick: bool) -> anyhow::Result<std::process::ExitCode> {

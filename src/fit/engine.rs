@@ -1,7 +1,8 @@
-//! Which Coulomb parameters an engine behaves as (`coulomb_fit.csv`): the
-//! dynamic model fitted to the engine's trajectory by `pushval fit`'s
-//! machinery ([`crate::fit`], Levenberg–Marquardt), and whether the fit
-//! explains the engine.
+//! Which Coulomb parameters an engine behaves as: the dynamic model fitted
+//! to an engine's trajectory by `pushval fit`'s machinery (Levenberg–
+//! Marquardt), and whether the fit explains the engine. A fit of an engine
+//! is a fit like any other, so it lives here; `pushval study` runs it as
+//! one of its tasks and writes its rows as `coulomb_fit.csv`.
 //!
 //! Two schedules of the paper plate, read from the shipped scenarios (the
 //! binary's, whatever folder the study runs in):
@@ -25,7 +26,7 @@
 use pushval_engine::Engine;
 use pushval_model::{DynamicModel, Sample, Simulator};
 
-use crate::fit::{fisher_at, fit, Param, Parametrised, Settings};
+use super::{fisher_at, fit, Param, Parametrised, Settings};
 
 /// The scenario files of the schedules, single push first.
 pub const SCHEDULES: [&str; 2] = ["friction-engines.toml", "paper-square-v1.0.toml"];
