@@ -466,7 +466,7 @@ pub fn read_csv(path: &Path) -> anyhow::Result<Vec<Row>> {
     let col = |name: &str| {
         header
             .iter()
-            .position(|h| *h == name)
+            .position(|h| h == name)
             .with_context(|| format!("{}: line 1: no column `{name}`", path.display()))
     };
     let (isc, ien, iki, ipl, imi, ico, itp, itt, ito, idt, iwa, ili) = (

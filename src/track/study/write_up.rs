@@ -1,6 +1,9 @@
 //! `track.svg` and `track.md`, every number from the stages' rows and
 //! files.
 
+use super::engines::EngineRow;
+use super::measure::{median_opt, ConvRow, EffRow};
+use super::step::StepRow;
 use super::*;
 
 // -------------------------------------------------------------- figure
