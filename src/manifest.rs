@@ -99,7 +99,7 @@ pub const RULES: &[Rule] = &[
     },
     Rule {
         command: "pushval fit-study",
-        source: "src/fit/study.rs",
+        source: "src/fit/study",
         files: &[
             "results/identifiability.csv",
             "results/identifiability.svg",
@@ -108,7 +108,7 @@ pub const RULES: &[Rule] = &[
     },
     Rule {
         command: "pushval track-study",
-        source: "src/track/study.rs",
+        source: "src/track/study",
         files: &[
             "results/track_cost.csv",
             "results/track_convergence.csv",

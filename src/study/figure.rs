@@ -9,7 +9,7 @@
 
 use plotters::style::RGBColor;
 
-use super::readme::cell_errors;
+use super::plate::{err, froude};
 use crate::outdir::{field_num as num, records};
 use crate::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, GREY, PURPLE};
 
@@ -41,6 +41,19 @@ fn grid(mut v: Vec<f64>) -> Vec<f64> {
     v.sort_by(f64::total_cmp);
     v.dedup();
     v
+}
+
+/// A map cell's errors against Coulomb, the law with the problem's loads
+/// and the law on the run's own loads (None where the file has no law ω,
+/// an absent column or a blank cell): relative with the gate's floor, or
+/// |ω|/|ω*| where the reference locks (NaN where the engine's ω is).
+pub fn cell_errors(r: &std::collections::BTreeMap<String, String>) -> [Option<f64>; 3] {
+    let speed = (num(r, "froude") / froude(1.0)).sqrt();
+    let (we, wc) = (num(r, "omega_engine"), num(r, "omega_coulomb"));
+    ["omega_coulomb", "omega_law", "omega_law_run"].map(|k| match num(r, k) {
+        w if w.is_finite() || k == "omega_coulomb" => Some(err(we, w, wc, speed)),
+        _ => None,
+    })
 }
 
 /// The figure of `map.csv`'s text (columns froude, phi, omega_engine,

@@ -6,8 +6,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
+use super::figure::cell_errors;
 use super::plan::{class_name, Plan, Task, LAW_RUN, LOADS};
-use super::plate::{err, froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
+use super::plate::{err, frs, phis, PHI_TABLE, TABLE_SPEEDS};
 use crate::fit::engine as fit;
 use crate::harness::law::law_integrates;
 use crate::outdir::{field_num as num, records, Csv, Records, Writer};
@@ -33,19 +34,6 @@ pub fn map_stats(map: &Records) -> [usize; 9] {
         }
     }
     s
-}
-
-/// A map cell's errors against Coulomb, the law with the problem's loads
-/// and the law on the run's own loads (None where the file has no law ω,
-/// an absent column or a blank cell): relative with the gate's floor, or
-/// |ω|/|ω*| where the reference locks (NaN where the engine's ω is).
-pub fn cell_errors(r: &std::collections::BTreeMap<String, String>) -> [Option<f64>; 3] {
-    let speed = (num(r, "froude") / froude(1.0)).sqrt();
-    let (we, wc) = (num(r, "omega_engine"), num(r, "omega_coulomb"));
-    ["omega_coulomb", "omega_law", "omega_law_run"].map(|k| match num(r, k) {
-        w if w.is_finite() || k == "omega_coulomb" => Some(err(we, w, wc, speed)),
-        _ => None,
-    })
 }
 
 fn pct(a: usize, b: usize) -> String {

@@ -972,10 +972,11 @@ fn the_law_integrated_on_a_runs_loads_follows_its_transient() {
     );
 }
 
-/// Issue 45, item 7: a project made by `pushval init` holds every shipped
-/// study file, also those of engines its registry does not run (Drake,
-/// PyBullet, …); `study` passes over those in silence, and still notes a
-/// study file the user wrote for a model the registry lacks.
+/// Issue 45, item 7: a project's study files are its `studies/`, else the
+/// shipped ones, among them those of engines its registry does not run
+/// (Drake, PyBullet, …); `study` passes over every shipped file it does not
+/// use in silence, and still notes a study file the user wrote, or changed,
+/// for a model the registry lacks.
 #[test]
 fn study_is_quiet_about_shipped_files_a_project_does_not_use() {
     let (dir, tmp, cache) = (
@@ -984,7 +985,7 @@ fn study_is_quiet_about_shipped_files_a_project_does_not_use() {
         tempfile::tempdir().unwrap(),
     );
     let run = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_pushval"))
+        let out = Command::new(env!("CARGO_BIN_EXE_pushval"))
             .current_dir(dir.path())
             .args(args)
             .env("CI", "1")
@@ -992,32 +993,48 @@ fn study_is_quiet_about_shipped_files_a_project_does_not_use() {
             .env("XDG_CACHE_HOME", cache.path())
             .env_remove("SLURM_ARRAY_TASK_ID")
             .output()
-            .unwrap()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(out.status.success(), "{err}");
+        err
     };
-    ok(run(&["init"]));
+    let skipped = |err: &str| -> Vec<String> {
+        err.lines()
+            .filter(|l| l.contains("skipping"))
+            .map(String::from)
+            .collect()
+    };
+    ok(Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .current_dir(dir.path())
+        .arg("init")
+        .env("TMPDIR", tmp.path())
+        .env("XDG_CACHE_HOME", cache.path())
+        .output()
+        .unwrap());
+    // The premise: a shipped study file of a model this project lacks.
+    let engines = run(&["engines"]);
+    let unused = "pybullet_contact";
+    let shipped = pushval::shipped::study_text(unused).expect("shipped");
+    assert!(!engines.contains(unused), "{engines}");
+    // The shipped files (no studies/ folder): nothing to say.
+    let err = run(&["study", "index", "--quick", "--out", "out"]);
+    assert!(skipped(&err).is_empty(), "{err}");
+    // A studies/ folder with a shipped file as shipped, and the user's own.
     let studies = dir.path().join("studies");
-    // The premise: the project holds shipped study files of models its
-    // registry does not list.
-    let models = String::from_utf8_lossy(&run(&["engines"]).stdout).to_string();
-    let unused: Vec<String> = std::fs::read_dir(&studies)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .map(|p| p.file_stem().unwrap().to_string_lossy().to_string())
-        .filter(|m| !models.contains(m.as_str()))
-        .collect();
-    assert!(!unused.is_empty(), "every shipped study is used: {models}");
+    std::fs::create_dir(&studies).unwrap();
+    std::fs::write(studies.join(format!("{unused}.toml")), shipped).unwrap();
     std::fs::write(studies.join("my_own_engine.toml"), "t_run = 2.0\n").unwrap();
-    let out = run(&["study", "index", "--quick", "--out", "out"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    let skipped: Vec<&str> = err.lines().filter(|l| l.contains("skipping")).collect();
-    assert_eq!(skipped.len(), 1, "{err}");
-    assert!(skipped[0].contains("my_own_engine.toml"), "{err}");
+    let err = run(&["study", "index", "--quick", "--out", "out"]);
+    let lines = skipped(&err);
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(lines[0].contains("my_own_engine.toml"), "{err}");
     // A shipped file the user changed is theirs: noted like any other.
-    let changed = studies.join(format!("{}.toml", unused[0]));
-    let text = std::fs::read_to_string(&changed).unwrap();
-    std::fs::write(&changed, format!("{text}\n# mine now\n")).unwrap();
-    let err = String::from_utf8_lossy(&run(&["study", "index", "--quick", "--out", "out"]).stderr)
-        .to_string();
-    assert!(err.contains(&format!("{}.toml", unused[0])), "{err}");
+    std::fs::write(
+        studies.join(format!("{unused}.toml")),
+        format!("{shipped}\n# mine now\n"),
+    )
+    .unwrap();
+    let err = run(&["study", "index", "--quick", "--out", "out"]);
+    assert_eq!(skipped(&err).len(), 2, "{err}");
+    assert!(err.contains(&format!("{unused}.toml")), "{err}");
 }

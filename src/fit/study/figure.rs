@@ -1,7 +1,7 @@
 //! `identifiability.svg`: the Fisher std of every parameter along each
 //! sweep, from the study's rows.
 
-use super::*;
+use super::analysis::*;
 
 pub(super) fn sweep_x(sweep: &str, p: &Point) -> f64 {
     match sweep {

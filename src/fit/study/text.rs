@@ -1,8 +1,8 @@
 //! `fit.md`: the settings, the answer, where each set is unidentifiable
 //! and the checks, every number from the rows.
 
+use super::analysis::*;
 use super::figure::sweep_x;
-use super::*;
 
 /// `fit.md`: the settings, the answer, where each set is unidentifiable and
 /// the checks, every number from the rows.

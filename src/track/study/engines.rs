@@ -1,7 +1,7 @@
 //! The filter run on every engine of the build (and the dynamic model):
 //! lack-of-fit episodes and the apparent parameters at each segment's end.
 
-use super::*;
+use super::setup::*;
 
 #[derive(Debug, Clone)]
 pub(super) struct EngineRow {

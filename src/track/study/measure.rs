@@ -2,7 +2,7 @@
 //! converge against noise and rate, and the efficiency against the
 //! Cramér–Rao bound.
 
-use super::*;
+use super::setup::*;
 
 // ---------------------------------------------------------------- cost
 

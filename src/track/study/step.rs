@@ -1,7 +1,7 @@
 //! μ stepping by +20 % mid-push: when the lack-of-fit test fires and when
 //! the estimate follows, with and without re-opening.
 
-use super::*;
+use super::setup::*;
 
 /// The 1 m/s push with μ × (1 + [`STEP`]) from [`STEP_AT`] on, sampled at
 /// `rate`: the first part's end state starts the second part.

@@ -3,8 +3,8 @@
 
 use super::engines::EngineRow;
 use super::measure::{median_opt, ConvRow, EffRow};
+use super::setup::*;
 use super::step::StepRow;
-use super::*;
 
 // -------------------------------------------------------------- figure
 
