@@ -559,11 +559,11 @@ fn readme(
     );
     for r in &paper {
         let (v, we, wc, wl, wr) = (
-            num(&r, "speed"),
-            num(&r, "omega_engine"),
-            num(&r, "omega_coulomb"),
-            num(&r, "omega_law"),
-            num(&r, "omega_law_run"),
+            num(r, "speed"),
+            num(r, "omega_engine"),
+            num(r, "omega_coulomb"),
+            num(r, "omega_law"),
+            num(r, "omega_law_run"),
         );
         let _ = writeln!(
             s,
@@ -575,10 +575,10 @@ fn readme(
             sig(err(we, wl, wc, v)),
             sig(wr),
             sig(err(we, wr, wc, v)),
-            sig(num(&r, "law_run_rms")),
-            sig(num(&r, "max_rise_m")),
-            share(num(&r, "contact_lost_share")),
-            load_range(&r)
+            sig(num(r, "law_run_rms")),
+            sig(num(r, "max_rise_m")),
+            share(num(r, "contact_lost_share")),
+            load_range(r)
         );
     }
     let mut map_section = |name: &str, file: &str, map: &Records| {
@@ -625,15 +625,15 @@ fn readme(
             let _ = writeln!(
                 s,
                 "| {v} | {} | {} | {} | {} | {} |",
-                num(&r, "dt"),
-                sig(num(&r, "omega_engine")),
-                sig(num(&r, "change")),
-                if num(&r, "observed_order").is_finite() {
-                    format!("{:.2}", num(&r, "observed_order"))
+                num(r, "dt"),
+                sig(num(r, "omega_engine")),
+                sig(num(r, "change")),
+                if num(r, "observed_order").is_finite() {
+                    format!("{:.2}", num(r, "observed_order"))
                 } else {
                     "–".into()
                 },
-                sig(num(&r, "richardson"))
+                sig(num(r, "richardson"))
             );
         }
     };
@@ -659,13 +659,13 @@ fn readme(
                 r["phi"],
                 r["dt"],
                 r["speed"],
-                sig(num(&r, "omega_engine")),
-                sig(num(&r, "omega_coulomb")),
-                sig(num(&r, "omega_law")),
+                sig(num(r, "omega_engine")),
+                sig(num(r, "omega_coulomb")),
+                sig(num(r, "omega_law")),
                 r["class"],
-                sig(num(&r, "omega_law_run")),
-                load_range(&r),
-                sig(num(&r, "theta_end"))
+                sig(num(r, "omega_law_run")),
+                load_range(r),
+                sig(num(r, "theta_end"))
             );
         }
     }
@@ -678,9 +678,9 @@ fn readme(
                 "| {} | {} | {} | {} | {} | {} |",
                 r["schedule"],
                 r["fitted"],
-                sig(num(&r, "mu_scale")),
-                sig(num(&r, "position_rms")),
-                sig(num(&r, "theta_rms")),
+                sig(num(r, "mu_scale")),
+                sig(num(r, "position_rms")),
+                sig(num(r, "theta_rms")),
                 if r["reason"].is_empty() {
                     r["verdict"].to_string()
                 } else {
