@@ -15,7 +15,7 @@ use std::f64::consts::FRAC_PI_4;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use pushval::study::creep_law::{markdown, CSV_COLUMNS};
+use pushval::report::creep_law::{markdown, CSV_COLUMNS};
 use pushval_mujoco::creep::{
     hold_time, measure, CreepCase, CreepRegime, CreepScene, SLIDING_SPEED,
 };
@@ -159,7 +159,7 @@ fn ladder() -> Vec<Cell> {
     cells
 }
 
-fn row(c: &Cell) -> Result<String, String> {
+fn row(c: &Cell) -> Result<[String; 25], String> {
     let s = &c.scene.settings;
     let hold = hold_time(c.case, c.load, c.scene.mu, s.gravity);
     let m = measure(&c.scene, c.case, c.load, c.direction, hold).map_err(|e| {
@@ -215,8 +215,7 @@ fn row(c: &Cell) -> Result<String, String> {
         e(p.penetration, 4),
         format!("{:.6}", p.impedance),
         e(pushval_mujoco::creep::slip_scale(&input), 6),
-    ]
-    .join(","))
+    ])
 }
 
 fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
@@ -242,17 +241,15 @@ fn run() -> Result<(), String> {
     }
     let cells = ladder();
     let start = std::time::Instant::now();
-    let mut csv = CSV_COLUMNS.join(",");
-    csv.push('\n');
+    let mut csv = pushval::outdir::Csv::new(&CSV_COLUMNS);
     for (i, c) in cells.iter().enumerate() {
-        csv += &row(c)?;
-        csv.push('\n');
+        csv.row(&row(c)?);
         if (i + 1) % 50 == 0 {
             eprintln!("creep_law: {}/{} runs", i + 1, cells.len());
         }
     }
-    let md = markdown(&csv)?;
-    write_atomic(&out.join("creep_law.csv"), &csv)?;
+    let md = markdown(csv.text())?;
+    write_atomic(&out.join("creep_law.csv"), csv.text())?;
     write_atomic(&out.join("creep_law.md"), &md)?;
     eprintln!(
         "creep_law: {} runs in {:.1} s; wrote {}/creep_law.csv and creep_law.md",

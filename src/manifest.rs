@@ -25,7 +25,6 @@
 //! with the evidence, until they are deleted.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -100,7 +99,7 @@ pub const RULES: &[Rule] = &[
     },
     Rule {
         command: "pushval fit-study",
-        source: "src/fit/study.rs",
+        source: "src/fit/study",
         files: &[
             "results/identifiability.csv",
             "results/identifiability.svg",
@@ -109,7 +108,7 @@ pub const RULES: &[Rule] = &[
     },
     Rule {
         command: "pushval track-study",
-        source: "src/track/study.rs",
+        source: "src/track/study",
         files: &[
             "results/track_cost.csv",
             "results/track_convergence.csv",
@@ -331,7 +330,7 @@ fn matches(pattern: &str, path: &str, models: &[String]) -> Option<Option<String
 }
 
 /// One row of the manifest.
-#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, serde::Deserialize)]
 pub struct Row {
     pub path: String,
     pub command: String,
@@ -453,74 +452,40 @@ impl Walk {
     }
 }
 
-/// One CSV field, quoted when it holds a comma, a quote or a line break.
-fn field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
-/// The manifest's text.
+/// The manifest's text (a field is quoted where it holds a comma, a quote
+/// or a line break).
 pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from("path,command\n");
+    let mut csv = crate::outdir::Csv::new(&["path", "command"]);
     for r in rows {
-        let _ = writeln!(s, "{},{}", field(&r.path), field(&r.command));
+        csv.row(&[&r.path, &r.command]);
     }
-    s
-}
-
-/// Splits one CSV line into fields (RFC 4180 quotes); `None` on an open quote.
-fn split_line(line: &str) -> Option<Vec<String>> {
-    let mut out = Vec::new();
-    let mut cur = String::new();
-    let mut chars = line.chars().peekable();
-    let mut quoted = false;
-    while let Some(c) = chars.next() {
-        match (quoted, c) {
-            (true, '"') if chars.peek() == Some(&'"') => {
-                cur.push('"');
-                chars.next();
-            }
-            (true, '"') => quoted = false,
-            (false, '"') if cur.is_empty() => quoted = true,
-            (false, ',') => out.push(std::mem::take(&mut cur)),
-            _ => cur.push(c),
-        }
-    }
-    if quoted {
-        return None;
-    }
-    out.push(cur);
-    Some(out)
+    csv.text().to_string()
 }
 
 /// Reads a manifest's rows; errors name the file and the line.
 pub fn parse(text: &str, file: &Path) -> anyhow::Result<Vec<Row>> {
-    let mut lines = text.lines().enumerate();
-    match lines.next() {
-        Some((_, "path,command")) => {}
-        _ => bail!(
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    if !reader
+        .headers()
+        .is_ok_and(|h| h.iter().eq(["path", "command"]))
+    {
+        bail!(
             "{}: line 1: expected the header `path,command`",
             file.display()
-        ),
+        );
     }
-    let mut rows = Vec::new();
-    for (i, line) in lines {
-        match split_line(line).as_deref() {
-            Some([p, c]) => rows.push(Row {
-                path: p.clone(),
-                command: c.clone(),
-            }),
-            _ => bail!(
-                "{}: line {}: expected two fields, path and command",
-                file.display(),
-                i + 1
-            ),
-        }
-    }
-    Ok(rows)
+    reader
+        .deserialize()
+        .map(|r| {
+            r.map_err(|e| {
+                let line = e.position().map_or(0, |p| p.line());
+                anyhow::anyhow!(
+                    "{}: line {line}: expected two fields, path and command ({e})",
+                    file.display()
+                )
+            })
+        })
+        .collect()
 }
 
 /// The command a generated text file names in its first lines: "Generated

@@ -18,7 +18,7 @@ pub struct Writer {
     written: Vec<PathBuf>,
     /// Rows of `key_figures.csv`: the figures README.md quotes that are not
     /// a column of a figure's CSV (figure, quantity, value in SI).
-    keys: Vec<String>,
+    keys: Vec<[String; 3]>,
 }
 
 impl Writer {
@@ -34,7 +34,8 @@ impl Writer {
     /// Records a figure that README.md quotes and no CSV column holds
     /// (`value` in SI units), for `key_figures.csv`. Returns `value`.
     pub fn key(&mut self, figure: &str, quantity: &str, value: f64) -> f64 {
-        self.keys.push(format!("{figure},{quantity},{value:.6e}\n"));
+        self.keys
+            .push([figure.into(), quantity.into(), format!("{value:.6e}")]);
         value
     }
     /// Writes `name` (relative to the output folder).
@@ -54,7 +55,7 @@ impl Writer {
         self.file(name, svg.as_bytes())
     }
     /// Takes the rows recorded by [`Writer::key`] so far.
-    pub fn take_keys(&mut self) -> Vec<String> {
+    pub fn take_keys(&mut self) -> Vec<[String; 3]> {
         std::mem::take(&mut self.keys)
     }
     /// The files written, in order (consumes the writer).
@@ -63,25 +64,55 @@ impl Writer {
     }
 }
 
-/// A CSV table built in memory.
-#[derive(Debug, Clone)]
+/// A CSV table built in memory with the `csv` crate: one header row, then
+/// rows of already formatted fields (each table keeps its own number
+/// format); a field is quoted only where it holds a comma, a quote or a
+/// line break.
+#[derive(Debug)]
 pub struct Csv {
-    text: String,
+    w: csv::Writer<Vec<u8>>,
 }
 
 impl Csv {
-    pub fn new(header: &[&str]) -> Self {
-        let mut text = header.join(",");
-        text.push('\n');
-        Self { text }
+    pub fn new<S: AsRef<str>>(header: &[S]) -> Self {
+        let mut csv = Self {
+            w: csv::Writer::from_writer(Vec::new()),
+        };
+        csv.row(header);
+        csv
     }
-    pub fn row(&mut self, fields: &[String]) {
-        self.text.push_str(&fields.join(","));
-        self.text.push('\n');
+    pub fn row<S: AsRef<str>>(&mut self, fields: &[S]) {
+        // Writing into memory fails only on a full heap.
+        self.w
+            .write_record(fields.iter().map(|f| f.as_ref()))
+            .and_then(|()| self.w.flush().map_err(csv::Error::from))
+            .expect("writing CSV into memory");
     }
     pub fn as_bytes(&self) -> &[u8] {
-        self.text.as_bytes()
+        self.w.get_ref()
     }
+    /// The table's text (every field was a `str`).
+    pub fn text(&self) -> &str {
+        std::str::from_utf8(self.w.get_ref()).expect("CSV of str fields is UTF-8")
+    }
+}
+
+/// One CSV table's rows by column name, as read back from its text.
+pub type Records = Vec<std::collections::BTreeMap<String, String>>;
+
+/// Parses CSV text with a header row into [`Records`]; an error names the
+/// record that does not parse (a row with another number of fields than
+/// the header included).
+pub fn records(text: &str) -> anyhow::Result<Records> {
+    csv::Reader::from_reader(text.as_bytes())
+        .deserialize()
+        .map(|r| r.context("reading CSV"))
+        .collect()
+}
+
+/// The number in column `key` of a record (NaN where blank or absent).
+pub fn field_num(r: &std::collections::BTreeMap<String, String>, key: &str) -> f64 {
+    r.get(key).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN)
 }
 
 /// A number for a data file: shortest round-trip form (`NaN` where undefined).

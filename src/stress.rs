@@ -46,6 +46,7 @@ use pushval_scenario::DEFAULT_GATE;
 use rayon::prelude::*;
 
 use crate::harness::{rel_err, tail_omega};
+use crate::outdir::Csv;
 
 /// A case is `ok` when its run stays within these of the reference (5 mm,
 /// 0.01 rad, 0.5 % steady ω: fixed here so the stability map does not move
@@ -526,9 +527,23 @@ fn field(v: Option<f64>) -> String {
 
 /// The `stress.csv` text (see the module docs).
 pub fn csv(outcomes: &[Outcome]) -> String {
-    let mut s = String::from(
-        "sweep,solver,dt,speed,mu,supports,aspect,horizon,status,position_err,theta_err,omega_rel_err,blowup_t,blowup_step,detail\n",
-    );
+    let mut csv = Csv::new(&[
+        "sweep",
+        "solver",
+        "dt",
+        "speed",
+        "mu",
+        "supports",
+        "aspect",
+        "horizon",
+        "status",
+        "position_err",
+        "theta_err",
+        "omega_rel_err",
+        "blowup_t",
+        "blowup_step",
+        "detail",
+    ]);
     for o in outcomes {
         let c = &o.case;
         let dt = (c.solver != Solver::Adaptive).then_some(c.dt);
@@ -536,31 +551,31 @@ pub fn csv(outcomes: &[Outcome]) -> String {
             Some(b) => (
                 Some(b.t),
                 b.step.to_string(),
+                // Kept free of commas and quotes, as the file always was:
+                // a line of it splits on commas.
                 b.what.replace([',', '"'], ";"),
             ),
             None => (None, String::new(), String::new()),
         };
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            c.sweep,
-            c.solver.name(),
+        csv.row(&[
+            c.sweep.to_string(),
+            c.solver.name().to_string(),
             field(dt),
             field(Some(c.speed)),
             field(Some(c.mu)),
-            c.supports,
+            c.supports.to_string(),
             field(Some(c.aspect)),
             field(Some(c.horizon)),
-            o.status.name(),
+            o.status.name().to_string(),
             field(o.position_err),
             field(o.theta_err),
             field(o.omega_rel_err),
             field(bt),
             bs,
-            what
-        );
+            what,
+        ]);
     }
-    s
+    csv.text().to_string()
 }
 
 /// Stability limits of one solver at one (μ, v_c) of the map.
@@ -612,19 +627,17 @@ pub fn limits(outcomes: &[Outcome]) -> Vec<Limit> {
 
 /// The `stability.csv` text.
 pub fn limits_csv(limits: &[Limit]) -> String {
-    let mut s = String::from("solver,mu,speed,dt_ok_max,dt_stable_max\n");
+    let mut csv = Csv::new(&["solver", "mu", "speed", "dt_ok_max", "dt_stable_max"]);
     for l in limits {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{}",
-            l.solver.name(),
+        csv.row(&[
+            l.solver.name().to_string(),
             field(Some(l.mu)),
             field(Some(l.speed)),
             field(l.dt_ok_max),
-            field(l.dt_stable_max)
-        );
+            field(l.dt_stable_max),
+        ]);
     }
-    s
+    csv.text().to_string()
 }
 
 /// A terminal summary: counts per sweep, solver and verdict, the blow-ups by

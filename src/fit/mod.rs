@@ -67,6 +67,7 @@
 //! order `parameters` is written in), vector parameters as two consecutive
 //! components x, y.
 
+pub mod engine;
 pub mod noise;
 pub mod params;
 mod residual;

@@ -13,6 +13,7 @@ use crate::registry;
 
 mod dt;
 mod figures;
+pub mod law;
 mod segments;
 pub mod tolerance;
 

@@ -22,6 +22,7 @@ use pushval_scenario::Scenario;
 use crate::harness::{
     compare_trajectory, run_scenario, Figures, Resolved, RunOptions, SegmentInfo, SteadyRead,
 };
+use crate::outdir::Csv;
 use crate::plot::{Axis, Figure, Legend, Panel, Series, Stroke, PALETTE};
 
 use crate::inject::inject;
@@ -334,21 +335,36 @@ pub fn applies(sc: &Scenario, kind: ErrorKind) -> bool {
 
 /// The CSV text.
 pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "scenario,engine,kind,unit,smallest_caught,smallest_caught_plus,smallest_caught_minus,smallest_caught_by_compare,at_search_floor,target,meets_target,tolerance_position_m,tolerance_theta_rad,tolerance_omega_rel,engine_dt_s,gate_wall_time_s,linear_estimate\n",
-    );
+    let mut csv = Csv::new(&[
+        "scenario",
+        "engine",
+        "kind",
+        "unit",
+        "smallest_caught",
+        "smallest_caught_plus",
+        "smallest_caught_minus",
+        "smallest_caught_by_compare",
+        "at_search_floor",
+        "target",
+        "meets_target",
+        "tolerance_position_m",
+        "tolerance_theta_rad",
+        "tolerance_omega_rel",
+        "engine_dt_s",
+        "gate_wall_time_s",
+        "linear_estimate",
+    ]);
     for r in rows {
         let meets = match (r.kind.target(), r.both()) {
             (Some(t), Some(b)) => (b <= t).to_string(),
             (Some(_), None) => "false".into(),
             (None, _) => "".into(),
         };
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{:.3e},{:.3e},{:.3e},{:.4e},{:.3},{}\n",
-            r.scenario,
-            r.engine,
-            r.kind.name(),
-            r.kind.unit(),
+        csv.row(&[
+            r.scenario.clone(),
+            r.engine.clone(),
+            r.kind.name().to_string(),
+            r.kind.unit().to_string(),
             opt(r.both()),
             opt(r.plus),
             if r.kind.signed() {
@@ -359,20 +375,21 @@ pub fn csv(rows: &[Row]) -> String {
             opt(r.compare),
             // Caught at the smallest magnitude searched: the true threshold
             // is at or below it.
-            r.kind != ErrorKind::Switching
+            (r.kind != ErrorKind::Switching
                 && r.both()
-                    .is_some_and(|b| b <= r.kind.range().0 * (1.0 + 1e-12)),
+                    .is_some_and(|b| b <= r.kind.range().0 * (1.0 + 1e-12)))
+            .to_string(),
             r.kind.target().map_or(String::new(), |t| format!("{t:e}")),
             meets,
-            r.tolerance.position_max,
-            r.tolerance.theta_max,
-            r.tolerance.omega_steady_rel,
-            r.dt,
-            r.gate_seconds,
-            r.linear.map_or(String::new(), |x| format!("{x:.3e}"))
-        ));
+            format!("{:.3e}", r.tolerance.position_max),
+            format!("{:.3e}", r.tolerance.theta_max),
+            format!("{:.3e}", r.tolerance.omega_steady_rel),
+            format!("{:.4e}", r.dt),
+            format!("{:.3}", r.gate_seconds),
+            r.linear.map_or(String::new(), |x| format!("{x:.3e}")),
+        ]);
     }
-    s
+    csv.text().to_string()
 }
 
 /// One panel per kind: the smallest magnitude caught (log) per scenario,
@@ -441,12 +458,15 @@ pub fn figure(rows: &[Row]) -> anyhow::Result<String> {
 pub fn read_csv(path: &Path) -> anyhow::Result<Vec<Row>> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("{}: cannot read", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let header = reader
+        .headers()
+        .with_context(|| format!("{}: line 1", path.display()))?
+        .clone();
     let col = |name: &str| {
         header
             .iter()
-            .position(|h| *h == name)
+            .position(|h| h == name)
             .with_context(|| format!("{}: line 1: no column `{name}`", path.display()))
     };
     let (isc, ien, iki, ipl, imi, ico, itp, itt, ito, idt, iwa, ili) = (
@@ -464,9 +484,10 @@ pub fn read_csv(path: &Path) -> anyhow::Result<Vec<Row>> {
         col("linear_estimate")?,
     );
     let mut rows = Vec::new();
-    for (n, line) in lines.enumerate() {
-        let f: Vec<&str> = line.split(',').collect();
-        let at = |i: usize| f.get(i).copied().unwrap_or_default();
+    for f in reader.records() {
+        let f = f.with_context(|| format!("{}: reading", path.display()))?;
+        let line = f.position().map_or(0, |p| p.line());
+        let at = |i: usize| f.get(i).unwrap_or_default();
         let num = |i: usize| at(i).parse::<f64>().ok();
         let kind = ErrorKind::ALL
             .into_iter()
@@ -475,7 +496,7 @@ pub fn read_csv(path: &Path) -> anyhow::Result<Vec<Row>> {
                 format!(
                     "{}: line {}: column `kind`: unknown `{}`",
                     path.display(),
-                    n + 2,
+                    line,
                     at(iki)
                 )
             })?;

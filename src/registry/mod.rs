@@ -37,7 +37,7 @@ pub use pushval_outside::{
 };
 
 /// MuJoCo's creep scene and thresholds, for the creep report
-/// (`crate::study::creep_law`), which reads what `examples/creep_law.rs`
+/// (`crate::report::creep_law`), which reads what `examples/creep_law.rs`
 /// measured.
 pub mod mujoco_creep {
     pub use pushval_mujoco::creep::{CreepScene, CHATTER_HEIGHT_STD, SLIDING_SPEED};

@@ -25,6 +25,7 @@
 //! file and a rename.
 
 pub mod cells;
+pub mod creep_law;
 pub mod figures;
 pub mod paper;
 mod readme;
@@ -128,8 +129,8 @@ pub fn run(opts: &Options) -> anyhow::Result<Summary> {
     entries.extend(figures::figures(&geoms, &tasks, &rows, opts.quick, &mut w)?);
     let keys = w.take_keys();
     if !keys.is_empty() {
-        let mut csv = String::from("figure,quantity,value\n");
-        csv.extend(keys);
+        let mut csv = crate::outdir::Csv::new(&["figure", "quantity", "value"]);
+        keys.iter().for_each(|k| csv.row(k));
         w.file(KEY_FIGURES, csv.as_bytes())?;
     }
     w.file("README.md", readme(&entries, opts.quick).as_bytes())?;

@@ -10,7 +10,7 @@
 use plotters::style::RGBColor;
 
 use super::plate::{err, froude};
-use super::records::{num, parse};
+use crate::outdir::{field_num as num, records};
 use crate::plot::{cell_edges, heat_map, Axis, Cell, Figure, MapCell, Scale, DARK, GREY, PURPLE};
 
 /// The error classes' lower bounds (dimensionless): class k is
@@ -43,11 +43,24 @@ fn grid(mut v: Vec<f64>) -> Vec<f64> {
     v
 }
 
+/// A map cell's errors against Coulomb, the law with the problem's loads
+/// and the law on the run's own loads (None where the file has no law ω,
+/// an absent column or a blank cell): relative with the gate's floor, or
+/// |ω|/|ω*| where the reference locks (NaN where the engine's ω is).
+pub fn cell_errors(r: &std::collections::BTreeMap<String, String>) -> [Option<f64>; 3] {
+    let speed = (num(r, "froude") / froude(1.0)).sqrt();
+    let (we, wc) = (num(r, "omega_engine"), num(r, "omega_coulomb"));
+    ["omega_coulomb", "omega_law", "omega_law_run"].map(|k| match num(r, k) {
+        w if w.is_finite() || k == "omega_coulomb" => Some(err(we, w, wc, speed)),
+        _ => None,
+    })
+}
+
 /// The figure of `map.csv`'s text (columns froude, phi, omega_engine,
 /// omega_coulomb, omega_law, class). Errors as in the README: relative with
 /// the gate's floor, or |ω|/|ω*| where the reference is a lock.
 pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
-    let rows = parse(csv);
+    let rows = records(csv)?;
     anyhow::ensure!(!rows.is_empty(), "map.csv of {model} has no rows");
     let frs = grid(rows.iter().map(|r| num(r, "froude")).collect());
     let phis = grid(rows.iter().map(|r| num(r, "phi")).collect());
@@ -62,26 +75,20 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
         ) else {
             anyhow::bail!("map.csv of {model}: a row without froude or phi");
         };
-        let (we, wc, wl) = (
-            num(r, "omega_engine"),
-            num(r, "omega_coulomb"),
-            num(r, "omega_law"),
-        );
-        let speed = (num(r, "froude") / froude(1.0)).sqrt();
-        let cell = |value| MapCell {
-            x,
-            y,
-            value,
-            mark: String::new(),
-        };
-        coulomb.push(cell(class(err(we, wc, wc, speed))));
-        if wl.is_finite() {
-            law.push(cell(class(err(we, wl, wc, speed))));
-        }
-        // Absent column or empty cell: no loads measured there.
-        let wr = num(r, "omega_law_run");
-        if wr.is_finite() {
-            law_run.push(cell(class(err(we, wr, wc, speed))));
+        // Absent column or empty cell: no law, or no loads measured there.
+        for (cells, e) in [&mut coulomb, &mut law, &mut law_run]
+            .into_iter()
+            .zip(cell_errors(r))
+        {
+            if let Some(e) = e {
+                let mark = String::new();
+                cells.push(MapCell {
+                    x,
+                    y,
+                    value: class(e),
+                    mark,
+                });
+            }
         }
         let color = match r.get("class").map(String::as_str) {
             Some("locked") => Some(DARK),
@@ -100,38 +107,30 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
             Axis::lin("push direction φ (rad)").range(yr.0, yr.1),
         )
     };
-    let (x, y) = axes();
-    let mut left = heat_map(
+    let titles = [
         format!("{model}: error against Coulomb"),
-        x,
-        y,
-        &coulomb,
-        &scale,
-    );
-    let (x, y) = axes();
-    let title = if law.is_empty() {
-        format!("{model}: no law declared")
-    } else if law_run.is_empty() {
-        format!("{model}: error against its law")
-    } else {
-        format!("{model}: against its law, problem's loads")
-    };
-    let mut right = heat_map(title, x, y, &law, &scale);
-    left.outlines.clone_from(&outlines);
-    right.outlines.clone_from(&outlines);
-    let mut panels = vec![left, right];
-    if !law_run.is_empty() {
-        let (x, y) = axes();
-        let mut run = heat_map(
-            format!("{model}: against its law, run's own loads"),
-            x,
-            y,
-            &law_run,
-            &scale,
-        );
-        run.outlines = outlines;
-        panels.push(run);
-    }
+        if law.is_empty() {
+            format!("{model}: no law declared")
+        } else if law_run.is_empty() {
+            format!("{model}: error against its law")
+        } else {
+            format!("{model}: against its law, problem's loads")
+        },
+        format!("{model}: against its law, run's own loads"),
+    ];
+    // The third panel only where the engine measured its loads.
+    let panels: Vec<_> = [coulomb, law, law_run]
+        .iter()
+        .zip(titles)
+        .enumerate()
+        .filter(|(k, (cells, _))| *k < 2 || !cells.is_empty())
+        .map(|(_, (cells, title))| {
+            let (x, y) = axes();
+            let mut panel = heat_map(title, x, y, cells, &scale);
+            panel.outlines.clone_from(&outlines);
+            panel
+        })
+        .collect();
     let labels = [
         "< 1e-4",
         "1e-4 – 1e-3",
@@ -139,23 +138,25 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
         "1e-2 – 1e-1",
         "≥ 1e-1",
     ];
-    let notes = if panels.len() == 3 {
-        vec![
-            "relative steady-ω error".to_string(),
-            "|ω_engine − ω_ref| / |ω_ref|,".to_string(),
-            "ref: Coulomb (left), the".to_string(),
-            "engine's law on the problem's".to_string(),
-            "loads (middle), on the run's".to_string(),
-            "own loads (right)".to_string(),
-        ]
+    let mut notes: Vec<String> = [
+        "relative steady-ω error",
+        "|ω_engine − ω_ref| / |ω_ref|,",
+        "ref: Coulomb (left), the",
+    ]
+    .map(String::from)
+    .into();
+    if panels.len() == 3 {
+        notes.extend(
+            [
+                "engine's law on the problem's",
+                "loads (middle), on the run's",
+                "own loads (right)",
+            ]
+            .map(String::from),
+        );
     } else {
-        vec![
-            "relative steady-ω error".to_string(),
-            "|ω_engine − ω_ref| / |ω_ref|,".to_string(),
-            "ref: Coulomb (left), the".to_string(),
-            "engine's law (right)".to_string(),
-        ]
-    };
+        notes.push("engine's law (right)".into());
+    }
     let mut key = scale.key("error", &labels, &notes);
     key.entries.push(("undefined".to_string(), GREY));
     key.outlined = vec![

@@ -11,7 +11,7 @@
 //! Richardson), `creep.csv` where the law locks, `variants.csv` /
 //! `map_NAME.csv`, `sweep_NAME.csv` (one quantity over a list, with engine
 //! and law support loads), `rest_moments.csv` where the law is semi-stable,
-//! `coulomb_fit.csv` ([`fit`]) and `README.md` from those files ([`readme`]).
+//! `coulomb_fit.csv` ([`crate::fit::engine`]) and `README.md` from those files ([`readme`]).
 //!
 //! What a study varies is data, `studies/MODEL.toml` ([`spec`]); nothing
 //! here names an engine. `all` runs every model of this build and writes an
@@ -24,13 +24,10 @@
 //! array's variables; `--merge` rebuilds exactly the single run's files
 //! ([`crate::shard`]).
 
-pub mod creep_law;
 pub mod figure;
-pub mod fit;
 mod plan;
 pub mod plate;
 pub mod readme;
-pub mod records;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
@@ -42,8 +39,7 @@ use crate::outdir::Writer;
 use crate::parallel::par_rows;
 use crate::shard::{grid_hash, grid_name, Parts, Shard};
 pub use plan::{
-    class_code, class_name, law_on_run_loads, models, whole_period_omega, Plan, Setup, SweepPlan,
-    Task, LAW_RUN, LAW_RUN_SAMPLES, LOADS, RUN_WIDTH,
+    class_code, class_name, models, Plan, Setup, SweepPlan, Task, LAW_RUN, LOADS, RUN_WIDTH,
 };
 pub use plate::err;
 pub use readme::opt;

@@ -4,11 +4,14 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::fit;
-use super::plan::{class_name, law_integrates, Plan, Task, LAW_RUN, LOADS};
-use super::plate::{err, froude, frs, phis, PHI_TABLE, TABLE_SPEEDS};
-use super::records::{num, parse, Records};
-use crate::outdir::Writer;
+use anyhow::Context;
+
+use super::figure::cell_errors;
+use super::plan::{class_name, Plan, Task, LAW_RUN, LOADS};
+use super::plate::{err, frs, phis, PHI_TABLE, TABLE_SPEEDS};
+use crate::fit::engine as fit;
+use crate::harness::law::law_integrates;
+use crate::outdir::{field_num as num, records, Csv, Records, Writer};
 
 /// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
 /// within 1e-2 of the law, turns, locked, semi_stable, with the law on the
@@ -16,22 +19,12 @@ use crate::outdir::Writer;
 pub fn map_stats(map: &Records) -> [usize; 9] {
     let mut s = [0; 9];
     for r in map {
-        let (we, wc, wl) = (
-            num(r, "omega_engine"),
-            num(r, "omega_coulomb"),
-            num(r, "omega_law"),
-        );
-        let speed = (num(r, "froude") / froude(1.0)).sqrt();
+        let [ec, el, er] = cell_errors(r);
         s[0] += 1;
-        s[1] += usize::from(err(we, wc, wc, speed) <= 1e-2);
-        if wl.is_finite() {
-            s[2] += 1;
-            s[3] += usize::from(err(we, wl, wc, speed) <= 1e-2);
-        }
-        let wr = num(r, "omega_law_run");
-        if wr.is_finite() {
-            s[7] += 1;
-            s[8] += usize::from(err(we, wr, wc, speed) <= 1e-2);
+        s[1] += usize::from(ec.is_some_and(|e| e <= 1e-2));
+        for (e, k) in [(el, 2), (er, 7)] {
+            s[k] += usize::from(e.is_some());
+            s[k + 1] += usize::from(e.is_some_and(|e| e <= 1e-2));
         }
         match r.get("class").map(String::as_str) {
             Some("turns") => s[4] += 1,
@@ -113,40 +106,63 @@ fn sig(v: f64) -> String {
     }
 }
 
-fn run_line(r: &[f64]) -> String {
-    format!("{},{},{}", opt(r[0]), opt(r[1]), opt(r[2]))
+/// A table's header: `lead`, then the columns of `tail` (a group of
+/// columns several tables share).
+fn head(lead: &[&'static str], tail: &[&'static str]) -> Vec<&'static str> {
+    [lead, tail].concat()
 }
+
+/// The columns of the engine's, Coulomb's and the law's ω.
+const RUN_HEAD: [&str; 3] = ["omega_engine", "omega_coulomb", "omega_law"];
 
 /// The columns of what the run's own loads give (empty where the engine
-/// measures no loads): header and values.
-const LAW_RUN_HEAD: &str =
-    "omega_law_run,law_run_rms,max_rise_m,contact_lost_share,load_min,load_max";
+/// measures no loads).
+const LAW_RUN_HEAD: [&str; 6] = [
+    "omega_law_run",
+    "law_run_rms",
+    "max_rise_m",
+    "contact_lost_share",
+    "load_min",
+    "load_max",
+];
 
-fn law_run_line(r: &[f64]) -> String {
-    r[LAW_RUN..LAW_RUN + 6]
-        .iter()
-        .map(|v| opt(*v))
-        .collect::<Vec<_>>()
-        .join(",")
+/// ω of the engine, Coulomb and the law: the fields of [`RUN_HEAD`].
+fn run_fields(r: &[f64]) -> impl Iterator<Item = String> + '_ {
+    r[..3].iter().map(|v| opt(*v))
 }
 
-fn map_csv(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], setup: usize) -> String {
-    let mut s = format!("froude,phi,omega_engine,omega_coulomb,omega_law,class,{LAW_RUN_HEAD}\n");
+/// The fields of [`LAW_RUN_HEAD`].
+fn law_run_fields(r: &[f64]) -> impl Iterator<Item = String> + '_ {
+    r[LAW_RUN..LAW_RUN + 6].iter().map(|v| opt(*v))
+}
+
+fn map_csv(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], setup: usize) -> Csv {
+    let mut csv = Csv::new(&head(
+        &[
+            "froude",
+            "phi",
+            "omega_engine",
+            "omega_coulomb",
+            "omega_law",
+            "class",
+        ],
+        &LAW_RUN_HEAD,
+    ));
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Map { s: k, i, j } = *t {
             if k == setup {
-                let (fr, phi) = (frs(plan.quick)[i], phis(plan.quick)[j]);
-                let _ = writeln!(
-                    s,
-                    "{fr},{phi},{},{},{}",
-                    run_line(r),
-                    class_name(r[3]),
-                    law_run_line(r)
-                );
+                let mut f = vec![
+                    frs(plan.quick)[i].to_string(),
+                    phis(plan.quick)[j].to_string(),
+                ];
+                f.extend(run_fields(r));
+                f.push(class_name(r[3]).into());
+                f.extend(law_run_fields(r));
+                csv.row(&f);
             }
         }
     }
-    s
+    csv
 }
 
 /// Writes every file of the study and its README.
@@ -159,30 +175,35 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             .map(|(t, r)| (*t, r))
             .collect()
     };
-    let mut paper = format!("speed,omega_engine,omega_coulomb,omega_law,{LAW_RUN_HEAD}\n");
+    let mut paper = Csv::new(&head(&head(&["speed"], &RUN_HEAD), &LAW_RUN_HEAD));
     for (t, r) in rows_of(&|t| matches!(t, Task::Table { s: 0, .. })) {
         if let Task::Table { v, .. } = t {
-            let _ = writeln!(
-                paper,
-                "{},{},{}",
-                TABLE_SPEEDS[v],
-                run_line(r),
-                law_run_line(r)
-            );
+            let mut f = vec![TABLE_SPEEDS[v].to_string()];
+            f.extend(run_fields(r).chain(law_run_fields(r)));
+            paper.row(&f);
         }
     }
     w.file("paper_plate.csv", paper.as_bytes())?;
     let map = map_csv(plan, tasks, rows, 0);
     w.file("map.csv", map.as_bytes())?;
-    w.figure("map.svg", &super::figure::map_figure(&plan.model, &map)?)?;
+    w.figure(
+        "map.svg",
+        &super::figure::map_figure(&plan.model, map.text())?,
+    )?;
 
     // The step ladder: change from the next coarser step, the observed
     // order from three steps, Richardson at the declared order.
     let p = plan.setups[0].engine.order();
     // The ladder's step ratio (2 for the default ladders).
     let ratio = plan.ladder[0] / plan.ladder[1];
-    let ladder_text = |sel: &dyn Fn(&Task) -> bool, lead: &dyn Fn(&Task) -> String, head: &str| {
-        let mut s = format!("{head}dt,omega_engine,omega_coulomb,omega_law,class,change,observed_order,richardson\n");
+    let ladder_csv = |sel: &dyn Fn(&Task) -> bool,
+                      lead: &dyn Fn(&Task) -> Vec<String>,
+                      first: &[&'static str]| {
+        let tail = ["change", "observed_order", "richardson"];
+        let mut csv = Csv::new(&head(
+            &head(&head(first, &["dt"]), &RUN_HEAD),
+            &head(&["class"], &tail),
+        ));
         let rs = rows_of(sel);
         for (n, (t, r)) in rs.iter().enumerate() {
             let same = |m: usize| n >= m && lead(&rs[n - m].0) == lead(t);
@@ -201,41 +222,35 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
                 _ => f64::NAN,
             };
             let rich = r[0] + change / (ratio.powf(p) - 1.0);
-            let _ = writeln!(
-                s,
-                "{}{dt},{},{},{},{},{}",
-                lead(t),
-                run_line(r),
-                class_name(r[3]),
-                opt(change),
-                opt(order),
-                opt(rich)
-            );
+            let mut f = lead(t);
+            f.push(dt.to_string());
+            f.extend(run_fields(r));
+            f.push(class_name(r[3]).into());
+            f.extend([change, order, rich].map(opt));
+            csv.row(&f);
         }
-        s
+        csv
     };
-    let ladder = ladder_text(
-        &|t| matches!(t, Task::Ladder { .. }),
-        &|_| String::new(),
-        "",
-    );
+    let ladder = ladder_csv(&|t| matches!(t, Task::Ladder { .. }), &|_| Vec::new(), &[]);
     w.file("dt_ladder.csv", ladder.as_bytes())?;
     let creep = (!plan.creep.is_empty()).then(|| {
-        ladder_text(
+        ladder_csv(
             &|t| matches!(t, Task::Creep { .. }),
             &|t| match t {
-                Task::Creep { v, .. } => format!("{},", TABLE_SPEEDS[*v]),
-                _ => String::new(),
+                Task::Creep { v, .. } => vec![TABLE_SPEEDS[*v].to_string()],
+                _ => Vec::new(),
             },
-            "speed,",
+            &["speed"],
         )
     });
     if let Some(c) = &creep {
         w.file("creep.csv", c.as_bytes())?;
     }
-    let mut variants = format!(
-        "variant,options,supports_half,phi,dt,speed,omega_engine,omega_coulomb,omega_law,class,{LAW_RUN_HEAD},theta_end\n",
-    );
+    let lead = ["variant", "options", "supports_half", "phi", "dt", "speed"];
+    let mut variants = Csv::new(&head(
+        &head(&head(&lead, &RUN_HEAD), &head(&["class"], &LAW_RUN_HEAD)),
+        &["theta_end"],
+    ));
     let mut variant_maps = Vec::new();
     for (k, s) in plan.setups.iter().enumerate().skip(1) {
         let options: Vec<String> = s
@@ -246,35 +261,37 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             .collect();
         for (t, r) in rows_of(&|t| matches!(t, Task::Table { s, .. } if *s == k)) {
             if let Task::Table { v, .. } = t {
-                let _ = writeln!(
-                    variants,
-                    "{},{},{},{},{},{},{},{},{},{}",
-                    s.name,
+                let mut f = vec![
+                    s.name.clone(),
+                    // One field: its commas read as `;` (as they always have).
                     options.join(" ").replace(',', ";"),
                     s.supports_half.map_or(String::new(), |h| h.to_string()),
-                    s.phi,
-                    s.dt,
-                    TABLE_SPEEDS[v],
-                    run_line(r),
-                    class_name(r[3]),
-                    law_run_line(r),
-                    opt(r[LAW_RUN - 1])
-                );
+                    s.phi.to_string(),
+                    s.dt.to_string(),
+                    TABLE_SPEEDS[v].to_string(),
+                ];
+                f.extend(run_fields(r));
+                f.push(class_name(r[3]).into());
+                f.extend(law_run_fields(r));
+                f.push(opt(r[LAW_RUN - 1]));
+                variants.row(&f);
             }
         }
         if s.map {
-            let text = map_csv(plan, tasks, rows, k);
-            w.file(&format!("map_{}.csv", s.name), text.as_bytes())?;
-            variant_maps.push((s.name.clone(), text));
+            let csv = map_csv(plan, tasks, rows, k);
+            w.file(&format!("map_{}.csv", s.name), csv.as_bytes())?;
+            variant_maps.push((s.name.clone(), csv.text().to_string()));
         }
     }
     if plan.setups.len() > 1 {
         w.file("variants.csv", variants.as_bytes())?;
     }
-    let mut fits = format!("schedule,{},verdict,reason\n", fit::COLUMNS);
+    let mut fits = Csv::new(&head(
+        &head(&["schedule"], &fit::COLUMNS),
+        &["verdict", "reason"],
+    ));
     for (t, r) in rows_of(&|t| matches!(t, Task::Fit { .. })) {
         if let Task::Fit { k } = t {
-            let vals: Vec<String> = r.iter().take(fit::WIDTH - 3).map(|v| opt(*v)).collect();
             let fitted = match (r[14] == 1.0, r[15] == 1.0) {
                 (true, true) => "mu_scale center_of_friction inertia_cm",
                 (false, true) => "mu_scale inertia_cm",
@@ -291,13 +308,11 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
                 "degenerate" => fit::degenerate_reason(r),
                 _ => String::new(),
             };
-            let _ = writeln!(
-                fits,
-                "{},{},{fitted},{verdict},{}",
-                fit::SCHEDULES[k],
-                vals.join(","),
-                reason.replace(',', ";")
-            );
+            let mut f = vec![fit::SCHEDULES[k].to_string()];
+            f.extend(r.iter().take(fit::WIDTH - 3).map(|v| opt(*v)));
+            // The reason's commas read as `;` (as they always have).
+            f.extend([fitted.into(), verdict.into(), reason.replace(',', ";")]);
+            fits.row(&f);
         }
     }
     if plan.fit {
@@ -307,14 +322,14 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     more.push_str(&rest_moments(plan, tasks, rows, w)?);
     let mut text = readme(
         plan,
-        &paper,
-        &map,
-        &ladder,
-        creep.as_deref(),
-        &variants,
+        paper.text(),
+        map.text(),
+        ladder.text(),
+        creep.as_ref().map(Csv::text),
+        variants.text(),
         &variant_maps,
-        &fits,
-    );
+        fits.text(),
+    )?;
     text.push_str(&more);
     w.file("README.md", text.as_bytes())
 }
@@ -336,15 +351,6 @@ fn options_text(o: &std::collections::BTreeMap<String, serde_json::Value>) -> St
         .join(", ")
 }
 
-/// Loads of a row, `n` engine then `n` law columns (blank where unknown).
-fn loads_cells(r: &[f64]) -> String {
-    r[7..7 + 2 * LOADS]
-        .iter()
-        .map(|v| opt(*v))
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
 /// `sweep_NAME.csv` of every sweep, and their README sections.
 fn sweeps(
     plan: &Plan,
@@ -362,15 +368,19 @@ fn sweeps(
         let has_loads = sel
             .iter()
             .any(|(_, r)| r[7..7 + 2 * LOADS].iter().any(|v| v.is_finite()));
-        let mut csv = String::from("value,speed,phi,dt,theta0,omega_engine,omega_coulomb,omega_law,class,err_vs_coulomb,err_vs_law,theta_end");
+        let mut columns: Vec<String> = head(
+            &head(&["value", "speed", "phi", "dt", "theta0"], &RUN_HEAD),
+            &["class", "err_vs_coulomb", "err_vs_law", "theta_end"],
+        )
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
         if has_loads {
             for who in ["engine", "law"] {
-                for k in 1..=LOADS {
-                    let _ = write!(csv, ",load_{who}_{k}");
-                }
+                columns.extend((1..=LOADS).map(|k| format!("load_{who}_{k}")));
             }
         }
-        csv.push('\n');
+        let mut csv = Csv::new(&columns);
         let name = &sw.spec.name;
         let _ = write!(
             md,
@@ -402,16 +412,12 @@ fn sweeps(
                     class_name(r[3]),
                 ),
             };
-            let _ = write!(
-                csv,
-                "{},{speed},{phi},{dt},{theta0},{},{},{},{},{}",
-                sw.spec.values[i],
-                run_line(r),
-                class,
-                opt(ec),
-                opt(el),
-                opt(r[LAW_RUN - 1])
-            );
+            let mut f: Vec<String> = [sw.spec.values[i], speed, phi, dt, theta0]
+                .map(|v| v.to_string())
+                .into();
+            f.extend(run_fields(r));
+            f.push(class.into());
+            f.extend([ec, el, r[LAW_RUN - 1]].map(opt));
             let _ = write!(
                 md,
                 "| {} | {speed} | {} | {} | {} | {} | {} | {} |",
@@ -424,7 +430,8 @@ fn sweeps(
                 sig(el)
             );
             if has_loads {
-                let _ = write!(csv, ",{}", loads_cells(r));
+                // Loads: `LOADS` engine then as many law columns.
+                f.extend(r[7..7 + 2 * LOADS].iter().map(|v| opt(*v)));
                 let fmt = |x: &[f64]| x.iter().map(dec3).collect::<Vec<_>>().join(" ");
                 let _ = write!(
                     md,
@@ -433,7 +440,7 @@ fn sweeps(
                     fmt(&r[7 + LOADS..7 + 2 * LOADS])
                 );
             }
-            csv.push('\n');
+            csv.row(&f);
             md.push('\n');
         }
         w.file(&format!("sweep_{name}.csv"), csv.as_bytes())?;
@@ -449,22 +456,22 @@ fn rest_moments(
     rows: &[Vec<f64>],
     w: &mut Writer,
 ) -> anyhow::Result<String> {
-    let mut csv = String::from("variant,froude,phi,class,moment,lock,hold\n");
+    let mut csv = Csv::new(&[
+        "variant", "froude", "phi", "class", "moment", "lock", "hold",
+    ]);
     let (mut semi, mut cells) = (0usize, 0usize);
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Map { s, i, j } = *t {
             cells += 1;
-            let _ = writeln!(
-                csv,
-                "{},{},{},{},{},{},{}",
-                plan.setups[s].name,
-                frs(plan.quick)[i],
-                phis(plan.quick)[j],
-                class_name(r[3]),
+            csv.row(&[
+                plan.setups[s].name.clone(),
+                frs(plan.quick)[i].to_string(),
+                phis(plan.quick)[j].to_string(),
+                class_name(r[3]).into(),
                 opt(r[4]),
                 opt(r[5]),
-                opt(r[6])
-            );
+                opt(r[6]),
+            ]);
             semi += usize::from(r[4].is_finite());
         }
     }
@@ -488,7 +495,10 @@ fn readme(
     variants: &str,
     variant_maps: &[(String, String)],
     fits: &str,
-) -> String {
+) -> anyhow::Result<String> {
+    let (paper, map, ladder) = (records(paper)?, records(map)?, records(ladder)?);
+    let (variants, fits) = (records(variants)?, records(fits)?);
+    let creep = creep.map(records).transpose()?;
     let e = plan.setups[0].engine.as_ref();
     let m = &plan.model;
     let mut s = format!(
@@ -529,9 +539,7 @@ fn readme(
     }
     // A law with dynamics is integrated along the run's loads where the
     // engine measured them (the rows' rise), else taken quasi-statically.
-    let integrated = parse(paper)
-        .iter()
-        .any(|r| num(r, "max_rise_m").is_finite())
+    let integrated = paper.iter().any(|r| num(r, "max_rise_m").is_finite())
         && e.law().is_some_and(|l| {
             let p = super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None);
             law_integrates(l, &p, 0, plan.dt)
@@ -549,13 +557,13 @@ fn readme(
         },
         if integrated { "" } else { " (quasi-static: no transient between samples)" },
     );
-    for r in parse(paper) {
+    for r in &paper {
         let (v, we, wc, wl, wr) = (
-            num(&r, "speed"),
-            num(&r, "omega_engine"),
-            num(&r, "omega_coulomb"),
-            num(&r, "omega_law"),
-            num(&r, "omega_law_run"),
+            num(r, "speed"),
+            num(r, "omega_engine"),
+            num(r, "omega_coulomb"),
+            num(r, "omega_law"),
+            num(r, "omega_law_run"),
         );
         let _ = writeln!(
             s,
@@ -567,14 +575,14 @@ fn readme(
             sig(err(we, wl, wc, v)),
             sig(wr),
             sig(err(we, wr, wc, v)),
-            sig(num(&r, "law_run_rms")),
-            sig(num(&r, "max_rise_m")),
-            share(num(&r, "contact_lost_share")),
-            load_range(&r)
+            sig(num(r, "law_run_rms")),
+            sig(num(r, "max_rise_m")),
+            share(num(r, "contact_lost_share")),
+            load_range(r)
         );
     }
-    let mut map_section = |name: &str, file: &str, text: &str| {
-        let st = map_stats(&parse(text));
+    let mut map_section = |name: &str, file: &str, map: &Records| {
+        let st = map_stats(map);
         let _ = write!(
             s,
             "\n## (Fr, φ) map{name} (`{file}`)\n\n{} cells, Fr from {} to {} (log), φ from {:.2} to {:.2} rad. \
@@ -591,7 +599,7 @@ fn readme(
             st[5],
             st[6]
         );
-        if let Some(line) = locked_turning(&parse(text)) {
+        if let Some(line) = locked_turning(map) {
             s.push_str(&line);
         }
         if name.is_empty() {
@@ -602,26 +610,30 @@ fn readme(
             });
         }
     };
-    map_section("", "map.csv", map);
+    map_section("", "map.csv", &map);
     for (n, t) in variant_maps {
-        map_section(&format!(", variant {n}"), &format!("map_{n}.csv"), t);
+        map_section(
+            &format!(", variant {n}"),
+            &format!("map_{n}.csv"),
+            &records(t)?,
+        );
     }
-    let ladder_table = |s: &mut String, text: &str| {
+    let ladder_table = |s: &mut String, rows: &Records| {
         s.push_str("| v_c | Δt (s) | ω engine | change | observed order | Richardson |\n|---|---|---|---|---|---|\n");
-        for r in parse(text) {
+        for r in rows {
             let v = r.get("speed").cloned().unwrap_or_else(|| "0.5".into());
             let _ = writeln!(
                 s,
                 "| {v} | {} | {} | {} | {} | {} |",
-                num(&r, "dt"),
-                sig(num(&r, "omega_engine")),
-                sig(num(&r, "change")),
-                if num(&r, "observed_order").is_finite() {
-                    format!("{:.2}", num(&r, "observed_order"))
+                num(r, "dt"),
+                sig(num(r, "omega_engine")),
+                sig(num(r, "change")),
+                if num(r, "observed_order").is_finite() {
+                    format!("{:.2}", num(r, "observed_order"))
                 } else {
                     "–".into()
                 },
-                sig(num(&r, "richardson"))
+                sig(num(r, "richardson"))
             );
         }
     };
@@ -630,14 +642,14 @@ fn readme(
         "\n## Step ladder (`dt_ladder.csv`)\n\nv_c = 0.5 m/s, φ = π/4 + 0.3. Declared order {}; Richardson at it.\n\n",
         e.order()
     );
-    ladder_table(&mut s, ladder);
-    if let Some(c) = creep {
+    ladder_table(&mut s, &ladder);
+    if let Some(c) = &creep {
         s.push_str("\n## Creep where the law locks (`creep.csv`)\n\nThe law holds ω = 0 at these table pushes; the engine's |ω| over the step ladder:\n\n");
         ladder_table(&mut s, c);
     }
     if plan.setups.len() > 1 {
         s.push_str("\n## Variants (`variants.csv`)\n\n| variant | options | supports half side (m) | φ (rad) | Δt (s) | v_c | ω engine | ω* Coulomb | ω law | class | ω law, run's loads | per-step loads (N) | θ at the end (rad) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-        for r in parse(variants) {
+        for r in &variants {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
@@ -647,28 +659,28 @@ fn readme(
                 r["phi"],
                 r["dt"],
                 r["speed"],
-                sig(num(&r, "omega_engine")),
-                sig(num(&r, "omega_coulomb")),
-                sig(num(&r, "omega_law")),
+                sig(num(r, "omega_engine")),
+                sig(num(r, "omega_coulomb")),
+                sig(num(r, "omega_law")),
                 r["class"],
-                sig(num(&r, "omega_law_run")),
-                load_range(&r),
-                sig(num(&r, "theta_end"))
+                sig(num(r, "omega_law_run")),
+                load_range(r),
+                sig(num(r, "theta_end"))
             );
         }
     }
     if plan.fit {
         s.push_str("\n## Coulomb fit (`coulomb_fit.csv`)\n\nThe dynamic model fitted to the engine's trajectory (`pushval fit`'s Levenberg–Marquardt); verdict against ten times the engine's own step error.\n\n\
                     | schedule | fitted | μ scale | residual position (m) | residual θ (rad) | verdict |\n|---|---|---|---|---|---|\n");
-        for r in parse(fits) {
+        for r in &fits {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} |",
                 r["schedule"],
                 r["fitted"],
-                sig(num(&r, "mu_scale")),
-                sig(num(&r, "position_rms")),
-                sig(num(&r, "theta_rms")),
+                sig(num(r, "mu_scale")),
+                sig(num(r, "position_rms")),
+                sig(num(r, "theta_rms")),
                 if r["reason"].is_empty() {
                     r["verdict"].to_string()
                 } else {
@@ -677,7 +689,7 @@ fn readme(
             );
         }
     }
-    s
+    Ok(s)
 }
 
 /// The index of every model's study, `OUT/README.md`, read from the
@@ -697,7 +709,7 @@ pub fn index(root: &Path, models: &[String], quick: bool, w: &mut Writer) -> any
         let (Some(paper), Some(map)) = (read("paper_plate.csv"), read("map.csv")) else {
             continue;
         };
-        let rows = parse(&paper);
+        let rows = records(&paper).with_context(|| format!("{m}/paper_plate.csv"))?;
         let Some(r) = rows.iter().find(|r| num(r, "speed") == 0.5) else {
             continue;
         };
@@ -706,7 +718,7 @@ pub fn index(root: &Path, models: &[String], quick: bool, w: &mut Writer) -> any
             &format!("{m}/map.svg"),
             &super::figure::map_figure(m, &map)?,
         )?;
-        let st = map_stats(&parse(&map));
+        let st = map_stats(&records(&map).with_context(|| format!("{m}/map.csv"))?);
         let _ = writeln!(
             s,
             "| [{m}]({m}/README.md) | {} | {} | {} | {} | {} | {} | {} / {} |",

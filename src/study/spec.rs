@@ -258,25 +258,13 @@ fn name_ok(key: &str, name: &str) -> Result<(), (String, String)> {
     Ok(())
 }
 
-/// The study files of `dir` named after no model of the registry: each is
-/// skipped with a note on standard error (a folder of study files serves
-/// several registries: the user's `pushval.toml` lists other engines than
-/// pushval's own).
+/// The study files of `dir` named after no model of the registry, less
+/// the shipped ones a project holds as `pushval init` wrote them (a
+/// project runs its own engines, not every one pushval ships a study
+/// for): each is skipped with a note on standard error (a folder of study
+/// files serves several registries).
 pub fn check_names(dir: &Path, models: &[String]) -> anyhow::Result<()> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Ok(());
-    };
-    let mut skipped: Vec<PathBuf> = entries
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .filter(|p| {
-            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-            !models.iter().any(|m| m == stem)
-        })
-        .collect();
-    skipped.sort();
-    for p in skipped {
+    for p in unused_files(dir, models) {
         eprintln!(
             "note: skipping {}: no engine model `{}` in this registry (`pushval engines`)",
             p.display(),
@@ -284,4 +272,26 @@ pub fn check_names(dir: &Path, models: &[String]) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// What [`check_names`] notes, sorted: the `.toml` files of `dir` whose
+/// stem is no model of `models` and whose text is not the shipped study
+/// file of that name.
+pub fn unused_files(dir: &Path, models: &[String]) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut skipped: Vec<PathBuf> = entries
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .filter(|p| {
+            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+            let shipped = crate::shipped::study_text(stem)
+                .is_some_and(|t| std::fs::read_to_string(p).is_ok_and(|own| own == t));
+            !models.iter().any(|m| m == stem) && !shipped
+        })
+        .collect();
+    skipped.sort();
+    skipped
 }

@@ -181,7 +181,7 @@ pub struct Row {
 }
 
 /// The header of `track.csv` for `params`.
-pub fn header(params: &[Param]) -> String {
+pub fn header(params: &[Param]) -> Vec<String> {
     let mut h = vec!["t".to_string()];
     for p in params {
         match p {
@@ -211,7 +211,7 @@ pub fn header(params: &[Param]) -> String {
     ] {
         h.push(c.into());
     }
-    h.join(",")
+    h
 }
 
 fn cell(v: f64) -> String {
@@ -222,8 +222,8 @@ fn cell(v: f64) -> String {
     }
 }
 
-/// One `track.csv` line for `row`.
-pub fn line(params: &[Param], row: &Row) -> String {
+/// The fields of one `track.csv` record for `row`.
+pub fn line(params: &[Param], row: &Row) -> Vec<String> {
     let mut f = vec![format!("{}", row.t)];
     for p in params {
         let idx: &[usize] = match p {
@@ -241,7 +241,7 @@ pub fn line(params: &[Param], row: &Row) -> String {
     f.extend(row.friction_std.map(cell));
     f.push(format!("{:.4}", row.nis));
     f.push(format!("{}", row.lack_of_fit as u8));
-    f.join(",")
+    f
 }
 
 /// What a streamed run produced.
@@ -274,7 +274,7 @@ pub fn stream(
     reader: &mut dyn BufRead,
     src: &str,
     csv: &mut dyn Write,
-    mut echo: Option<&mut dyn Write>,
+    echo: Option<&mut dyn Write>,
 ) -> anyhow::Result<Outcome> {
     let md = track_model(sc)?;
     if free.center_of_friction && !md.center_of_friction_free() {
@@ -287,7 +287,9 @@ pub fn stream(
     let mut ekf = Ekf::new(md, free, settings, None);
     let origin = sc.center_of_mass;
     let head = header(params);
-    writeln!(csv, "{head}")?;
+    let mut csv = csv::Writer::from_writer(csv);
+    csv.write_record(&head)?;
+    let mut echo = echo.map(csv::Writer::from_writer);
     let select = match model_name {
         Some(m) => format::Select::Model(m.to_string()),
         None => format::Select::One,
@@ -311,7 +313,7 @@ pub fn stream(
     }
     // The input's header is good: the estimate's header goes out.
     if let Some(e) = echo.as_mut() {
-        writeln!(e, "{head}")?;
+        e.write_record(&head)?;
         e.flush()?;
     }
     let mut out = Outcome {
@@ -371,9 +373,9 @@ pub fn stream(
             update_time,
         };
         let l = line(params, &row);
-        writeln!(csv, "{l}")?;
+        csv.write_record(&l)?;
         if let Some(e) = echo.as_mut() {
-            writeln!(e, "{l}")?;
+            e.write_record(&l)?;
             e.flush()?;
         }
         if rep.lack_of_fit {
@@ -393,6 +395,7 @@ pub fn stream(
         out.lack_at_end = rep.lack_of_fit;
         out.rows.push(row);
     }
+    csv.flush()?;
     if out.rows.is_empty() {
         bail!(
             "{src}: no data rows{}",

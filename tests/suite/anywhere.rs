@@ -248,7 +248,7 @@ fn engines_file_is_found_in_a_parent_folder() {
 
 /// A study of a compiled-in engine runs in an empty folder: the study files
 /// come from the binary, and those of models this registry lacks
-/// (pybullet_contact) are skipped with a note, not fatal.
+/// (pybullet_contact) are skipped, neither fatal nor noted.
 #[test]
 fn study_runs_in_an_empty_folder() {
     let dir = tempfile::tempdir().unwrap();
@@ -258,7 +258,9 @@ fn study_runs_in_an_empty_folder() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{stderr}");
-    assert!(stderr.contains("pybullet_contact"), "{stderr}");
+    // The shipped study files of models this registry lacks are passed
+    // over in silence (issue 45, item 7).
+    assert!(!stderr.contains("pybullet_contact"), "{stderr}");
     assert!(dir.path().join("s/map.csv").is_file());
 }
 

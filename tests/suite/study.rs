@@ -779,7 +779,7 @@ fn creep_law_section_comes_from_its_csv() {
     let dir = root().join("results/friction_models/mujoco");
     let csv = std::fs::read_to_string(dir.join("creep_law.csv")).unwrap();
     let md = std::fs::read_to_string(dir.join("creep_law.md")).unwrap();
-    assert_eq!(pushval::study::creep_law::markdown(&csv).unwrap(), md);
+    assert_eq!(pushval::report::creep_law::markdown(&csv).unwrap(), md);
 }
 
 /// Engines whose declared law misses most of their turning cells on the
@@ -891,7 +891,8 @@ fn whole_period_tails_give_the_period_mean() {
     let p = problem(0.5, 1.0, 10.0, None);
     let exact = c * (1.0 - a * a).sqrt();
     let whole =
-        pushval::study::whole_period_omega(&p, &traj, 0.75, std::f64::consts::FRAC_PI_2).unwrap();
+        pushval::harness::law::whole_period_omega(&p, &traj, 0.75, std::f64::consts::FRAC_PI_2)
+            .unwrap();
     assert!((whole - exact).abs() < 1e-4 * exact, "{whole} vs {exact}");
     let plain = pushval_engine::tail_mean_omega(&p, &traj, 0.75)[0].unwrap();
     assert!(
@@ -899,7 +900,7 @@ fn whole_period_tails_give_the_period_mean() {
         "plain {plain}, whole {whole}, exact {exact}"
     );
     // Less than one period in the tail: no whole-period mean.
-    assert!(pushval::study::whole_period_omega(&p, &traj, 0.05, 2.0).is_none());
+    assert!(pushval::harness::law::whole_period_omega(&p, &traj, 0.05, 2.0).is_none());
 }
 
 /// The law on a run's loads, integrated in time: fed the analytic model's
@@ -944,7 +945,7 @@ fn the_law_integrated_on_a_runs_loads_follows_its_transient() {
             diagnostics: serde_json::json!({}),
             contact: Some(contact.clone()),
         };
-        pushval::study::law_on_run_loads(law, &p, 0, 1e-3, 1.0, &run, &contact)
+        pushval::harness::law::law_on_run_loads(law, &p, 0, 1e-3, 1.0, &run, &contact)
     };
     let traj = crate::common::run(&model, &p);
     let w_star = coulomb(&p).abs();
@@ -969,4 +970,71 @@ fn the_law_integrated_on_a_runs_loads_follows_its_transient() {
         quasi > 1e3 * rms,
         "quasi-static {quasi} vs integrated {rms}"
     );
+}
+
+/// Issue 45, item 7: a project's study files are its `studies/`, else the
+/// shipped ones, among them those of engines its registry does not run
+/// (Drake, PyBullet, …); `study` passes over every shipped file it does not
+/// use in silence, and still notes a study file the user wrote, or changed,
+/// for a model the registry lacks.
+#[test]
+fn study_is_quiet_about_shipped_files_a_project_does_not_use() {
+    let (dir, tmp, cache) = (
+        tempfile::tempdir().unwrap(),
+        tempfile::tempdir().unwrap(),
+        tempfile::tempdir().unwrap(),
+    );
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_pushval"))
+            .current_dir(dir.path())
+            .args(args)
+            .env("CI", "1")
+            .env("TMPDIR", tmp.path())
+            .env("XDG_CACHE_HOME", cache.path())
+            .env_remove("SLURM_ARRAY_TASK_ID")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(out.status.success(), "{err}");
+        err
+    };
+    let skipped = |err: &str| -> Vec<String> {
+        err.lines()
+            .filter(|l| l.contains("skipping"))
+            .map(String::from)
+            .collect()
+    };
+    ok(Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .current_dir(dir.path())
+        .arg("init")
+        .env("TMPDIR", tmp.path())
+        .env("XDG_CACHE_HOME", cache.path())
+        .output()
+        .unwrap());
+    // The premise: a shipped study file of a model this project lacks.
+    let engines = run(&["engines"]);
+    let unused = "pybullet_contact";
+    let shipped = pushval::shipped::study_text(unused).expect("shipped");
+    assert!(!engines.contains(unused), "{engines}");
+    // The shipped files (no studies/ folder): nothing to say.
+    let err = run(&["study", "index", "--quick", "--out", "out"]);
+    assert!(skipped(&err).is_empty(), "{err}");
+    // A studies/ folder with a shipped file as shipped, and the user's own.
+    let studies = dir.path().join("studies");
+    std::fs::create_dir(&studies).unwrap();
+    std::fs::write(studies.join(format!("{unused}.toml")), shipped).unwrap();
+    std::fs::write(studies.join("my_own_engine.toml"), "t_run = 2.0\n").unwrap();
+    let err = run(&["study", "index", "--quick", "--out", "out"]);
+    let lines = skipped(&err);
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(lines[0].contains("my_own_engine.toml"), "{err}");
+    // A shipped file the user changed is theirs: noted like any other.
+    std::fs::write(
+        studies.join(format!("{unused}.toml")),
+        format!("{shipped}\n# mine now\n"),
+    )
+    .unwrap();
+    let err = run(&["study", "index", "--quick", "--out", "out"]);
+    assert_eq!(skipped(&err).len(), 2, "{err}");
+    assert!(err.contains(&format!("{unused}.toml")), "{err}");
 }

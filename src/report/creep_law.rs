@@ -1,9 +1,11 @@
-//! MuJoCo's creep ladder as a README section: `creep_law.csv` (one row per
+//! MuJoCo's creep ladder as a results README: `creep_law.csv` (one row per
 //! run, written by `examples/creep_law.rs` from MuJoCo's creep measurement
-//! and the closed form) read back and
-//! written up as `creep_law.md`. Every number of the section is taken from
+//! and the closed form) read back and written up as `creep_law.md`. It
+//! lives with the reports, not the study: `pushval study` neither runs nor
+//! reads it. Every number of the section is taken from
 //! the CSV's text; the engine crate only simulates and predicts.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::registry::mujoco_creep::{CreepScene, CHATTER_HEIGHT_STD, SLIDING_SPEED};
@@ -37,54 +39,37 @@ pub const CSV_COLUMNS: [&str; 25] = [
     "slip_scale",
 ];
 
-/// Parses `creep_law.csv` text into rows of (column → text).
-pub fn parse_csv(text: &str) -> Result<Vec<Vec<(String, String)>>, String> {
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines
-        .next()
-        .ok_or("creep_law.csv: empty file")?
-        .split(',')
-        .collect();
-    if head != CSV_COLUMNS {
+/// One run of `creep_law.csv`: its fields by column name.
+pub type Row = BTreeMap<String, String>;
+
+/// Parses `creep_law.csv` text into rows; the header must be
+/// [`CSV_COLUMNS`].
+pub fn parse_csv(text: &str) -> Result<Vec<Row>, String> {
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let head = reader
+        .headers()
+        .map_err(|e| format!("creep_law.csv: {e}"))?
+        .clone();
+    if head.iter().ne(CSV_COLUMNS) {
         return Err(format!(
             "creep_law.csv: header is {head:?}, expected {CSV_COLUMNS:?}"
         ));
     }
-    let mut rows = Vec::new();
-    for (i, l) in lines.enumerate() {
-        let cells: Vec<&str> = l.split(',').collect();
-        if cells.len() != head.len() {
-            return Err(format!(
-                "creep_law.csv line {}: {} cells, expected {}",
-                i + 2,
-                cells.len(),
-                head.len()
-            ));
-        }
-        rows.push(
-            head.iter()
-                .zip(&cells)
-                .map(|(h, c)| (h.to_string(), c.to_string()))
-                .collect(),
-        );
-    }
-    Ok(rows)
+    reader
+        .deserialize()
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("creep_law.csv: {e}"))
 }
 
 /// The value of `key` in a parsed row ("" when absent).
-pub fn cell<'a>(row: &'a [(String, String)], key: &str) -> &'a str {
-    row.iter()
-        .find(|(k, _)| k == key)
-        .map(|(_, v)| v.as_str())
-        .unwrap_or("")
+pub fn cell<'a>(row: &'a Row, key: &str) -> &'a str {
+    row.get(key).map_or("", String::as_str)
 }
 
 /// The number in `key` of a parsed row (NaN when empty or not a number).
-pub fn num(row: &[(String, String)], key: &str) -> f64 {
+pub fn num(row: &Row, key: &str) -> f64 {
     cell(row, key).parse().unwrap_or(f64::NAN)
 }
-
-type Row = Vec<(String, String)>;
 
 fn fmt_e(v: f64, digits: usize) -> String {
     if v.is_finite() {
@@ -96,13 +81,13 @@ fn fmt_e(v: f64, digits: usize) -> String {
 
 /// Whether the plate of a row settled on its feet (its height varied by
 /// less than [`CHATTER_HEIGHT_STD`] over the measuring window).
-pub fn settles(row: &[(String, String)]) -> bool {
+pub fn settles(row: &Row) -> bool {
     num(row, "height_std") < CHATTER_HEIGHT_STD
 }
 
 /// Whether a row lies in the closed form's domain: a steady state exists
 /// (regime not `slides`) and MuJoCo's noslip pass is off.
-pub fn in_domain(row: &[(String, String)]) -> bool {
+pub fn in_domain(row: &Row) -> bool {
     cell(row, "regime") != "slides" && num(row, "noslip") == 0.0
 }
 

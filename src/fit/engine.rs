@@ -1,7 +1,8 @@
-//! Which Coulomb parameters an engine behaves as (`coulomb_fit.csv`): the
-//! dynamic model fitted to the engine's trajectory by `pushval fit`'s
-//! machinery ([`crate::fit`], Levenberg–Marquardt), and whether the fit
-//! explains the engine.
+//! Which Coulomb parameters an engine behaves as: the dynamic model fitted
+//! to an engine's trajectory by `pushval fit`'s machinery (Levenberg–
+//! Marquardt), and whether the fit explains the engine. A fit of an engine
+//! is a fit like any other, so it lives here; `pushval study` runs it as
+//! one of its tasks and writes its rows as `coulomb_fit.csv`.
 //!
 //! Two schedules of the paper plate, read from the shipped scenarios (the
 //! binary's, whatever folder the study runs in):
@@ -25,7 +26,7 @@
 use pushval_engine::Engine;
 use pushval_model::{DynamicModel, Sample, Simulator};
 
-use crate::fit::{fisher_at, fit, Param, Parametrised, Settings};
+use super::{fisher_at, fit, Param, Parametrised, Settings};
 
 /// The scenario files of the schedules, single push first.
 pub const SCHEDULES: [&str; 2] = ["friction-engines.toml", "paper-square-v1.0.toml"];
@@ -36,7 +37,23 @@ pub const THRESHOLD_FACTOR: f64 = 10.0;
 /// Above this (m, rad) a threshold no longer decides.
 pub const THRESHOLD_CAP: f64 = 1e-3;
 /// The columns of `coulomb_fit.csv` after `schedule`.
-pub const COLUMNS: &str = "dt,mu_scale,mu_scale_std,cof_x,cof_y,inertia_cm,inertia_cm_std,start_position_rms,start_theta_rms,position_rms,theta_rms,engine_error_position,engine_error_theta,converged,fitted";
+pub const COLUMNS: [&str; 15] = [
+    "dt",
+    "mu_scale",
+    "mu_scale_std",
+    "cof_x",
+    "cof_y",
+    "inertia_cm",
+    "inertia_cm_std",
+    "start_position_rms",
+    "start_theta_rms",
+    "position_rms",
+    "theta_rms",
+    "engine_error_position",
+    "engine_error_theta",
+    "converged",
+    "fitted",
+];
 /// Values in a fit's row (the columns above less `fitted`, plus three
 /// flags: centre of friction fitted, I_cm fitted, and which parameters are
 /// near zero: 1 the μ scale, 2 I_cm, 3 both, 0 none).
