@@ -570,22 +570,20 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
     })
 }
 
-/// The plant's trajectory rows with the applied push, as CSV.
+/// The plant's trajectory rows with the applied push (columns `speed`,
+/// `phi`), through the trajectory format's writer.
 pub fn trajectory_csv(out: &LoopOutcome, run: &pushval_engine::EngineRun, model: &str) -> String {
-    let mut s = format!("{},speed,phi\n", pushval_model::format::HEADER);
-    for smp in &run.trajectory.samples {
-        let p = push_at(&out.applied, smp.t);
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{}\n",
-            model,
-            smp.t,
-            smp.x,
-            smp.y,
-            smp.theta,
-            smp.omega,
-            p.map_or(0.0, |p| p.speed),
-            p.map_or(0.0, |p| p.phi)
-        ));
-    }
-    s
+    let mut bytes = Vec::new();
+    pushval_model::format::write_with(
+        &mut bytes,
+        &[(model, run.trajectory.samples.as_slice())],
+        &["speed", "phi"],
+        |smp| {
+            // After the release the pusher is gone: speed 0.
+            let p = push_at(&out.applied, smp.t).filter(|_| smp.t <= out.release.t + 1e-12);
+            vec![p.map_or(0.0, |p| p.speed), p.map_or(0.0, |p| p.phi)]
+        },
+    )
+    .expect("writing to memory");
+    String::from_utf8(bytes).expect("the format is ASCII")
 }

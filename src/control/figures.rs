@@ -9,7 +9,10 @@ use pushval_control::predict::Start;
 use pushval_control::{Goal, ModelKind, Reach};
 use pushval_model::Problem;
 
-use super::study::{Group, SEGMENTS};
+/// One success.csv row's key: engine, speed (bits), plan predictor, mode,
+/// plant.
+pub(crate) type Group = (String, u64, &'static str, &'static str, &'static str);
+
 use crate::plot::{self, Axis, Figure, Legend, MapCell, Panel, Scale, Series, Stroke};
 
 const COLUMNS: [(&str, &str, &str); 8] = [
@@ -130,6 +133,7 @@ pub(crate) fn success_figure(
 /// dynamic model's prediction.
 pub(crate) fn paths_figure(
     problem: &Problem,
+    segments: usize,
     names: &[String],
     goals: &[Goal],
     speeds: &[f64],
@@ -138,7 +142,7 @@ pub(crate) fn paths_figure(
     let goal = goals[0];
     let start = Start::of_problem(problem);
     let spec = PlanSpec {
-        segments: SEGMENTS,
+        segments,
         speed: v,
         predictor: ModelKind::Dynamic,
         at: pushval_control::At::Release,

@@ -475,7 +475,7 @@ pub fn cli(
 }
 
 /// One success.csv row's key.
-pub(crate) type Group = (String, u64, &'static str, &'static str, &'static str);
+use super::figures::Group;
 
 #[allow(clippy::too_many_arguments)]
 fn write_outputs(
@@ -596,7 +596,7 @@ fn write_outputs(
         "success.svg",
         &super::figures::success_figure(names, speeds, &summary),
     )?;
-    let paths = super::figures::paths_figure(problem, names, goals, speeds)?;
+    let paths = super::figures::paths_figure(problem, SEGMENTS, names, goals, speeds)?;
     dir.figure("paths.svg", &paths)?;
     let mut failed_runs: BTreeMap<String, usize> = BTreeMap::new();
     for (t, r) in list.iter().zip(rows) {

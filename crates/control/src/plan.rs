@@ -736,8 +736,9 @@ fn checked(
         At::Rest => Some(problem.release.unwrap_or_default()),
         At::Release => None,
     };
-    let total = p.duration();
-    p.sample_dt = problem.sample_dt.max(total / 10_000.0).min(total);
+    // At most about 10,000 samples over the pushes and the slide.
+    let horizon = p.duration() + p.release.map_or(0.0, |r| r.max_duration);
+    p.sample_dt = problem.sample_dt.max(horizon / 10_000.0);
     let traj = DynamicModel::default().simulate(&p)?;
     let from_rest = matches!(start.motion, Motion::Rest);
     let switches = switch_checks(&p, &traj, from_rest);

@@ -623,14 +623,34 @@ pub fn derive_omega(samples: &mut [Sample]) {
 /// Writes runs in the format: the header [`HEADER`], then each run's samples
 /// in order, one row per sample.
 pub fn write<W: Write>(out: &mut W, runs: &[(&str, &[Sample])]) -> io::Result<()> {
-    writeln!(out, "{HEADER}")?;
+    write_with(out, runs, &[], |_| Vec::new())
+}
+
+/// [`write`] with further columns `names` after the format's own, their
+/// values for each sample from `extra` (one per name, shortest round-trip
+/// form): e.g. the push applied at each sample of a closed loop.
+pub fn write_with<W: Write>(
+    out: &mut W,
+    runs: &[(&str, &[Sample])],
+    names: &[&str],
+    extra: impl Fn(&Sample) -> Vec<f64>,
+) -> io::Result<()> {
+    write!(out, "{HEADER}")?;
+    for n in names {
+        write!(out, ",{n}")?;
+    }
+    writeln!(out)?;
     for (name, samples) in runs {
         for p in *samples {
-            writeln!(
+            write!(
                 out,
                 "{name},{},{},{},{},{}",
                 p.t, p.x, p.y, p.theta, p.omega
             )?;
+            for v in extra(p) {
+                write!(out, ",{v}")?;
+            }
+            writeln!(out)?;
         }
     }
     Ok(())
