@@ -72,7 +72,7 @@ fn engine(name: &str) -> Box<dyn Engine> {
 
 /// The engines that release, with their steps (s).
 fn releasing() -> Vec<(Box<dyn Engine>, f64)> {
-    ["rapier2d"]
+    ["rapier2d", "box2d"]
         .iter()
         .map(|n| {
             let e = engine(n);
@@ -123,10 +123,17 @@ fn pure_translation_stops_at_the_closed_form() {
                 "{}: {d} m, closed form {d_exact} m",
                 e.name()
             );
-            // Along the velocity, not turning.
+            // Along the velocity, not turning (to single precision: Box2D
+            // keeps its velocities and rotation in f32).
             let along = (last.x * v[0] + last.y * v[1]) / speed;
-            assert!((along - d).abs() < 1e-9 * d_exact, "{}", e.name());
-            assert!((last.theta - theta).abs() < 1e-9, "{}", e.name());
+            let first = run.trajectory.samples[0];
+            assert!((along - d).abs() < 1e-6 * d_exact, "{}", e.name());
+            assert!(
+                (last.theta - first.theta).abs() < 1e-6,
+                "{}: turned {} rad",
+                e.name(),
+                last.theta - first.theta
+            );
         }
     }
 }

@@ -25,6 +25,7 @@ mod contact;
 mod options;
 mod resample;
 mod session;
+pub mod slide;
 pub mod stepping;
 
 pub use contact::{ContactRecord, LoadRecorder, LOST_SHARE_OF_WEIGHT};

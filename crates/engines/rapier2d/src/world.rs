@@ -28,14 +28,6 @@ const MIN_SLIDING_SPEED: f64 = 1e-12;
 /// step length used here and drift is corrected fully at each substep.
 const JOINT_FREQUENCY: Real = 1.0e9;
 
-/// Largest number of projected Gauss–Seidel sweeps over the supports per
-/// step of the slide ([`World2d::slide_step`]).
-const SLIDE_SWEEPS: usize = 500;
-
-/// The sweeps stop once no support's impulse changed by more than this
-/// share of the largest friction impulse `μᵢ Nᵢ h`.
-const SLIDE_SWEEP_TOL: f64 = 1e-13;
-
 fn v(x: f64, y: f64) -> Vector {
     Vector::new(x as Real, y as Real)
 }
@@ -495,60 +487,27 @@ impl PlateWorld for World2d {
     }
 
     /// The supports' Coulomb friction over a step of the slide, without
-    /// chattering at the stop: the impulses `Pᵢ` (each within its disc
-    /// `|Pᵢ| ≤ μᵢ Nᵢ h`) are the ones that leave each support's slip
-    /// velocity zero at the step's end where the disc allows it, and
-    /// otherwise oppose the end-of-step slip with the full `μᵢ Nᵢ h`
-    /// (implicit Coulomb friction, the most dissipative impulses within the
-    /// discs), solved jointly by projected Gauss–Seidel over the supports
-    /// from the velocity at the step's start (at most `SLIDE_SWEEPS` sweeps,
-    /// to a change below `SLIDE_SWEEP_TOL` of the largest cap). A support whose slip one
-    /// step's friction would reverse is therefore stopped, not reversed,
-    /// and a plate that one step can stop comes to rest exactly. The
-    /// impulses are applied as the constant forces `Pᵢ / h`.
+    /// chattering at the stop: the implicit Coulomb impulses of
+    /// [`pushval_engine::slide`] (each support's impulse capped at what
+    /// leaves its slip zero at the step's end), applied as the constant
+    /// forces `Pᵢ / h` at the supports.
     fn slide_step(&mut self, state: &State, h: f64) {
-        let (inv_m, inv_i) = (1.0 / self.mass, 1.0 / self.inertia_cm);
-        let rs: Vec<[f64; 2]> = self.supports.iter().map(|s| state.rot.apply(s.0)).collect();
-        let caps: Vec<f64> = self.supports.iter().map(|s| s.1.max(0.0) * h).collect();
-        let cap_max = caps.iter().copied().fold(0.0, f64::max);
-        let mut acc = vec![[0.0; 2]; rs.len()];
-        let (mut vel, mut w) = (state.v, state.omega);
-        for _ in 0..SLIDE_SWEEPS {
-            let mut change: f64 = 0.0;
-            for ((r, &cap), a) in rs.iter().zip(&caps).zip(acc.iter_mut()) {
-                if cap <= 0.0 {
-                    continue;
-                }
-                let u = [vel[0] - w * r[1], vel[1] + w * r[0]];
-                // A projected gradient step on the support's impulse with
-                // the largest slip change per unit impulse there, 1/m +
-                // |r|²/I (the largest eigenvalue of the support's 2×2
-                // effective inverse mass): its fixed points are exactly the
-                // Coulomb ones (a clamped impulse opposes the end-of-step
-                // slip), which a step with the full 2×2 inverse would not
-                // give (the disc is round in impulse, not in its metric).
-                let rp = [-r[1], r[0]];
-                let k = inv_m + inv_i * (r[0] * r[0] + r[1] * r[1]);
-                let dp = [-u[0] / k, -u[1] / k];
-                let mut p = [a[0] + dp[0], a[1] + dp[1]];
-                let n = p[0].hypot(p[1]);
-                if n > cap {
-                    p = [p[0] * cap / n, p[1] * cap / n];
-                }
-                let d = [p[0] - a[0], p[1] - a[1]];
-                vel = [vel[0] + inv_m * d[0], vel[1] + inv_m * d[1]];
-                w += inv_i * (rp[0] * d[0] + rp[1] * d[1]);
-                *a = p;
-                change = change.max(d[0].hypot(d[1]));
-            }
-            if change <= SLIDE_SWEEP_TOL * cap_max {
-                break;
-            }
-        }
+        let rs: Vec<([f64; 2], f64)> = self
+            .supports
+            .iter()
+            .map(|s| (state.rot.apply(s.0), s.1.max(0.0) * h))
+            .collect();
+        let acc = pushval_engine::slide::coulomb_impulses(
+            self.mass,
+            self.inertia_cm,
+            state.v,
+            state.omega,
+            &rs,
+        );
         let rb = &mut self.world.bodies[self.object];
         rb.reset_forces(false);
         rb.reset_torques(false);
-        for (r, a) in rs.iter().zip(&acc) {
+        for ((r, _), a) in rs.iter().zip(&acc) {
             if *a != [0.0, 0.0] {
                 let point = v(state.x + r[0], state.y + r[1]);
                 rb.add_force_at_point(v(a[0] / h, a[1] / h), point, true);
