@@ -20,6 +20,7 @@ mod outside;
 mod power;
 mod properties;
 mod readme;
+mod release;
 mod report;
 mod scenarios;
 mod sessions;

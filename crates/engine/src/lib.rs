@@ -25,6 +25,7 @@ mod contact;
 mod options;
 mod resample;
 mod session;
+pub mod slide;
 pub mod stepping;
 
 pub use contact::{ContactRecord, LoadRecorder, LOST_SHARE_OF_WEIGHT};
@@ -35,12 +36,13 @@ pub use pushval_laws::{
     coulomb_steady, Coulomb, FrictionLaw, LawClass, LawSteady, COULOMB, GRAVITY,
 };
 pub use resample::{
-    resample, sample, segment_reports, step_tail_omega, tail_mean_omega, trajectory_from_steps,
-    StepRecord,
+    extend_through_slide, resample, sample, segment_reports, step_tail_omega, tail_mean_omega,
+    trajectory_from_steps, StepRecord,
 };
 pub use session::{
-    on_first_push, on_thread, rigid_cm_velocity, run_via_session, with_pushes, EngineSession,
-    EngineState, ReplaySession, Session,
+    after_release, no_release, on_first_push, on_thread, rest_speed, rigid_cm_velocity,
+    run_via_session, with_pushes, EngineSession, EngineState, ReplaySession, Session, REST_SPEED,
+    REST_STEPS,
 };
 
 /// What one engine run produced.

@@ -233,3 +233,59 @@ pub fn tail_mean_omega(
         })
         .collect()
 }
+
+/// Continues `trajectory` (sampled up to the release at `release.t`)
+/// through an engine's free slide: `steps` are the slide's steps (each its
+/// end time and pose, with the ω held over it), `end` the rest state (or
+/// the state at the release's `max_duration`). Samples go on on the
+/// problem's grid (`k · sample_dt`, the pose linear between step ends, ω
+/// the step's) after the release and before the end; the last row is
+/// `end`; [`Trajectory::slide`] is set to `report`. The release row itself
+/// is added when the trajectory does not end there (a throw: no pushes).
+pub fn extend_through_slide(
+    problem: &Problem,
+    trajectory: &mut Trajectory,
+    release: Sample,
+    steps: &[Sample],
+    end: Sample,
+    report: pushval_model::SlideReport,
+) {
+    let eps = 1e-9 * problem.sample_dt;
+    if trajectory
+        .samples
+        .last()
+        .is_none_or(|l| l.t < release.t - eps)
+    {
+        trajectory.samples.push(release);
+    }
+    let nodes: Vec<Sample> = std::iter::once(release)
+        .chain(steps.iter().copied())
+        .filter(|s| s.t <= end.t + eps)
+        .collect();
+    for ts in problem.sample_times_through(end.t) {
+        if nodes.len() < 2 || ts <= release.t + eps || ts >= end.t - eps {
+            continue;
+        }
+        let k = nodes
+            .partition_point(|r| r.t <= ts)
+            .clamp(1, nodes.len() - 1);
+        let (a, b) = (nodes[k - 1], nodes[k]);
+        let w = if b.t > a.t {
+            ((ts - a.t) / (b.t - a.t)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        trajectory.samples.push(Sample {
+            t: ts,
+            x: a.x + w * (b.x - a.x),
+            y: a.y + w * (b.y - a.y),
+            theta: a.theta + w * (b.theta - a.theta),
+            omega: b.omega,
+        });
+    }
+    match trajectory.samples.last_mut() {
+        Some(l) if l.t >= end.t - eps => *l = end,
+        _ => trajectory.samples.push(end),
+    }
+    trajectory.slide = Some(report);
+}

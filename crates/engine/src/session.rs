@@ -27,7 +27,7 @@
 use std::sync::{mpsc, Arc};
 use std::thread::JoinHandle;
 
-use pushval_model::{ModelError, Problem, Push};
+use pushval_model::{ModelError, Problem, Push, SlideReport};
 
 use crate::{Engine, EngineRun};
 
@@ -108,14 +108,64 @@ pub trait EngineSession {
     }
     /// Engine steps taken so far, replays included (the cost of the session).
     fn steps_taken(&self) -> usize;
-    /// Lets go: the pusher withdraws and the engine steps until the plate is
-    /// at rest, or `max_duration` s pass. An engine that cannot release
-    /// refuses (this default), naming the release.
-    fn release(&mut self, _max_duration: f64) -> Result<(), ModelError> {
-        Err(ModelError::Adapter(
-            "this engine cannot release the plate (no free slide after the last push)".into(),
-        ))
+    /// Lets go of the plate: the pusher's constraint goes and the engine
+    /// steps until the plate is at rest, or until `max_duration` (s) has
+    /// passed (then the slide is reported as not stopped, never as rest).
+    ///
+    /// **At rest** means: the plate's speed `|v_cm| + |ω| L` (m/s, `L` the
+    /// largest distance of a support from the centre of mass) is below
+    /// [`REST_SPEED`] on [`REST_STEPS`] consecutive steps; the stop time is
+    /// the end of the first of those steps. After a release,
+    /// [`state`](EngineSession::state) is the rest state (its `t` the stop
+    /// time) or the state at `max_duration`, [`slide`](EngineSession::slide)
+    /// says which, and the run [`finish`](EngineSession::finish) returns goes
+    /// on through the slide (its last row the rest) with
+    /// [`Trajectory::slide`](pushval_model::Trajectory::slide) set. No push
+    /// can follow a release.
+    ///
+    /// Without a push applied before it, the plate is thrown: it starts
+    /// the slide with the problem's `initial.velocity` and ω.
+    ///
+    /// By default an engine cannot release: [`ModelError::NoRelease`], never
+    /// a run that ends at the release.
+    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        let _ = max_duration;
+        Err(no_release("its session has no free slide"))
     }
+    /// What the release found (None before a release, or for a session that
+    /// does not release).
+    fn slide(&self) -> Option<SlideReport> {
+        None
+    }
+}
+
+/// Speed (m/s) below which a plate counts as at rest: `|v_cm| + |ω| L`, `L`
+/// the largest distance of a support from the centre of mass. At a
+/// deceleration μg of a few m/s² it is passed a few microseconds before the
+/// stop.
+pub const REST_SPEED: f64 = 1e-5;
+
+/// Consecutive steps the plate must stay below [`REST_SPEED`] to be at
+/// rest (a plate passing through zero speed is not at rest).
+pub const REST_STEPS: usize = 10;
+
+/// The refusal of an engine that cannot release, for `reason`; the engine's
+/// name is filled in by the session [`start`] hands out.
+pub fn no_release(reason: impl Into<String>) -> ModelError {
+    ModelError::NoRelease {
+        engine: String::new(),
+        reason: reason.into(),
+    }
+}
+
+/// The plate's speed measure of the rest rule (m/s): `|v_cm| + |ω| L`.
+pub fn rest_speed(problem: &Problem, v_cm: [f64; 2], omega: f64) -> f64 {
+    let l = problem
+        .body
+        .supports()
+        .map(|s| s.position.norm())
+        .fold(0.0, f64::max);
+    v_cm[0].hypot(v_cm[1]) + omega.abs() * l
 }
 
 /// An owned engine session, as [`Engine::start`](crate::Engine::start)
@@ -190,11 +240,34 @@ impl EngineSession for Deferred {
     fn steps_taken(&self) -> usize {
         self.session.as_ref().map_or(0, |s| s.steps_taken())
     }
+
+    /// A release before any push throws the plate: the world is built at
+    /// rest (no push gives it a velocity) and the release sets it moving
+    /// with `initial.velocity` and ω.
+    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        if self.session.is_none() {
+            let build = self.build.take().ok_or_else(|| {
+                ModelError::Adapter("the session failed to start at its release".into())
+            })?;
+            let mut problem = self.problem.clone();
+            problem.initial.from_rest = true;
+            self.session = Some(build(&problem)?);
+        }
+        self.session
+            .as_mut()
+            .expect("built above")
+            .release(max_duration)
+    }
+
+    fn slide(&self) -> Option<SlideReport> {
+        self.session.as_ref().and_then(|s| s.slide())
+    }
 }
 
 /// What a [`Threaded`] session asks its thread.
 enum Ask {
     Advance(Push),
+    Release(f64),
     Finish,
 }
 
@@ -202,6 +275,7 @@ enum Ask {
 /// run.
 enum Answer {
     Advanced(Result<(EngineState, usize), ModelError>),
+    Released(Result<(EngineState, usize, Option<SlideReport>), ModelError>),
     Finished(Result<EngineRun, ModelError>),
 }
 
@@ -243,6 +317,14 @@ where
                             return;
                         }
                     }
+                    Ask::Release(max_duration) => {
+                        let r = session
+                            .release(max_duration)
+                            .map(|()| (session.state(), session.steps_taken(), session.slide()));
+                        if answer_tx.send(Answer::Released(r)).is_err() {
+                            return;
+                        }
+                    }
                     Ask::Finish => {
                         let _ = answer_tx.send(Answer::Finished(session.finish()));
                         return;
@@ -259,6 +341,7 @@ where
         thread: Some(thread),
         state: EngineState::default(),
         steps: 0,
+        slide: None,
     };
     let (state, steps) = s.advanced()?;
     s.state = state;
@@ -273,6 +356,7 @@ struct Threaded {
     thread: Option<JoinHandle<()>>,
     state: EngineState,
     steps: usize,
+    slide: Option<SlideReport>,
 }
 
 impl Threaded {
@@ -293,7 +377,7 @@ impl Threaded {
     fn advanced(&mut self) -> Result<(EngineState, usize), ModelError> {
         match self.answer.recv() {
             Ok(Answer::Advanced(r)) => r,
-            Ok(Answer::Finished(_)) | Err(_) => Err(self.lost()),
+            Ok(Answer::Finished(_) | Answer::Released(_)) | Err(_) => Err(self.lost()),
         }
     }
 }
@@ -319,7 +403,7 @@ impl EngineSession for Threaded {
         }
         let run = match self.answer.recv() {
             Ok(Answer::Finished(r)) => r,
-            Ok(Answer::Advanced(_)) | Err(_) => Err(self.lost()),
+            Ok(Answer::Advanced(_) | Answer::Released(_)) | Err(_) => Err(self.lost()),
         };
         if let Some(t) = self.thread.take() {
             let _ = t.join();
@@ -329,6 +413,24 @@ impl EngineSession for Threaded {
 
     fn steps_taken(&self) -> usize {
         self.steps
+    }
+
+    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        if self.ask.send(Ask::Release(max_duration)).is_err() {
+            return Err(self.lost());
+        }
+        let (state, steps, slide) = match self.answer.recv() {
+            Ok(Answer::Released(r)) => r?,
+            Ok(Answer::Advanced(_) | Answer::Finished(_)) | Err(_) => return Err(self.lost()),
+        };
+        self.state = state;
+        self.steps = steps;
+        self.slide = slide;
+        Ok(())
+    }
+
+    fn slide(&self) -> Option<SlideReport> {
+        self.slide.clone()
     }
 }
 
@@ -343,6 +445,7 @@ pub struct ReplaySession {
     last: Option<EngineRun>,
     state: EngineState,
     steps: usize,
+    released: bool,
 }
 
 impl ReplaySession {
@@ -356,6 +459,7 @@ impl ReplaySession {
             applied: Vec::new(),
             last: None,
             steps: 0,
+            released: false,
         }
     }
 }
@@ -366,6 +470,9 @@ impl EngineSession for ReplaySession {
     }
 
     fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        if self.released {
+            return Err(after_release());
+        }
         self.applied.push(*push);
         let problem = with_pushes(&self.problem, self.applied.clone());
         let run = self.engine.run(&problem, self.dt)?;
@@ -396,6 +503,49 @@ impl EngineSession for ReplaySession {
         true
     }
 
+    /// Re-runs the pushes applied with the release after them; the state
+    /// is the run's last row (its velocity the rest's zero, or, when the
+    /// plate has not stopped, the last two rows' difference).
+    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        if self.released {
+            return Err(after_release());
+        }
+        let mut problem = with_pushes(&self.problem, self.applied.clone());
+        problem.release = Some(pushval_model::Release { max_duration });
+        let run = self.engine.run(&problem, self.dt)?;
+        self.steps += run.steps;
+        let rows = &run.trajectory.samples;
+        let s = *rows.last().ok_or(ModelError::EmptySchedule)?;
+        let stopped = run
+            .trajectory
+            .slide
+            .as_ref()
+            .is_some_and(|r| r.t_stop.is_some());
+        let v_cm = match rows.len() {
+            n if n >= 2 && !stopped => {
+                let p = rows[n - 2];
+                let dt = (s.t - p.t).max(f64::MIN_POSITIVE);
+                [(s.x - p.x) / dt, (s.y - p.y) / dt]
+            }
+            _ => [0.0, 0.0],
+        };
+        self.state = EngineState {
+            t: s.t,
+            x: s.x,
+            y: s.y,
+            theta: s.theta,
+            omega: if stopped { 0.0 } else { s.omega },
+            v_cm,
+        };
+        self.last = Some(run);
+        self.released = true;
+        Ok(())
+    }
+
+    fn slide(&self) -> Option<SlideReport> {
+        self.last.as_ref().and_then(|r| r.trajectory.slide.clone())
+    }
+
     fn steps_taken(&self) -> usize {
         self.steps
     }
@@ -416,11 +566,72 @@ pub fn start<E: Engine + ?Sized>(
             value: dt,
         });
     }
-    engine.session(&with_pushes(problem, Vec::new()), dt)
+    let inner = engine.session(&with_pushes(problem, Vec::new()), dt)?;
+    Ok(Box::new(Named {
+        engine: engine.info().name.clone(),
+        inner,
+    }))
+}
+
+/// The refusal of a push after the release.
+pub fn after_release() -> ModelError {
+    ModelError::Adapter("the plate was released: no push can follow the release".into())
+}
+
+/// An engine's session as [`start`] hands it out: the engine's own, whose
+/// refusal to release names the engine and whose run carries its name.
+struct Named {
+    engine: String,
+    inner: Session,
+}
+
+impl EngineSession for Named {
+    fn state(&self) -> EngineState {
+        self.inner.state()
+    }
+    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        self.inner.advance(push)
+    }
+    fn finish(self: Box<Self>) -> Result<EngineRun, ModelError> {
+        let mut run = self.inner.finish()?;
+        if run.trajectory.model.is_empty() {
+            run.trajectory.model = self.engine;
+        }
+        Ok(run)
+    }
+    fn replays(&self) -> bool {
+        self.inner.replays()
+    }
+    fn steps_taken(&self) -> usize {
+        self.inner.steps_taken()
+    }
+    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        if !(max_duration.is_finite() && max_duration > 0.0) {
+            return Err(ModelError::Parameter {
+                name: "release max_duration",
+                requirement: "finite and > 0",
+                value: max_duration,
+            });
+        }
+        match self.inner.release(max_duration) {
+            Err(ModelError::NoRelease { engine, reason }) if engine.is_empty() => {
+                Err(ModelError::NoRelease {
+                    engine: self.engine.clone(),
+                    reason,
+                })
+            }
+            r => r,
+        }
+    }
+    fn slide(&self) -> Option<SlideReport> {
+        self.inner.slide()
+    }
 }
 
 /// `run` as the contract defines it: `start`, one `advance` per push of the
-/// schedule, `finish`. The one push loop of the engines.
+/// schedule, the release when the problem has one (without pushes: at once,
+/// the plate thrown with `initial.velocity` and ω), `finish`. The one push
+/// loop of the engines.
 pub fn run_via_session<E: Engine + ?Sized>(
     engine: &E,
     problem: &Problem,
@@ -430,6 +641,9 @@ pub fn run_via_session<E: Engine + ?Sized>(
     let mut session = start(engine, problem, dt)?;
     for push in &problem.pushes {
         session.advance(push)?;
+    }
+    if let Some(release) = &problem.release {
+        session.release(release.max_duration)?;
     }
     session.finish()
 }

@@ -32,7 +32,9 @@
 //! The arithmetic is written once here, in a fixed order, so that every
 //! engine using it gets the same numbers it got from its own copy of the loop.
 
-use pushval_model::{ModelError, Problem, Push, SolverStats, Trajectory};
+use std::time::Instant;
+
+use pushval_model::{ModelError, Problem, Push, Sample, SlideReport, SolverStats, Trajectory};
 
 use crate::contact::{ContactRecord, LoadRecorder};
 use crate::resample::{resample, StepRecord};
@@ -209,6 +211,27 @@ pub trait PlateWorld {
     fn cm_velocity(&self, _state: &Self::State) -> Option<[f64; 2]> {
         None
     }
+
+    /// Lets go of the plate ([`Stepping::release`]): the pusher's
+    /// constraint goes (the pusher withdraws without an impulse). `throw`,
+    /// given when no push was applied, is the velocity to start the slide
+    /// with: the centre of mass's (m/s, world) and ω (rad/s). By default the
+    /// world cannot release ([`crate::no_release`]).
+    fn release(
+        &mut self,
+        _state: &Self::State,
+        _throw: Option<([f64; 2], f64)>,
+    ) -> Result<(), ModelError> {
+        Err(crate::no_release(
+            "its world cannot remove the pusher's constraint",
+        ))
+    }
+
+    /// Before every step of the slide (the pusher gone) from `state`, of
+    /// length `h` (s): what the world applies itself (its supports'
+    /// friction where the engine's own contacts do not). Nothing by
+    /// default.
+    fn slide_step(&mut self, _state: &Self::State, _h: f64) {}
 }
 
 /// Which steps of a segment of `n` steps make its tail.
@@ -411,6 +434,28 @@ pub struct Stepping<W: PlateWorld> {
     log: Vec<StepLog>,
     applied: Vec<Push>,
     t_seg: f64,
+    slide: Option<SlideOut>,
+}
+
+/// What [`Stepping::release`] gathered: the slide's steps (to the first step
+/// of the rest), the rest state (or the state at `max_duration`) and the
+/// report.
+#[derive(Debug, Clone)]
+struct SlideOut {
+    release: Sample,
+    steps: Vec<Sample>,
+    end: crate::EngineState,
+    report: SlideReport,
+}
+
+fn row(s: &crate::EngineState) -> Sample {
+    Sample {
+        t: s.t,
+        x: s.x,
+        y: s.y,
+        theta: s.theta,
+        omega: s.omega,
+    }
 }
 
 impl<W: PlateWorld> Stepping<W> {
@@ -433,6 +478,7 @@ impl<W: PlateWorld> Stepping<W> {
             log: Vec::new(),
             applied: Vec::new(),
             t_seg: 0.0,
+            slide: None,
         }
     }
 
@@ -471,6 +517,9 @@ impl<W: PlateWorld> Stepping<W> {
     /// [`PlateWorld::cm_velocity`], else the one a rigid contact moving with
     /// the last push gives.
     pub fn engine_state(&self) -> crate::EngineState {
+        if let Some(slide) = &self.slide {
+            return slide.end;
+        }
         let p = self.world.plate(&self.state);
         let v_cm = self.world.cm_velocity(&self.state).unwrap_or_else(|| {
             crate::rigid_cm_velocity(&self.problem, self.applied.last(), p.theta, p.omega)
@@ -485,8 +534,128 @@ impl<W: PlateWorld> Stepping<W> {
         }
     }
 
+    /// What the release found (None before it).
+    pub fn slide(&self) -> Option<&SlideReport> {
+        self.slide.as_ref().map(|s| &s.report)
+    }
+
+    /// Lets go ([`crate::EngineSession::release`]): the world removes the
+    /// pusher's constraint ([`PlateWorld::release`]; without a push applied
+    /// it throws the plate with the problem's `initial.velocity` and ω),
+    /// then steps of the loop's `dt` (the last one ending at
+    /// `max_duration`), each after [`PlateWorld::slide_step`], until the
+    /// plate is at rest by the rule of [`crate::REST_SPEED`] and
+    /// [`crate::REST_STEPS`]. The slide's steps are kept apart from the
+    /// pushes' (the tails, loads and extremes stay the pushes'; the largest
+    /// tilt and lift take the slide's too).
+    pub fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        if self.slide.is_some() {
+            return Err(crate::after_release());
+        }
+        let throw = self.applied.is_empty().then(|| {
+            let i = &self.problem.initial;
+            ([i.velocity.x, i.velocity.y], i.omega)
+        });
+        self.world.release(&self.state, throw)?;
+        self.state = self.world.state(&self.state);
+        let t_rel = self.t_seg;
+        let mut prev = self.world.plate(&self.state);
+        let v0 = self.world.cm_velocity(&self.state).unwrap_or_else(|| {
+            if throw.is_some() {
+                throw.map_or([0.0, 0.0], |t| t.0)
+            } else {
+                crate::rigid_cm_velocity(&self.problem, self.applied.last(), prev.theta, prev.omega)
+            }
+        });
+        let start = crate::EngineState {
+            t: t_rel,
+            x: prev.x,
+            y: prev.y,
+            theta: prev.theta,
+            omega: prev.omega,
+            v_cm: v0,
+        };
+        let h = self.cfg.dt;
+        let n = (max_duration / h * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+        let mut steps = Vec::new();
+        let mut last = start;
+        let mut rest: Option<(usize, crate::EngineState)> = None;
+        let mut held = 0;
+        for k in 0..n {
+            let t0 = t_rel + k as f64 * h;
+            let t1 = if k + 1 == n {
+                t_rel + max_duration
+            } else {
+                t0 + h
+            };
+            let hk = t1 - t0;
+            self.world.slide_step(&self.state, hk);
+            self.world.step(hk, t1)?;
+            self.out.steps += 1;
+            self.state = self.world.state(&self.state);
+            if !self.world.finite(&self.state) {
+                return Err(ModelError::NonFinite {
+                    t: t1,
+                    step: self.out.steps,
+                });
+            }
+            self.world.after_step(&self.state);
+            let p = self.world.plate(&self.state);
+            self.out.max_tilt = self.out.max_tilt.max(p.tilt);
+            self.out.max_lift = self.out.max_lift.max((p.z - self.cfg.z_rest).abs());
+            let v_cm = self
+                .world
+                .cm_velocity(&self.state)
+                .unwrap_or([(p.x - prev.x) / hk, (p.y - prev.y) / hk]);
+            prev = p;
+            last = crate::EngineState {
+                t: t1,
+                x: p.x,
+                y: p.y,
+                theta: p.theta,
+                omega: p.omega,
+                v_cm,
+            };
+            steps.push(row(&last));
+            if crate::rest_speed(&self.problem, v_cm, p.omega) < crate::REST_SPEED {
+                if rest.is_none() {
+                    rest = Some((steps.len(), last));
+                }
+                held += 1;
+                if held >= crate::REST_STEPS {
+                    break;
+                }
+            } else {
+                rest = None;
+                held = 0;
+            }
+        }
+        let (end, t_stop) = match rest.filter(|_| held >= crate::REST_STEPS) {
+            Some((k, st)) => {
+                steps.truncate(k);
+                (st, Some(st.t))
+            }
+            None => (last, None),
+        };
+        self.t_seg = end.t;
+        self.slide = Some(SlideOut {
+            release: row(&start),
+            steps,
+            end,
+            report: SlideReport {
+                t_release: t_rel,
+                t_stop,
+                pivots: Vec::new(),
+            },
+        });
+        Ok(())
+    }
+
     /// Runs one push (see the module docs).
     pub fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+        if self.slide.is_some() {
+            return Err(crate::after_release());
+        }
         let j = self.applied.len();
         let cfg = self.cfg;
         let n_sup = cfg.supports;
@@ -736,6 +905,16 @@ impl<W: PlateWorld + ?Sized> PlateWorld for &mut W {
     fn cm_velocity(&self, state: &Self::State) -> Option<[f64; 2]> {
         (**self).cm_velocity(state)
     }
+    fn release(
+        &mut self,
+        state: &Self::State,
+        throw: Option<([f64; 2], f64)>,
+    ) -> Result<(), ModelError> {
+        (**self).release(state, throw)
+    }
+    fn slide_step(&mut self, state: &Self::State, h: f64) {
+        (**self).slide_step(state, h)
+    }
 }
 
 /// An engine's session over the shared loop: a [`Stepping`] and how the
@@ -744,6 +923,7 @@ impl<W: PlateWorld + ?Sized> PlateWorld for &mut W {
 pub struct PlateSession<W: PlateWorld> {
     stepping: Stepping<W>,
     finish: PlateFinish<W>,
+    started: Instant,
 }
 
 /// How a [`PlateSession`] ends: the world, what the loop gathered and the
@@ -755,7 +935,11 @@ pub type PlateFinish<W> =
 impl<W: PlateWorld> PlateSession<W> {
     /// The session of `stepping`, ended by `finish`.
     pub fn new(stepping: Stepping<W>, finish: PlateFinish<W>) -> Self {
-        Self { stepping, finish }
+        Self {
+            stepping,
+            finish,
+            started: Instant::now(),
+        }
     }
 }
 
@@ -766,16 +950,65 @@ impl<W: PlateWorld> crate::EngineSession for PlateSession<W> {
     fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
         self.stepping.advance(push)
     }
+    /// The engine's run of the pushes, continued through the slide when
+    /// the plate was released ([`crate::extend_through_slide`]); a plate
+    /// thrown without pushes gives the slide alone (diagnostics: the steps).
     fn finish(self: Box<Self>) -> Result<crate::EngineRun, ModelError> {
-        let this = *self;
+        let mut this = *self;
+        let slide = this.stepping.slide.take();
         if this.stepping.applied.is_empty() {
-            return Err(ModelError::EmptySchedule);
+            let Some(slide) = slide else {
+                return Err(ModelError::EmptySchedule);
+            };
+            let problem = this.stepping.applied_problem();
+            let steps = this.stepping.out.steps;
+            let mut trajectory = Trajectory {
+                stats: SolverStats {
+                    rhs_evals: steps,
+                    steps,
+                    rejected: 0,
+                },
+                ..Default::default()
+            };
+            crate::extend_through_slide(
+                &problem,
+                &mut trajectory,
+                slide.release,
+                &slide.steps,
+                row(&slide.end),
+                slide.report,
+            );
+            return Ok(crate::EngineRun {
+                trajectory,
+                dt: this.stepping.cfg.dt,
+                steps,
+                wall_time: this.started.elapsed(),
+                diagnostics: serde_json::json!({ "steps": steps }),
+                contact: None,
+            });
         }
         let (world, stepped, problem) = this.stepping.finish();
-        (this.finish)(world, stepped, &problem)
+        let mut run = (this.finish)(world, stepped, &problem)?;
+        if let Some(slide) = slide {
+            crate::extend_through_slide(
+                &problem,
+                &mut run.trajectory,
+                slide.release,
+                &slide.steps,
+                row(&slide.end),
+                slide.report,
+            );
+        }
+        Ok(run)
     }
     fn steps_taken(&self) -> usize {
         self.stepping.steps()
+    }
+    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        self.stepping.release(max_duration)
+    }
+    fn slide(&self) -> Option<SlideReport> {
+        self.stepping.slide().cloned()
     }
 }
 

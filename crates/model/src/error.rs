@@ -57,6 +57,16 @@ pub enum ModelError {
         /// The model's name.
         model: String,
     },
+    /// The engine cannot let go of the plate: its session has no free slide
+    /// (or not for this problem). A problem with a release is refused rather
+    /// than ended at the release.
+    #[error("{engine} cannot release: {reason} (the problem has a [release]; it is refused rather than ended at the release)")]
+    NoRelease {
+        /// The engine's name (empty until the session's engine fills it in).
+        engine: String,
+        /// Why it cannot.
+        reason: String,
+    },
     /// The engine could not be run at all (an outside engine's process
     /// failed to start, exited with an error, timed out or wrote rows that
     /// do not parse): an input error, not a result. The harness stops with

@@ -4,7 +4,7 @@
 use std::time::{Duration, Instant};
 
 use boxdd::{
-    BodyId, BodyType, ConstraintTuning, Foundation, MassData, MotorJointDef, Position,
+    BodyId, BodyType, ConstraintTuning, Foundation, JointId, MassData, MotorJointDef, Position,
     RevoluteJointDef, Vec2, World,
 };
 use pushval_engine::stepping::{
@@ -65,11 +65,16 @@ struct Scene {
     world: World,
     object: BodyId,
     pusher: BodyId,
+    /// The pin joint (the pusher's constraint), destroyed at the release.
+    joint: JointId,
     /// Contact point (m, object frame).
     pc: [f64; 2],
     /// Support positions (m, object frame) and friction magnitudes `F_i` (N).
     supports: Vec<([f64; 2], f64)>,
     friction: Friction,
+    /// Mass (kg) and inertia about the centre of mass (kg m²).
+    mass: f64,
+    inertia_cm: f64,
 }
 
 impl Scene {
@@ -160,7 +165,7 @@ impl Scene {
                 ConstraintTuning::new(settings.joint_hertz as f32, JOINT_DAMPING_RATIO as f32)
                     .map_err(&err)?,
             );
-        world
+        let joint = world
             .create_revolute_joint(&RevoluteJointDef::new(base))
             .map_err(&err)?;
 
@@ -181,9 +186,12 @@ impl Scene {
             world,
             object,
             pusher,
+            joint,
             pc,
             supports,
             friction: settings.friction,
+            mass: body.mass(),
+            inertia_cm: body.inertia_cm(),
         })
     }
 
@@ -279,6 +287,8 @@ impl Scene {
 /// and tilt zero).
 pub(crate) struct Stepper {
     scene: Scene,
+    /// Whether the pusher has let go.
+    released: bool,
     substeps: i32,
     /// The object after the last step (read inside `step`, where an engine
     /// error can be returned).
@@ -306,6 +316,7 @@ pub(crate) fn start(
     let state = scene.read(problem.initial.theta, 0.0)?;
     let w = Stepper {
         scene,
+        released: false,
         substeps: settings.substeps as i32,
         last: state,
         t0: 0.0,
@@ -379,8 +390,10 @@ impl PlateWorld for Stepper {
         );
         self.step_time += before.elapsed();
         self.last = self.scene.read(self.last.theta, t1)?;
-        let drift = self.scene.drift(&self.last, t1)?;
-        self.max_drift = self.max_drift.max(drift);
+        if !self.released {
+            let drift = self.scene.drift(&self.last, t1)?;
+            self.max_drift = self.max_drift.max(drift);
+        }
         Ok(())
     }
 
@@ -398,5 +411,78 @@ impl PlateWorld for Stepper {
 
     fn cm_velocity(&self, s: &State) -> Option<[f64; 2]> {
         Some(s.v)
+    }
+
+    /// Destroys the pin joint and stops the pusher; a throw sets the
+    /// object's velocity. Only the Coulomb model slides (the motor-joint
+    /// idiom has no slide here).
+    fn release(
+        &mut self,
+        _state: &State,
+        throw: Option<([f64; 2], f64)>,
+    ) -> Result<(), ModelError> {
+        if self.scene.friction != Friction::Coulomb {
+            return Err(pushval_engine::no_release(
+                "the motor-joint friction idiom has no free slide in this adapter (only the Coulomb model slides)",
+            ));
+        }
+        let err = engine_error(self.t0);
+        let w = &mut self.scene.world;
+        w.joint(self.scene.joint)
+            .map_err(&err)?
+            .destroy(true)
+            .map_err(&err)?;
+        w.body(self.scene.pusher)
+            .map_err(&err)?
+            .set_linear_velocity(Vec2::new(0.0, 0.0))
+            .map_err(&err)?;
+        if let Some((v, omega)) = throw {
+            let mut b = w.body(self.scene.object).map_err(&err)?;
+            b.set_linear_velocity(Vec2::new(v[0] as f32, v[1] as f32))
+                .map_err(&err)?;
+            b.set_angular_velocity(omega as f32).map_err(&err)?;
+        }
+        self.last = self.scene.read(self.last.theta, self.t0)?;
+        self.released = true;
+        Ok(())
+    }
+
+    /// The supports' implicit Coulomb impulses of
+    /// [`pushval_engine::slide`] (no chatter at the stop), applied as a
+    /// constant force at the centre of mass and a torque over the step.
+    fn slide_step(&mut self, state: &State, h: f64) {
+        let sup: Vec<([f64; 2], f64)> = self
+            .scene
+            .supports
+            .iter()
+            .map(|&(p, f)| (rot(state.c, state.s, p), f.max(0.0) * h))
+            .collect();
+        let p = pushval_engine::slide::coulomb_impulses(
+            self.scene.mass,
+            self.scene.inertia_cm,
+            state.v,
+            state.omega,
+            &sup,
+        );
+        let (mut force, mut torque) = ([0.0f64; 2], 0.0f64);
+        for ((r, _), q) in sup.iter().zip(&p) {
+            force[0] += q[0] / h;
+            force[1] += q[1] / h;
+            torque += (r[0] * q[1] - r[1] * q[0]) / h;
+        }
+        let err = engine_error(self.t0);
+        let r = self
+            .scene
+            .world
+            .body(self.scene.object)
+            .map_err(&err)
+            .and_then(|mut b| {
+                b.apply_force_to_center(Vec2::new(force[0] as f32, force[1] as f32), true)
+                    .map_err(&err)?;
+                b.apply_torque(torque as f32, true).map_err(&err)
+            });
+        if let Err(e) = r {
+            self.error = Some(e);
+        }
     }
 }

@@ -95,6 +95,10 @@ pub(crate) struct World2d {
     world: PhysicsWorld,
     object: RigidBodyHandle,
     pusher: RigidBodyHandle,
+    /// The pin joint (the pusher's constraint), removed at the release.
+    joint: ImpulseJointHandle,
+    /// Whether the pusher has let go.
+    released: bool,
     /// Contact point (m, object frame).
     pc: [f64; 2],
     /// Support positions (m, object frame) and friction magnitudes `F_i` (N).
@@ -183,7 +187,7 @@ pub(crate) fn start(
         .local_anchor2(v(pc[0], pc[1]))
         .contacts_enabled(false)
         .softness(SpringCoefficients::new(JOINT_FREQUENCY, 1.0));
-    world.insert_impulse_joint(pusher, object, joint);
+    let joint = world.insert_impulse_joint(pusher, object, joint);
     if settings.colliders {
         attach_colliders(&mut world, object, pusher, outline, &supports, pc)?;
     }
@@ -197,6 +201,8 @@ pub(crate) fn start(
         world,
         object,
         pusher,
+        joint,
+        released: false,
         pc,
         supports,
         mass: body.mass(),
@@ -425,6 +431,9 @@ impl PlateWorld for World2d {
     }
 
     fn after_step(&mut self, state: &State) {
+        if self.released {
+            return;
+        }
         let anchor = self.world.bodies[self.pusher].translation();
         let rc = state.rot.apply(self.pc);
         let drift = ((anchor.x as f64 - state.x - rc[0]).powi(2)
@@ -446,6 +455,64 @@ impl PlateWorld for World2d {
 
     fn cm_velocity(&self, s: &State) -> Option<[f64; 2]> {
         Some(s.v)
+    }
+
+    /// Removes the pin joint and stops the pusher; a throw sets the
+    /// object's velocity. Only the Coulomb model slides (the idioms'
+    /// impulse caps and regularisations have no slide here).
+    fn release(
+        &mut self,
+        _state: &State,
+        throw: Option<([f64; 2], f64)>,
+    ) -> Result<(), ModelError> {
+        if self.friction_model != FrictionModel::Coulomb {
+            return Err(pushval_engine::no_release(format!(
+                "the {} friction idiom has no free slide in this adapter (only the Coulomb model slides)",
+                self.friction_model.as_str()
+            )));
+        }
+        self.world.remove_impulse_joint(self.joint);
+        {
+            let p = &mut self.world.bodies[self.pusher];
+            p.set_linvel(v(0.0, 0.0), true);
+            p.set_angvel(0.0, true);
+        }
+        if let Some((vel, omega)) = throw {
+            let rb = &mut self.world.bodies[self.object];
+            rb.set_linvel(v(vel[0], vel[1]), true);
+            rb.set_angvel(omega as Real, true);
+        }
+        self.released = true;
+        Ok(())
+    }
+
+    /// The supports' Coulomb friction over a step of the slide, without
+    /// chattering at the stop: the implicit Coulomb impulses of
+    /// [`pushval_engine::slide`] (each support's impulse capped at what
+    /// leaves its slip zero at the step's end), applied as the constant
+    /// forces `Pᵢ / h` at the supports.
+    fn slide_step(&mut self, state: &State, h: f64) {
+        let rs: Vec<([f64; 2], f64)> = self
+            .supports
+            .iter()
+            .map(|s| (state.rot.apply(s.0), s.1.max(0.0) * h))
+            .collect();
+        let acc = pushval_engine::slide::coulomb_impulses(
+            self.mass,
+            self.inertia_cm,
+            state.v,
+            state.omega,
+            &rs,
+        );
+        let rb = &mut self.world.bodies[self.object];
+        rb.reset_forces(false);
+        rb.reset_torques(false);
+        for ((r, _), a) in rs.iter().zip(&acc) {
+            if *a != [0.0, 0.0] {
+                let point = v(state.x + r[0], state.y + r[1]);
+                rb.add_force_at_point(v(a[0] / h, a[1] / h), point, true);
+            }
+        }
     }
 }
 
