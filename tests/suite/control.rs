@@ -404,7 +404,7 @@ fn plan_writes_a_scenario_every_command_takes_and_its_checks() {
     let st = pushval()
         .args(["plan"])
         .arg(root().join("scenarios/paper-square-v1.0.toml"))
-        .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--out"])
+        .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--at", "release", "--out"])
         .arg(&out)
         .output()
         .unwrap();
@@ -415,6 +415,11 @@ fn plan_writes_a_scenario_every_command_takes_and_its_checks() {
     );
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(doc["at"], "release");
+    assert!(doc["rest_pose"].is_null());
+    assert!(!std::fs::read_to_string(out.join("plan.toml"))
+        .unwrap()
+        .contains("[release]"));
     assert_eq!(doc["converged"], true);
     assert_eq!(doc["reached"], true);
     assert!(doc["why_missed"].is_null());
@@ -512,7 +517,7 @@ fn loop_writes_the_applied_push_and_loop_json() {
         .args(["loop"])
         .arg(root().join("scenarios/paper-square-v1.0.toml"))
         .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--engine", "box2d"])
-        .args(["--plant", "mu_scale=0.8,inertia_scale=1.2", "--out"])
+        .args(["--plant", "mu_scale=0.8,inertia_scale=1.2", "--at", "release", "--out"])
         .arg(&out)
         .output()
         .unwrap();
@@ -605,6 +610,8 @@ fn a_protocol_1_adapter_without_the_kit_is_a_plant_under_loop() {
             "1.0",
             "--engine",
             "plain",
+            "--at",
+            "release",
             "--out",
         ])
         .arg(&out)
@@ -695,4 +702,72 @@ fn control_study_only_lists_are_checked() {
         );
         assert!(!out.exists(), "{list} wrote {}", out.display());
     }
+}
+
+/// Judged at rest (the default): the plan aims for the pose where the plate
+/// stops after the pusher lets go. Checked independently: the dynamic model
+/// at its default tolerance, run through the slide on the written
+/// plan.toml, comes to rest at the goal, and the plate is still moving at
+/// the release (so the rule is not the release's).
+#[test]
+fn a_plan_judged_at_rest_stops_at_the_goal_after_its_slide() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("plan");
+    let st = pushval()
+        .args(["plan"])
+        .arg(root().join("scenarios/paper-square-v1.0.toml"))
+        .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(doc["at"], "rest");
+    let sc = pushval::registry::load(out.join("plan.toml")).unwrap();
+    let p = sc.problem();
+    assert!(p.release.is_some(), "plan.toml carries [release]");
+    let traj = DynamicModel::default().simulate(&p).unwrap();
+    let rest = *traj.samples.last().unwrap();
+    let slide = traj.slide.as_ref().unwrap();
+    let t_stop = slide.t_stop.expect("the plate stops");
+    assert!(t_stop > slide.t_release + 0.05, "{slide:?}");
+    assert!((rest.x - GOAL.x).hypot(rest.y - GOAL.y) < 2e-3, "{rest:?}");
+    assert!((rest.theta - GOAL.theta).abs() < 5e-3, "{rest:?}");
+    // At the release the plate is elsewhere: the slide matters at 1 m/s.
+    let release = traj
+        .samples
+        .iter()
+        .rfind(|s| s.t <= slide.t_release + 1e-9)
+        .unwrap();
+    assert!((release.x - rest.x).hypot(release.y - rest.y) > 0.02, "{release:?} {rest:?}");
+}
+
+/// A loop judged at rest releases the plant after the last push and judges
+/// the pose where it stops: on a nominal Box2D plate (Coulomb per support,
+/// the model's law) it reaches the goal at rest, and the rest comes after
+/// the release with the plate stopped.
+#[test]
+fn a_loop_judged_at_rest_releases_the_plant_and_judges_its_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("loop");
+    let st = pushval()
+        .args(["loop"])
+        .arg(root().join("scenarios/paper-square-v1.0.toml"))
+        .args(["--goal=0.8,0.2,-0.5", "--speed", "0.5", "--engine", "box2d", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
+    assert!(st.status.success(), "{}\n{doc}", String::from_utf8_lossy(&st.stderr));
+    assert_eq!(doc["at"], "rest");
+    let rest = &doc["rest_pose"];
+    let release = &doc["release_state"];
+    assert!(rest["t"].as_f64().unwrap() > release["t"].as_f64().unwrap());
+    let v = release["vx"].as_f64().unwrap().hypot(release["vy"].as_f64().unwrap());
+    assert!(v > 0.1, "the plate moves at the release: {release}");
+    let d = (rest["x"].as_f64().unwrap() - GOAL.x).hypot(rest["y"].as_f64().unwrap() - GOAL.y);
+    assert!(d < 0.02, "{doc}");
+    assert!(std::fs::read_to_string(out.join("applied.toml")).unwrap().contains("[release]"));
 }
