@@ -28,7 +28,7 @@ use pushval_control::mpc::{open_loop, run_loop, LoopSpec, PlantScale};
 use pushval_control::plan::{straight_time, PlanSpec, Planner, Solution};
 use pushval_control::predict::Start;
 use pushval_control::stats::{median, median_p99};
-use pushval_control::{Goal, ModelKind as Predictor, Reach};
+use pushval_control::{At, Goal, ModelKind as Predictor, Reach};
 use pushval_engine::FrictionLaw;
 
 /// The study's scene: a shipped scenario.
@@ -111,8 +111,25 @@ impl Task {
 /// The numbers of one run: success (0/1), position error (m), angle error
 /// (rad), predictor median and p99 (µs; NaN open loop), whether the engine
 /// replayed its schedule (0/1), whether the run failed with an error (0/1),
-/// the wall time (s).
-const ROW: usize = 8;
+/// whether it was judged at rest (1) or at the release because the engine
+/// cannot release (0), the wall time (s).
+const ROW: usize = 9;
+
+/// Whether `e` is an engine's refusal to release the plate.
+fn cannot_release(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        matches!(
+            c.downcast_ref::<pushval_model::ModelError>(),
+            Some(pushval_model::ModelError::NoRelease { .. })
+        ) || matches!(
+            c.downcast_ref::<pushval_control::ControlError>(),
+            Some(pushval_control::ControlError::Plant {
+                source: pushval_model::ModelError::NoRelease { .. },
+                ..
+            })
+        )
+    })
+}
 
 /// The study's scene problem, from rest.
 pub fn scene() -> anyhow::Result<Problem> {
@@ -299,22 +316,20 @@ fn run_task(
     let dt = engine.default_dt();
     let goal = goals[t.goal];
     let reach = Reach::default();
-    let spec = PlanSpec {
-        segments: SEGMENTS,
-        speed: t.speed,
-        predictor: t.predictor,
-        at: AT,
-    };
-    let result: anyhow::Result<Vec<f64>> = (|| {
+    // One run judged `at`; an engine that cannot release is run again judged
+    // at the release, and its row says so (column `at`).
+    let attempt = |at: At| -> anyhow::Result<Vec<f64>> {
+        let spec = PlanSpec {
+            segments: SEGMENTS,
+            speed: t.speed,
+            predictor: t.predictor,
+            at,
+        };
         let plant = t.plant().apply(problem)?;
         let mut session = engine.start(&plant, dt)?;
+        let max_slide = problem.release.unwrap_or_default().max_duration;
         let row = match t.mode {
             Mode::Open => {
-                let plan = plans
-                    .get(&(t.speed.to_bits(), t.goal, t.predictor.as_str()))
-                    .context("no plan from rest")?;
-                // The plan with its time on the engine's step grid,
-                // re-solved there: what the engine runs is what was planned.
                 let start = Start::of_problem(problem);
                 let mut planner = Planner::new(
                     problem,
@@ -323,11 +338,21 @@ fn run_task(
                     straight_time(&start, &goal, t.speed),
                     reach,
                 );
+                let plan = match plans.get(&(t.speed.to_bits(), t.goal, t.predictor.as_str())) {
+                    Some(p) if at == AT => p.clone(),
+                    _ => planner.plan(&start).context("no plan from rest")?,
+                };
+                // The plan with its time on the engine's step grid,
+                // re-solved there: what the engine runs is what was planned.
                 let pushes = planner
-                    .on_grid(&start, plan, dt)
+                    .on_grid(&start, &plan, dt)
                     .context("re-solving the plan on the engine's step grid")?
                     .pushes;
-                let st = open_loop(session.as_mut(), &pushes)?;
+                let mut st = open_loop(session.as_mut(), &pushes)?;
+                if at == At::Rest {
+                    session.release(max_slide)?;
+                    st = session.state();
+                }
                 let (pe, ae) = pushval_control::pose_errors(st.x, st.y, st.theta, &goal);
                 vec![
                     f64::from(u8::from(reach.holds(pe, ae))),
@@ -360,10 +385,31 @@ fn run_task(
         };
         session.finish()?;
         Ok(row)
-    })();
+    };
+    let at_rest = |r: anyhow::Result<Vec<f64>>, at: At| {
+        r.map(|mut v| {
+            v.push(f64::from(u8::from(at == At::Rest)));
+            v
+        })
+    };
+    let result = match attempt(AT) {
+        Err(e) if AT == At::Rest && cannot_release(&e) => {
+            at_rest(attempt(At::Release), At::Release)
+        }
+        r => at_rest(r, AT),
+    };
     let mut row = result.unwrap_or_else(|e| {
         eprintln!("control-study: {}: {e:#}", t.key());
-        vec![0.0, f64::NAN, f64::NAN, f64::NAN, f64::NAN, 0.0, 1.0]
+        vec![
+            0.0,
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            0.0,
+            1.0,
+            f64::NAN,
+        ]
     });
     row.push(clock.elapsed().as_secs_f64());
     row
@@ -507,6 +553,7 @@ fn write_outputs(
         "predictor_us_p99",
         "engine_replayed",
         "error",
+        "at",
         "wall_s",
     ]);
     for (t, r) in list.iter().zip(rows) {
@@ -528,7 +575,12 @@ fn write_outputs(
             num(r[4]),
             num(r[5]),
             num(r[6]),
-            num(r[7]),
+            match r[7] {
+                x if x == 1.0 => "rest".to_string(),
+                x if x == 0.0 => "release".to_string(),
+                _ => String::new(),
+            },
+            num(r[8]),
         ]);
     }
     dir.file("runs.csv", runs.as_bytes())?;
@@ -599,9 +651,13 @@ fn write_outputs(
     let paths = super::figures::paths_figure(problem, SEGMENTS, names, goals, speeds)?;
     dir.figure("paths.svg", &paths)?;
     let mut failed_runs: BTreeMap<String, usize> = BTreeMap::new();
+    let mut at_release: BTreeMap<String, usize> = BTreeMap::new();
     for (t, r) in list.iter().zip(rows) {
         if r[6] == 1.0 {
             *failed_runs.entry(t.engine.clone()).or_default() += 1;
+        }
+        if r[7] == 0.0 {
+            *at_release.entry(t.engine.clone()).or_default() += 1;
         }
     }
     let readme = readme(
@@ -611,6 +667,7 @@ fn write_outputs(
         goals.len(),
         &summary,
         &failed_runs,
+        &at_release,
         quick,
     );
     dir.file("README.md", readme.as_bytes())?;
@@ -649,6 +706,7 @@ fn readme(
     goals: usize,
     summary: &BTreeMap<Group, (usize, usize, f64, f64)>,
     failed_runs: &BTreeMap<String, usize>,
+    at_release: &BTreeMap<String, usize>,
     quick: bool,
 ) -> String {
     let vmax = speeds.iter().copied().fold(f64::MIN, f64::max);
@@ -666,7 +724,7 @@ fn readme(
     }
     s.push_str("` (docs/closed-loop.md); do not edit.\n\n");
     s.push_str(&format!(
-        "The seed paper's plate (`{SCENE}`, from rest), {goals} goals 0.3–1 m away with turns up to ±90° (`goals.csv`), each reachable by the dynamic model at every speed ({}). A plan is {SEGMENTS} pushes of equal duration; success is the final centre of mass within 20 mm and the angle within 5°. MPC re-plans every {PERIOD} s from the engine's state. The perturbed plant has μ × 0.8 and I_cm × 1.2; the predictor keeps the nominal values.\n\n",
+        "The seed paper's plate (`{SCENE}`, from rest), {goals} goals 0.3–1 m away with turns up to ±90° (`goals.csv`), each reachable by the dynamic model at every speed ({}). A plan is {SEGMENTS} pushes of equal duration; success is the centre of mass within 20 mm of the goal and the angle within 5°, judged at rest: the pusher lets go after the last push and the plate slides to a stop (the plans aim for that pose; an engine that cannot release is judged at the release instead, column `at` of `runs.csv`). MPC re-plans every {PERIOD} s from the engine's state. The perturbed plant has μ × 0.8 and I_cm × 1.2; the predictor keeps the nominal values.\n\n",
         speeds.iter().map(|v| format!("{v} m/s")).collect::<Vec<_>>().join(", ")
     ));
     s.push_str("Files: `success.csv` (one row per engine, speed, plan predictor, mode and plant), `runs.csv` (every run), `success.svg`, `paths.svg` (goal 0 in every engine).\n\n");
@@ -757,8 +815,14 @@ fn readme(
                 " {k} of its runs ended with an engine error and count as misses (`runs.csv`, column `error`; the study prints the message)."
             ),
         };
+        let released = match at_release.get(n.as_str()).copied().unwrap_or(0) {
+            0 => String::new(),
+            k => {
+                format!(" {k} of its runs were judged at the release: it cannot release the plate.")
+            }
+        };
         s.push_str(&format!(
-            "- **{n}** ({}/{tot} open, {}/{tot} MPC, {}/{tot} MPC on the perturbed plant): {why}.{errors}\n",
+            "- **{n}** ({}/{tot} open, {}/{tot} MPC, {}/{tot} MPC on the perturbed plant): {why}.{errors}{released}\n",
             ok_open, ok_mpc, ok_mpc_p
         ));
     }

@@ -404,7 +404,14 @@ fn plan_writes_a_scenario_every_command_takes_and_its_checks() {
     let st = pushval()
         .args(["plan"])
         .arg(root().join("scenarios/paper-square-v1.0.toml"))
-        .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--at", "release", "--out"])
+        .args([
+            "--goal=0.8,0.2,-0.5",
+            "--speed",
+            "1.0",
+            "--at",
+            "release",
+            "--out",
+        ])
         .arg(&out)
         .output()
         .unwrap();
@@ -517,7 +524,13 @@ fn loop_writes_the_applied_push_and_loop_json() {
         .args(["loop"])
         .arg(root().join("scenarios/paper-square-v1.0.toml"))
         .args(["--goal=0.8,0.2,-0.5", "--speed", "1.0", "--engine", "box2d"])
-        .args(["--plant", "mu_scale=0.8,inertia_scale=1.2", "--at", "release", "--out"])
+        .args([
+            "--plant",
+            "mu_scale=0.8,inertia_scale=1.2",
+            "--at",
+            "release",
+            "--out",
+        ])
         .arg(&out)
         .output()
         .unwrap();
@@ -720,7 +733,11 @@ fn a_plan_judged_at_rest_stops_at_the_goal_after_its_slide() {
         .arg(&out)
         .output()
         .unwrap();
-    assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
     assert_eq!(doc["at"], "rest");
@@ -740,7 +757,10 @@ fn a_plan_judged_at_rest_stops_at_the_goal_after_its_slide() {
         .iter()
         .rfind(|s| s.t <= slide.t_release + 1e-9)
         .unwrap();
-    assert!((release.x - rest.x).hypot(release.y - rest.y) > 0.02, "{release:?} {rest:?}");
+    assert!(
+        (release.x - rest.x).hypot(release.y - rest.y) > 0.02,
+        "{release:?} {rest:?}"
+    );
 }
 
 /// A loop judged at rest releases the plant after the last push and judges
@@ -754,20 +774,36 @@ fn a_loop_judged_at_rest_releases_the_plant_and_judges_its_rest() {
     let st = pushval()
         .args(["loop"])
         .arg(root().join("scenarios/paper-square-v1.0.toml"))
-        .args(["--goal=0.8,0.2,-0.5", "--speed", "0.5", "--engine", "box2d", "--out"])
+        .args([
+            "--goal=0.8,0.2,-0.5",
+            "--speed",
+            "0.5",
+            "--engine",
+            "box2d",
+            "--out",
+        ])
         .arg(&out)
         .output()
         .unwrap();
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
-    assert!(st.status.success(), "{}\n{doc}", String::from_utf8_lossy(&st.stderr));
+    assert!(
+        st.status.success(),
+        "{}\n{doc}",
+        String::from_utf8_lossy(&st.stderr)
+    );
     assert_eq!(doc["at"], "rest");
     let rest = &doc["rest_pose"];
     let release = &doc["release_state"];
     assert!(rest["t"].as_f64().unwrap() > release["t"].as_f64().unwrap());
-    let v = release["vx"].as_f64().unwrap().hypot(release["vy"].as_f64().unwrap());
+    let v = release["vx"]
+        .as_f64()
+        .unwrap()
+        .hypot(release["vy"].as_f64().unwrap());
     assert!(v > 0.1, "the plate moves at the release: {release}");
     let d = (rest["x"].as_f64().unwrap() - GOAL.x).hypot(rest["y"].as_f64().unwrap() - GOAL.y);
     assert!(d < 0.02, "{doc}");
-    assert!(std::fs::read_to_string(out.join("applied.toml")).unwrap().contains("[release]"));
+    assert!(std::fs::read_to_string(out.join("applied.toml"))
+        .unwrap()
+        .contains("[release]"));
 }
