@@ -137,27 +137,40 @@ fn cost_table() {
     let goals = goals(&problem, &speeds, 20);
     let start = Start::of_problem(&problem);
     let reach = Reach::default();
+    // Plans judged at the release and plans aimed at rest (the slide in the
+    // prediction), timed side by side: for each goal and speed, five solves
+    // of each, alternately.
     let mut plan_us = Vec::new();
+    let mut rest_us = Vec::new();
     for &v in &speeds {
         for goal in &goals {
-            let spec = PlanSpec {
-                segments: 6,
-                speed: v,
-                predictor: Predictor::Dynamic,
-                at: pushval::control::At::Release,
+            let planner_at = |at| {
+                let spec = PlanSpec {
+                    segments: 6,
+                    speed: v,
+                    predictor: Predictor::Dynamic,
+                    at,
+                };
+                Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach)
             };
-            let planner =
-                Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
-            let mut t: Vec<f64> = (0..5)
-                .map(|_| {
+            let planners = [
+                planner_at(pushval::control::At::Release),
+                planner_at(pushval::control::At::Rest),
+            ];
+            let mut t = [Vec::new(), Vec::new()];
+            for _ in 0..5 {
+                for (k, planner) in planners.iter().enumerate() {
                     let mut p = planner.clone();
                     let c = std::time::Instant::now();
                     std::hint::black_box(p.plan(&start));
-                    c.elapsed().as_secs_f64() * 1e6
-                })
-                .collect();
-            t.sort_by(f64::total_cmp);
-            plan_us.push(t[2]);
+                    t[k].push(c.elapsed().as_secs_f64() * 1e6);
+                }
+            }
+            for v in &mut t {
+                v.sort_by(f64::total_cmp);
+            }
+            plan_us.push(t[0][2]);
+            rest_us.push(t[1][2]);
         }
     }
     let engine = pushval::registry::engine("rapier2d", &Default::default());
@@ -185,6 +198,7 @@ fn cost_table() {
     }
     let nan = (f64::NAN, f64::NAN);
     let (pm, pp) = median_p99(&plan_us).unwrap_or(nan);
+    let (rm, rp) = median_p99(&rest_us).unwrap_or(nan);
     let (mm, mp) = median_p99(&period_us).unwrap_or(nan);
     let (cm, cp) = median_p99(&period_cpu_us).unwrap_or(nan);
     let load = std::fs::read_to_string("/proc/loadavg")
@@ -195,6 +209,8 @@ fn cost_table() {
         "quantity,value,unit,target,note\n\
          plan_solve_median,{pm:.1},us,1000,\"{} plans from rest (20 study goals x 0.1/0.5/1 m/s), 6 pushes, each the median of 5 solves\"\n\
          plan_solve_p99,{pp:.1},us,,\"same plans\"\n\
+         plan_rest_solve_median,{rm:.1},us,1000,\"the same plans aimed at rest (the slide to rest in every prediction), timed alternately with them\"\n\
+         plan_rest_solve_p99,{rp:.1},us,,\"same plans\"\n\
          mpc_period_median,{mm:.1},us,100,\"{} re-plans of the dynamic predictor, rapier2d plant with mu x 0.8 and I_cm x 1.2, 20 goals at 1 m/s, period 0.02 s\"\n\
          mpc_period_p99,{mp:.1},us,1000,\"same periods (a stalled warm start runs one stage of the fallback search: a fresh Jacobian, or one starting guess)\"\n\
          mpc_period_cpu_median,{cm:.1},us,100,\"the same periods' thread CPU time (what the predictor computes; wall time adds the waits of a shared machine)\"\n\
