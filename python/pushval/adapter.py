@@ -919,6 +919,10 @@ class Stepper:
         else:
             slide = Push(index=len(self.applied), t_start=t0, duration=t_end - t0, speed=0.0, phi=0.0)
             rows = self._samples(slide, states, more, m, h, t_end)
+            # The last row is the rest (or the state at max_duration): its
+            # ω the last step's, not the interval's middle.
+            r = rows[-1]
+            rows[-1] = (*r[:4], float(states[m - 1][3]), *r[5:])
         self.last = rows[-1]
         self.end = t_end
         return out + rows
