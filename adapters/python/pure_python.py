@@ -17,6 +17,15 @@ Where the pusher velocity jumps (every segment start; the start too when the
 object starts from rest), omega jumps by the problem's switching rule
 (impulsive: the angular momentum about the contact point is kept).
 
+Released (protocol 3's release; the step receives no push), the plate slides
+freely on its supports: each step's support impulses are implicit Coulomb
+friction, each within its disc |P_i| <= mu_i N_i h and leaving the support's
+slip zero at the step's end where the disc allows it (solved jointly by
+projected Gauss-Seidel, as pushval_engine::slide does), so a plate that one
+step can stop comes to rest instead of chattering; then the velocities take
+the impulses and the pose moves with the new velocities (semi-implicit Euler,
+first order).
+
 The protocol (one-shot or --session, limits, progress, --timing) is
 pushval.adapter's; see adapters/python/README.md.
 """
@@ -37,6 +46,7 @@ class PurePython(Engine):
 
     name = "pure_python.py"
     step_rule = "round"
+    can_release = True
 
     @classmethod
     def add_arguments(cls, parser):
@@ -64,7 +74,10 @@ class PurePython(Engine):
         self.sup = [(s.offset[0], s.offset[1], s.friction) for s in problem.supports]
         self.x, self.y = problem.initial.position
         self.th = problem.initial.theta
-        self.w = self.problem.start_omega()
+        # A plate thrown (no pushes) starts with its initial velocity and ω.
+        self.w = self.problem.start_omega() if problem.pushes else problem.initial.omega
+        # The centre of mass's world velocity (m/s), kept for the release.
+        self.vx, self.vy = problem.initial.velocity
         return State(self.x, self.y, self.th, self.w)
 
     def switch(self, before, after):
@@ -91,7 +104,53 @@ class PurePython(Engine):
                 torque += (px - pcx) * fy - (py - pcy) * fx
         return torque
 
+    def slide(self, h):
+        """One step of the free slide: implicit Coulomb support impulses,
+        then the pose with the new velocities."""
+        c, s = math.cos(self.th), math.sin(self.th)
+        m, i_cm = self.m, self.problem.inertia_cm
+        sup = [(c * sx - s * sy, s * sx + c * sy, max(f, 0.0) * h) for sx, sy, f in self.sup]
+        cap_max = max((q[2] for q in sup), default=0.0)
+        acc = [[0.0, 0.0] for _ in sup]
+        vx, vy, w = self.vx, self.vy, self.w
+        for _ in range(500):
+            change = 0.0
+            for (rx, ry, cap), a in zip(sup, acc):
+                if cap <= 0.0:
+                    continue
+                ux, uy = vx - w * ry, vy + w * rx
+                k = 1.0 / m + (rx * rx + ry * ry) / i_cm
+                px, py = a[0] - ux / k, a[1] - uy / k
+                n = math.hypot(px, py)
+                if n > cap:
+                    px, py = px * cap / n, py * cap / n
+                dx, dy = px - a[0], py - a[1]
+                vx += dx / m
+                vy += dy / m
+                w += (rx * dy - ry * dx) / i_cm
+                a[0], a[1] = px, py
+                change = max(change, math.hypot(dx, dy))
+            if change <= 1e-13 * cap_max:
+                break
+        self.vx, self.vy, self.w = vx, vy, w
+        self.th += h * w
+        self.x += h * vx
+        self.y += h * vy
+        return State(self.x, self.y, self.th, w)
+
     def step(self, push, h):
+        if push is None:
+            return self.slide(h)
+        state = self.pushed(push, h)
+        # The centre of mass's velocity the constraint gives at the new pose.
+        rcx, rcy = self.rc
+        c, s = math.cos(self.th), math.sin(self.th)
+        pcx, pcy = c * rcx - s * rcy, s * rcx + c * rcy
+        vpx, vpy = push.world_velocity(self.th)
+        self.vx, self.vy = vpx + self.w * pcy, vpy - self.w * pcx
+        return state
+
+    def pushed(self, push, h):
         speed, phi = push.speed, push.phi
         if self.args.scheme == "heun":
             d1 = self.rates(self.th, self.w, speed, phi)

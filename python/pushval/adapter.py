@@ -273,6 +273,10 @@ class Initial:
     """The object is at rest when the pusher starts (the start is a switch
     from zero velocity); otherwise it already moves with the first push at
     ω = `omega`."""
+    velocity: tuple[float, float] = (0.0, 0.0)
+    """World velocity of the centre of mass (m/s); only a problem without
+    pushes sets it (a plate thrown: the free slide starts from it and ω =
+    `omega` at t = 0)."""
 
 
 @dataclass(frozen=True)
@@ -325,6 +329,10 @@ class Problem:
     version 1 documents state none and mean ``"impulsive"``."""
     limits: Limits = Limits()
     """The answer's cap (version 2); no cap when the document gives none."""
+    release: float | None = None
+    """The release's longest slide (s): after the last push the pusher lets
+    go and the plate slides to rest (protocol 3's ``release`` op); None: no
+    release."""
 
     @property
     def version(self) -> int:
@@ -560,6 +568,7 @@ def parse_problem(document: str | bytes | dict[str, Any], schedule: bool = True)
             theta=ini.number("theta"),
             omega=ini.number("omega"),
             from_rest=ini.boolean("from_rest"),
+            velocity=ini.point("velocity") if ini.has("velocity") else (0.0, 0.0),
         ),
         pushes=pushes,
         sample_dt=doc.number("sample_dt", 0.0, strict=True),
@@ -567,6 +576,11 @@ def parse_problem(document: str | bytes | dict[str, Any], schedule: bool = True)
         options=options,
         switching=switching,
         limits=limits,
+        release=(
+            doc.obj("release").number("max_duration", 0.0, strict=True)
+            if doc.has("release") and doc.raw("release") is not None
+            else None
+        ),
     )
 
 
@@ -593,6 +607,10 @@ class Engine:
     rows: ClassVar[str] = "steps"
     """``"steps"``: one row per step (best for pushval's resampler);
     ``"samples"``: one row per sample time."""
+    can_release: ClassVar[bool] = False
+    """Whether `step` slides the plate freely when its ``push`` is None (the
+    pusher gone: no contact force), which protocol 3's ``release`` needs; a
+    release asked of an engine that cannot is refused, naming the release."""
 
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
@@ -617,10 +635,13 @@ class Engine:
         ``problem.omega_after_switch(before, after, omega)``. Default:
         nothing (the engine's own contact makes the jump)."""
 
-    def step(self, push: Push, dt: float) -> State:
+    def step(self, push: Push | None, dt: float) -> State:
         """Advances the scene by ``dt`` (s) with the pusher's contact point
         moving at ``push.world_velocity(theta)``, and returns the state at
-        the step's end (ω: the one held over the step)."""
+        the step's end (ω: the one held over the step). ``push`` None (only
+        for an engine that `can_release`): the pusher has let go and the
+        plate slides freely on its supports (a plate thrown without pushes
+        starts with `Initial.velocity` and `Initial.omega`)."""
         raise NotImplementedError(f"{type(self).__name__}.step")
 
     def close(self) -> None:
@@ -712,6 +733,16 @@ def _fine(rows: Sequence[tuple[Any, ...]]) -> bool:
         return False
 
 
+REST_SPEED = 1e-5
+"""Speed (m/s) below which a released plate counts as at rest: ``|v_cm| +
+|ω| L``, ``L`` the farthest support from the centre of mass (pushval's
+``pushval_engine::REST_SPEED``)."""
+
+REST_STEPS = 10
+"""Consecutive steps below `REST_SPEED` that make a rest (pushval's
+``pushval_engine::REST_STEPS``)."""
+
+
 class Stepper:
     """One problem stepped push by push on an engine (protocol 3, and what
     `simulate` runs): `Engine.reset` before the first push, `Engine.switch`
@@ -752,10 +783,13 @@ class Stepper:
         self.step_time_s = 0.0
         self.header_sent = False
         self.closed = False
+        self.released = False
 
-    def _reset(self, first: Push) -> list[tuple[float, ...]]:
+    def _reset(self, first: Push | None) -> list[tuple[float, ...]]:
         engine = self.engine
-        problem = self.reset_problem or dataclasses.replace(self.problem, pushes=(first,))
+        problem = self.reset_problem or dataclasses.replace(
+            self.problem, pushes=(first,) if first is not None else ()
+        )
         started = time.perf_counter()
         state = engine.reset(problem)
         self.step_time_s += time.perf_counter() - started
@@ -783,6 +817,8 @@ class Stepper:
         ``progress(t, total)`` is called every 1024 steps."""
         if self.closed:
             raise AdapterError("the problem is finished: start another")
+        if self.released:
+            raise AdapterError("the plate was released: no push can follow the release")
         out: list[tuple[float, ...]] = []
         if not self.applied:
             out += self._reset(push)
@@ -811,6 +847,85 @@ class Stepper:
             push = Push(index=len(self.applied), t_start=self.end, duration=du, speed=sp, phi=ph)
             out += self.apply(push)
         return out
+
+    def release(self, max_duration: float) -> list[tuple[float, ...]]:
+        """Protocol 3's ``release``: the pusher lets go after the pushes
+        applied (none: the plate is thrown from `Initial`) and the engine
+        steps (``push`` None) in equal steps of at most the problem's dt
+        until the plate is at rest or ``max_duration`` (s) has passed.
+
+        At rest: the speed ``|v_cm| + |ω| L`` (``v_cm`` from the step's
+        displacement, ``L`` the farthest support from the centre of mass)
+        below `REST_SPEED` on `REST_STEPS` consecutive steps; the rows end
+        at the first of them (the stop time). Rows that end at ``t_release
+        + max_duration`` mean the plate had not stopped. Returns the rows
+        (after the pushes' last row; the row at t = 0 first for a throw)."""
+        if self.closed:
+            raise AdapterError("the problem is finished: start another")
+        if self.released:
+            raise AdapterError("the plate was already released")
+        engine = self.engine
+        if not engine.can_release:
+            raise AdapterError(
+                f"{_engine_name(engine)} cannot release: its step has no free slide "
+                "(Engine.can_release is False), and a problem with a release is refused "
+                "rather than ended at the release"
+            )
+        out: list[tuple[float, ...]] = []
+        if not self.applied:
+            self.pending = []
+            out += self._reset(None)
+        self.released = True
+        n = max(1, math.ceil(max_duration / self.problem.dt * (1.0 - 1e-12)))
+        h = max_duration / n
+        t0 = self.end
+        reach = max((math.hypot(*s.offset) for s in self.problem.supports), default=0.0)
+        prev = self.last
+        assert prev is not None
+        px, py = prev[1], prev[2]
+        states: list[Any] = []
+        more: list[Any] = []
+        held, first_rest = 0, None
+        step = engine.step
+        columns = self.columns
+        started = time.perf_counter()
+        for k in range(1, n + 1):
+            s = step(None, h)
+            states.append(s)
+            if columns:
+                more.append(engine.extras())
+            x, y, w = s[0], s[1], s[3]
+            speed = math.hypot(x - px, y - py) / h + abs(w) * reach
+            px, py = x, y
+            if speed < REST_SPEED:
+                if first_rest is None:
+                    first_rest = k
+                held += 1
+                if held >= REST_STEPS:
+                    break
+            else:
+                first_rest, held = None, 0
+        self.step_time_s += time.perf_counter() - started
+        self.steps += len(states)
+        m = first_rest if (first_rest is not None and held >= REST_STEPS) else len(states)
+        states, more = states[:m], more[:m]
+        t_end = t0 + max_duration if m == n else t0 + m * h
+        if self.mode == "steps":
+            times = [t0 + j * h for j in range(1, m)] + [t_end]
+            rows = [
+                (t, *_state(s, t), *(_extras(e, columns, t) if columns else ()))
+                for t, s, e in zip(times, states, more if columns else itertools.repeat(()))
+            ]
+        else:
+            slide = Push(index=len(self.applied), t_start=t0, duration=t_end - t0, speed=0.0, phi=0.0)
+            rows = self._samples(slide, states, more, m, h, t_end)
+            # The last row is the rest (or the state at max_duration): its
+            # ω the last step's, not the interval's middle.
+            r = rows[-1]
+            rows[-1] = (*r[:4], float(states[m - 1][3]), *r[5:])
+        self.last = rows[-1]
+        self.end = t_end
+        return out + rows
 
     def _segment(self, push: Push, progress, total) -> list[tuple[float, ...]]:
         engine = self.engine
@@ -1192,8 +1307,8 @@ class _Server:
             self.stepper = Stepper(self.engine, problem, rows)
             self.compact = r.has("compact") and r.boolean("compact")
             return f"#ok{tag}\n"
-        if op not in ("advance", "finish"):
-            raise ProblemError(f"`op` is {op!r}; known: start, advance, finish")
+        if op not in ("advance", "release", "finish"):
+            raise ProblemError(f"`op` is {op!r}; known: start, advance, release, finish")
         if self.stepper is None:
             raise ProblemError(f"`{op}` without a `start` before it (or after a failed request)")
         stepper = self.stepper
@@ -1206,6 +1321,8 @@ class _Server:
                 )
                 self.err.flush()
             return f"#end{tag}\n"
+        if op == "release":
+            return self.rows(stepper, stepper.release(r.number("max_duration", 0.0, strict=True)), tag)
         rows = stepper.advance(
             r.number("speed", 0.0), r.number("phi"), r.number("duration", 0.0, strict=True)
         )

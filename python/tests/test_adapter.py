@@ -492,3 +492,110 @@ class TemplateTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+def _pure_python():
+    """adapters/python/pure_python.py's engine class."""
+    import importlib.util
+
+    path = os.path.join(ROOT, "adapters", "python", "pure_python.py")
+    spec = importlib.util.spec_from_file_location("pure_python", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.PurePython
+
+
+class ReleaseTest(unittest.TestCase):
+    """Protocol 3's ``release``: the kit steps the engine with no push until
+    the plate rests, and refuses an engine that cannot release."""
+
+    A = 0.125
+    MU = 0.5
+
+    def square(self, **changes):
+        """The seed plate (0.25 m square, 1 kg, mu 0.5 on its corners), v2."""
+        a = self.A
+        d = doc(
+            format="pushval-problem/2",
+            switching="impulsive",
+            dt=0.001,
+            sample_dt=0.01,
+            object={"mass": 1.0, "inertia_cm": (2 * a) ** 2 / 6, "center_of_mass": [0.0, 0.0],
+                    "polygon": [[-a, -a], [a, -a], [a, a], [-a, a]]},
+            supports=[{"point": p, "mu": self.MU, "normal_force": 9.81 / 4}
+                      for p in [[-a, -a], [a, -a], [a, a], [-a, a]]],
+            contact={"point": [-a, 0.0]},
+        )
+        d.update(changes)
+        d.pop("pushes", None)
+        return d
+
+    def session(self, engine, problem, ops, rows="steps"):
+        docs = [{"request": 1, "op": "start", "rows": rows, "problem": problem}]
+        for i, op in enumerate(ops):
+            docs.append(dict(op, request=2 + i))
+        docs.append({"request": 2 + len(ops), "op": "finish"})
+        out, err = io.StringIO(), io.StringIO()
+        status = serve(engine, True, io.StringIO("\n".join(map(json.dumps, docs)) + "\n"), out, err)
+        self.assertEqual(status, 0)
+        return answers(out.getvalue())
+
+    def rows(self, answer):
+        return [list(map(float, l.split(","))) for l in answer[:-1] if not l.startswith("t,")]
+
+    def test_pure_python_translation_stops_at_the_closed_form(self):
+        """Supports symmetric about the centre of mass, no spin: the plate
+        stops after v/(mu g), v^2/(2 mu g) along its velocity (within a step
+        and v h: the implicit friction's first-order error)."""
+        engine = _pure_python()(argparse_namespace())
+        v, h, g = 1.0, 0.001, 9.81
+        problem = self.square(initial={"position": [0.0, 0.0], "theta": 0.3, "omega": 0.0,
+                                       "from_rest": False, "velocity": [0.6 * v, 0.8 * v]})
+        got = self.session(engine, problem, [{"op": "release", "max_duration": 10.0}])
+        rows = self.rows(got[1])
+        t, x, y, theta, omega = rows[-1]
+        t_exact, d_exact = v / (self.MU * g), v * v / (2 * self.MU * g)
+        self.assertTrue(t_exact - 1e-9 <= t <= t_exact + h + 1e-9, (t, t_exact))
+        self.assertLess(abs(math.hypot(x, y) - d_exact), v * h)
+        self.assertAlmostEqual(x * 0.8 - y * 0.6, 0.0, places=12)
+        self.assertAlmostEqual(theta, 0.3, places=12)
+        self.assertEqual(rows[0][0], 0.0)
+
+    def test_pure_python_rests_after_a_push_without_chattering(self):
+        """After a push the plate slides on; its last rows are the rest (no
+        reversal: the speed falls monotonically to zero)."""
+        engine = _pure_python()(argparse_namespace())
+        problem = self.square(initial={"position": [0.0, 0.0], "theta": 0.0, "omega": 0.0, "from_rest": True})
+        got = self.session(engine, problem, [
+            {"op": "advance", "speed": 0.5, "phi": 0.3, "duration": 0.4},
+            {"op": "release", "max_duration": 10.0},
+        ])
+        rows = self.rows(got[1]) + self.rows(got[2])
+        slide = [r for r in rows if r[0] >= 0.4]
+        speeds = [math.hypot(b[1] - a[1], b[2] - a[2]) / (b[0] - a[0]) for a, b in zip(slide, slide[1:])]
+        self.assertTrue(all(s2 <= s1 + 1e-9 for s1, s2 in zip(speeds, speeds[1:])), speeds[-5:])
+        self.assertLess(slide[-1][0], 0.4 + 10.0)
+        self.assertLess(abs(slide[-1][4]), 1e-9)
+
+    def test_a_short_slide_ends_at_max_duration(self):
+        engine = _pure_python()(argparse_namespace())
+        problem = self.square(initial={"position": [0.0, 0.0], "theta": 0.0, "omega": 2.0,
+                                       "from_rest": False, "velocity": [1.0, 0.0]})
+        got = self.session(engine, problem, [{"op": "release", "max_duration": 0.05}], rows="samples")
+        rows = self.rows(got[1])
+        self.assertEqual([r[0] for r in rows][-1], 0.05)
+        self.assertEqual(got[1][0], "t,x,y,theta,omega,steps")
+
+    def test_an_engine_that_cannot_release_is_refused_naming_the_release(self):
+        problem = self.square(initial={"position": [0.0, 0.0], "theta": 0.0, "omega": 0.0, "from_rest": True})
+        got = self.session(Recorder(), problem, [{"op": "release", "max_duration": 1.0}])
+        self.assertRegex(got[1][0], r"^#error 2 .*cannot release")
+
+
+def argparse_namespace(**kw):
+    import argparse
+
+    ns = argparse.Namespace(scheme="euler", inertia_scale=1.0)
+    for k, v in kw.items():
+        setattr(ns, k, v)
+    return ns

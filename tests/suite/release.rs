@@ -65,14 +65,16 @@ fn thrown(v: [f64; 2], theta: f64, omega: f64) -> Problem {
 }
 
 fn engine(name: &str) -> Box<dyn Engine> {
+    crate::common::use_repo_engines();
     pushval::registry::entry(name)
         .unwrap_or_else(|| panic!("{name} is not registered"))
         .default_engine()
 }
 
-/// The engines that release, with their steps (s).
+/// The engines that release with Coulomb friction at every support, with
+/// their steps (s): rapier2d, Box2D and the outside pure_python (protocol 3).
 fn releasing() -> Vec<(Box<dyn Engine>, f64)> {
-    ["rapier2d", "box2d"]
+    ["rapier2d", "box2d", "pure_python"]
         .iter()
         .map(|n| {
             let e = engine(n);
@@ -272,5 +274,40 @@ fn an_engine_that_cannot_release_refuses_naming_it() {
             assert!(text.contains("release"), "{text}");
         }
         other => panic!("not refused: {other:?}"),
+    }
+}
+
+/// rapier3d slides on its own contact friction (the feet on a floor): it
+/// must stop (its rest state at rest); where it rests is reported against
+/// the model, not held to it (its friction is the engine's contact
+/// solver's, not Coulomb's law at each support).
+#[test]
+fn rapier3d_stops_after_a_throw_and_a_push() {
+    let e = engine("rapier3d");
+    let h = e.default_dt();
+    let push = Push {
+        duration: 0.4,
+        speed: 0.5,
+        phi: 0.3,
+    };
+    for p in [
+        thrown([0.8, 0.3], 0.2, 4.0),
+        thrown([1.0, 0.0], 0.0, 0.0),
+        problem(vec![push], Initial::default()),
+    ] {
+        let mut s = e.start(&p, h).unwrap();
+        for q in &p.pushes {
+            s.advance(q).unwrap();
+        }
+        s.release(10.0).unwrap();
+        let st = s.state();
+        assert_eq!(
+            s.slide().unwrap().t_stop,
+            Some(st.t),
+            "rapier3d does not stop"
+        );
+        assert!(rest_speed(&p, st.v_cm, st.omega) < REST_SPEED, "{st:?}");
+        let (dx, dth, dt) = gaps(e.as_ref(), &p, h);
+        eprintln!("rapier3d: rest gap {dx:.3e} m, {dth:.3e} rad, stop {dt:.3e} s");
     }
 }

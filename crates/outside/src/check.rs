@@ -73,6 +73,14 @@ impl Bound {
         self.omega = self.omega0 + self.speed / self.gyration;
     }
 
+    /// The bound once the plate slides freely from a centre-of-mass speed
+    /// `speed` (m/s) and spin `omega` (rad/s): friction only slows it.
+    pub(crate) fn widen_slide(&mut self, speed: f64, omega: f64) {
+        self.speed = self.speed.max(speed.abs());
+        self.omega0 = self.omega0.max(omega.abs());
+        self.omega = self.omega.max(self.omega0 + self.speed / self.gyration);
+    }
+
     /// Whether the step from row `a` to row `b` is within the bound; else
     /// the sentence saying which jump is not (naming `b`'s line as `where_`
     /// tells).

@@ -148,6 +148,17 @@ pub fn problem_document_v2(
         "limits".into(),
         json!({"max_rows": limits.max_rows, "max_bytes": limits.max_bytes}),
     );
+    // The slide: written only when the problem has one (a release, a
+    // thrown plate's velocity), so that other documents are unchanged.
+    if let Some(r) = &problem.release {
+        o.insert("release".into(), json!({"max_duration": r.max_duration}));
+    }
+    let v = problem.initial.velocity;
+    if v.x != 0.0 || v.y != 0.0 {
+        if let Some(Value::Object(init)) = o.get_mut("initial") {
+            init.insert("velocity".into(), json!([v.x, v.y]));
+        }
+    }
     doc
 }
 

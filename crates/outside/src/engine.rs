@@ -4,11 +4,11 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use pushval_engine::{
-    rigid_cm_velocity, trajectory_from_steps, with_pushes, ContactRecord, Engine, EngineCrate,
-    EngineInfo, EngineOptions, EngineRun, EngineSession, EngineState, FrictionLaw, LoadRecorder,
-    OptionKeys, ReplaySession, Session, StepRecord,
+    after_release, extend_through_slide, rigid_cm_velocity, trajectory_from_steps, with_pushes,
+    ContactRecord, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, EngineSession,
+    EngineState, FrictionLaw, LoadRecorder, OptionKeys, ReplaySession, Session, StepRecord,
 };
-use pushval_model::{ModelError, Problem, Push};
+use pushval_model::{ModelError, Problem, Push, Sample, SlideReport, Trajectory};
 
 use crate::check::{self, Bound};
 use crate::config::Spec;
@@ -136,6 +136,15 @@ impl Engine for OutsideEngine {
         }
         let start = Instant::now();
         problem.check()?;
+        if problem.release.is_some() {
+            return Err(ModelError::NoRelease {
+                engine: self.spec.name.clone(),
+                reason: format!(
+                    "a protocol {} document is a whole run without a slide (only a protocol 3 session, session = true, can be asked to release)",
+                    self.spec.protocol
+                ),
+            });
+        }
         let limits = Limits::for_problem(problem, dt);
         let doc = if self.spec.protocol >= 2 {
             problem_document_v2(&self.spec.name, problem, &self.options, dt, limits)
@@ -228,6 +237,19 @@ impl OutsideEngine {
     }
 
     /// A process failure as the run's error.
+    /// A failed `release` request: an `#error` answer is the adapter's
+    /// refusal to release ([`ModelError::NoRelease`], naming the engine);
+    /// anything else is [`OutsideEngine::broken`].
+    fn refused(&self, e: ProcessError) -> ModelError {
+        if e.what.contains("with `#error") {
+            return ModelError::NoRelease {
+                engine: self.spec.name.clone(),
+                reason: e.what,
+            };
+        }
+        self.broken(e)
+    }
+
     fn broken(&self, e: ProcessError) -> ModelError {
         ModelError::Adapter(format!(
             "{}: {}; {}",
@@ -300,6 +322,19 @@ struct Stepping {
     /// Set once a request failed: the adapter's world is no longer the
     /// pushes applied, so the session takes no further request.
     failed: bool,
+    /// The slide's rows after the release (the rows of `rows` end at the
+    /// release).
+    slide_rows: Vec<csv::Record>,
+    /// What the release found, once released.
+    slide: Option<SlideReport>,
+}
+
+/// What an answer's rows cover: a push, or the slide after the release
+/// (its `max_duration`, s).
+#[derive(Clone, Copy)]
+enum Span<'a> {
+    Push(&'a Push),
+    Release(f64),
 }
 
 impl Stepping {
@@ -343,6 +378,19 @@ impl Stepping {
         request.insert("phi".into(), push.phi.into());
         request.insert("duration".into(), push.duration.into());
         (request, Limits::for_push(problem, push.duration, dt))
+    }
+
+    /// The `release` request, and the cap of its answer (a run as long as
+    /// the longest slide).
+    fn release_doc(
+        problem: &Problem,
+        dt: f64,
+        max_duration: f64,
+    ) -> (serde_json::Map<String, serde_json::Value>, Limits) {
+        let mut request = serde_json::Map::new();
+        request.insert("op".into(), "release".into());
+        request.insert("max_duration".into(), max_duration.into());
+        (request, Limits::for_push(problem, max_duration, dt))
     }
 
     fn finish_doc() -> serde_json::Map<String, serde_json::Value> {
@@ -398,6 +446,8 @@ impl Stepping {
             requests: vec![started_by.request],
             answered_before: started_by.answered_before,
             failed: false,
+            slide_rows: Vec::new(),
+            slide: None,
         }
     }
 
@@ -424,6 +474,10 @@ impl Stepping {
             let (doc, limits) = Self::advance_doc(problem, dt, push);
             docs.push((doc, "advance", Close::End, limits));
         }
+        if let Some(r) = &problem.release {
+            let (doc, limits) = Self::release_doc(problem, dt, r.max_duration);
+            docs.push((doc, "release", Close::End, limits));
+        }
         docs.push((Self::finish_doc(), "finish", Close::End, Self::SMALL));
         let mut answers = lease.pipeline(docs, timeout).into_iter();
         let mut next = |what: &str| {
@@ -439,7 +493,11 @@ impl Stepping {
         for push in &problem.pushes {
             let a = next("advance").map_err(|e| engine.broken(e))?;
             s.applied.push(*push);
-            s.absorb(a, push)?;
+            s.absorb(a, Span::Push(push))?;
+        }
+        if let Some(r) = &problem.release {
+            let a = next("release").map_err(|e| engine.refused(e))?;
+            s.absorb(a, Span::Release(r.max_duration))?;
         }
         let a = next("finish").map_err(|e| engine.broken(e))?;
         s.close(a)
@@ -447,7 +505,7 @@ impl Stepping {
 
     /// The rows of one advance's answer (`text`: the header first in the
     /// first answer), checked against the rows before.
-    fn read(&mut self, text: &str, request: u64, push: &Push) -> Result<(), String> {
+    fn read(&mut self, text: &str, request: u64, push: Span) -> Result<(), String> {
         let supports = self.problem.body.len();
         let first = self.header.is_none();
         if text
@@ -482,7 +540,7 @@ impl Stepping {
     }
 
     /// An answer of compact lines (the header first, in the first answer).
-    fn read_compact(&mut self, text: &str, request: u64, push: &Push) -> Result<(), String> {
+    fn read_compact(&mut self, text: &str, request: u64, push: Span) -> Result<(), String> {
         let first = self.header.is_none();
         let mut lines = text
             .lines()
@@ -522,8 +580,14 @@ impl Stepping {
         rows: Vec<csv::Record>,
         first: bool,
         request: u64,
-        push: &Push,
+        span: Span,
     ) -> Result<(), String> {
+        let push = match span {
+            Span::Push(p) => p,
+            Span::Release(max_duration) => {
+                return self.take_slide(rows, first, request, max_duration)
+            }
+        };
         let where_ = |line: usize| format!("line {line} of its answer to request {request}");
         let t0 = self.end;
         let t1 = t0 + push.duration;
@@ -567,11 +631,104 @@ impl Stepping {
         self.rows.extend(rows);
         Ok(())
     }
+
+    /// Checks the release's rows (the row at t = 0 first for a plate
+    /// thrown without pushes) and keeps them: they start after the release
+    /// and end at the rest, before `t_release + max_duration`, or at it
+    /// (the plate has not stopped).
+    fn take_slide(
+        &mut self,
+        mut rows: Vec<csv::Record>,
+        first: bool,
+        request: u64,
+        max_duration: f64,
+    ) -> Result<(), String> {
+        let where_ = |line: usize| format!("line {line} of its answer to request {request}");
+        let t0 = self.end;
+        let t_max = t0 + max_duration;
+        let tol = 1e-9 * t_max.max(1.0);
+        if rows.is_empty() || (first && rows.len() < 2) {
+            return Err(format!(
+                "answered request {request} (release at {t0} s) with no row of the slide"
+            ));
+        }
+        if first && rows[0].numbers[0].abs() > tol {
+            return Err(format!(
+                "{}: the first row is at t = {} s, not at 0 (a release without pushes starts with the header and the row at t = 0)",
+                where_(rows[0].line),
+                rows[0].numbers[0]
+            ));
+        }
+        let last = rows.last().expect("not empty").clone();
+        let t_end = last.numbers[0];
+        if !(t_end > t0 + tol && t_end <= t_max + tol) {
+            return Err(format!(
+                "{}: the slide released at {t0} s ends at t = {t_end} s, not within its max_duration ({t_max} s)",
+                where_(last.line)
+            ));
+        }
+        let init = &self.problem.initial;
+        let (speed, omega) = if first {
+            (init.velocity.norm(), init.omega)
+        } else {
+            (
+                self.state.v_cm[0].hypot(self.state.v_cm[1]),
+                self.state.omega,
+            )
+        };
+        let mut bound = self.bound;
+        bound.widen_slide(speed, omega);
+        check::rows(&bound, self.rows.last(), &rows, |r| where_(r.line))
+            .map_err(|e| format!("wrote a row that is not a motion of the slide: {e}"))?;
+        let stopped = t_end < t_max - tol;
+        let s = last.numbers;
+        let v_cm = match (stopped, rows.len()) {
+            (false, n) if n >= 2 => {
+                let p = rows[n - 2].numbers;
+                let dt = (s[0] - p[0]).max(f64::MIN_POSITIVE);
+                [(s[1] - p[1]) / dt, (s[2] - p[2]) / dt]
+            }
+            _ => [0.0, 0.0],
+        };
+        self.state = EngineState {
+            t: s[0],
+            x: s[1],
+            y: s[2],
+            theta: s[3],
+            omega: s[4],
+            v_cm,
+        };
+        if first {
+            self.rows.push(rows.remove(0));
+        }
+        self.slide = Some(SlideReport {
+            t_release: t0,
+            t_stop: stopped.then_some(t_end),
+            pivots: Vec::new(),
+        });
+        self.end = t_end;
+        self.bound = bound;
+        self.slide_rows.extend(rows);
+        Ok(())
+    }
+}
+
+/// A row as a sample.
+fn sample_of(r: &csv::Record) -> Sample {
+    let n = r.numbers;
+    Sample {
+        t: n[0],
+        x: n[1],
+        y: n[2],
+        theta: n[3],
+        omega: n[4],
+    }
 }
 
 impl Stepping {
-    /// Reads an advance's answer for `push` (already in `applied`).
-    fn absorb(&mut self, a: Answer, push: &Push) -> Result<(), ModelError> {
+    /// Reads an advance's answer for `push` (already in `applied`), or the
+    /// release's.
+    fn absorb(&mut self, a: Answer, push: Span) -> Result<(), ModelError> {
         let engine = Arc::clone(&self.engine);
         self.failed = true;
         self.process_time += a.elapsed;
@@ -610,17 +767,54 @@ impl Stepping {
         }
         self.process_time += a.elapsed;
         self.requests.push(a.request);
-        let problem = with_pushes(&self.problem, self.applied.clone());
-        problem.check()?;
+        let mut problem = with_pushes(&self.problem, self.applied.clone());
+        problem.release = None;
         let parse = Instant::now();
-        let mut run = engine
-            .assemble(&problem, self.dt, &self.rows)
-            .map_err(|e| {
-                engine.fail(
-                    format!("wrote rows that do not cover the run: {e}"),
-                    &a.stderr(),
-                )
-            })?;
+        let mut run = if self.applied.is_empty() {
+            // A plate thrown: the run is the slide alone.
+            let steps = engine_steps(&self.rows) + engine_steps(&self.slide_rows);
+            let mut trajectory = Trajectory {
+                model: engine.spec.name.clone(),
+                ..Default::default()
+            };
+            trajectory.stats.steps = steps;
+            trajectory.stats.rhs_evals = steps;
+            EngineRun {
+                trajectory,
+                dt: self.dt,
+                steps,
+                wall_time: Duration::ZERO,
+                diagnostics: serde_json::Value::Null,
+                contact: None,
+            }
+        } else {
+            problem.check()?;
+            engine
+                .assemble(&problem, self.dt, &self.rows)
+                .map_err(|e| {
+                    engine.fail(
+                        format!("wrote rows that do not cover the run: {e}"),
+                        &a.stderr(),
+                    )
+                })?
+        };
+        if let Some(report) = self.slide.take() {
+            let release =
+                self.rows.last().map(sample_of).ok_or_else(|| {
+                    engine.fail("wrote no row before its slide".into(), &a.stderr())
+                })?;
+            let steps: Vec<Sample> = self.slide_rows.iter().map(sample_of).collect();
+            let end = *steps.last().expect("a slide has a row");
+            if !self.applied.is_empty() {
+                let n = engine_steps(&self.slide_rows);
+                run.steps += n;
+                run.trajectory.stats.steps += n;
+                run.trajectory.stats.rhs_evals += n;
+            }
+            extend_through_slide(&problem, &mut run.trajectory, release, &steps, end, report);
+        } else if self.applied.is_empty() {
+            return Err(ModelError::EmptySchedule);
+        }
         self.parse_time += parse.elapsed();
         run.wall_time = self.started.elapsed();
         run.diagnostics = serde_json::json!({
@@ -660,6 +854,9 @@ impl EngineSession for Stepping {
 
     fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
         self.usable()?;
+        if self.slide.is_some() {
+            return Err(after_release());
+        }
         self.failed = true;
         let engine = Arc::clone(&self.engine);
         let (doc, limits) = Self::advance_doc(&self.problem, self.dt, push);
@@ -669,7 +866,31 @@ impl EngineSession for Stepping {
             .request(doc, "advance", Close::End, limits, timeout)
             .map_err(|e| engine.broken(e))?;
         self.applied.push(*push);
-        self.absorb(a, push)
+        self.absorb(a, Span::Push(push))
+    }
+
+    /// The `release` request: the adapter steps its plate free to rest and
+    /// answers the slide's rows (see the protocol in
+    /// docs/outside-engines.md); an adapter that cannot release answers
+    /// `#error`, which is the release's refusal.
+    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+        self.usable()?;
+        if self.slide.is_some() {
+            return Err(after_release());
+        }
+        self.failed = true;
+        let engine = Arc::clone(&self.engine);
+        let (doc, limits) = Self::release_doc(&self.problem, self.dt, max_duration);
+        let timeout = self.timeout();
+        let a = self
+            .lease
+            .request(doc, "release", Close::End, limits, timeout)
+            .map_err(|e| engine.refused(e))?;
+        self.absorb(a, Span::Release(max_duration))
+    }
+
+    fn slide(&self) -> Option<SlideReport> {
+        self.slide.clone()
     }
 
     fn finish(mut self: Box<Self>) -> Result<EngineRun, ModelError> {

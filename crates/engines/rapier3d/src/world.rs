@@ -120,6 +120,8 @@ pub(crate) struct Scene3d {
     world: PhysicsWorld,
     object: RigidBodyHandle,
     pusher: RigidBodyHandle,
+    /// The pusher's joint, removed at the release.
+    joint: ImpulseJointHandle,
     /// The pusher joint's anchor in the object's frame.
     anchor_local: Vector,
     feet: Feet,
@@ -176,6 +178,26 @@ impl PlateWorld for Scene3d {
     fn cm_velocity(&self, _st: &State) -> Option<[f64; 2]> {
         let v = self.world.bodies[self.object].linvel();
         Some([v.x, v.y])
+    }
+
+    /// Removes the pusher's joint and stops the pusher; a throw sets the
+    /// object's horizontal velocity and its spin about the vertical. The
+    /// slide is the engine's own: the feet's contact friction on the floor
+    /// (nothing is applied besides).
+    fn release(&mut self, _st: &State, throw: Option<([f64; 2], f64)>) -> Result<(), ModelError> {
+        self.world.remove_impulse_joint(self.joint);
+        {
+            let p = &mut self.world.bodies[self.pusher];
+            p.set_linvel(Vector::ZERO, true);
+            p.set_angvel(Vector::ZERO, true);
+        }
+        if let Some((v, omega)) = throw {
+            let rb = &mut self.world.bodies[self.object];
+            let (vz, w) = (rb.linvel().z, rb.angvel());
+            rb.set_linvel(v3(v[0], v[1], vz), true);
+            rb.set_angvel(v3(w.x, w.y, omega), true);
+        }
+        Ok(())
     }
 }
 
@@ -323,11 +345,12 @@ pub(crate) fn start(
         .local_anchor2(anchor_local)
         .contacts_enabled(false)
         .softness(SpringCoefficients::new(JOINT_FREQUENCY, 1.0));
-    world.insert_impulse_joint(pusher, object, joint);
+    let joint = world.insert_impulse_joint(pusher, object, joint);
     let mut w = Scene3d {
         world,
         object,
         pusher,
+        joint,
         anchor_local,
         feet,
         h_cm,
