@@ -276,7 +276,7 @@ enum Ask {
 enum Answer {
     Advanced(Result<(EngineState, usize), ModelError>),
     Released(Result<(EngineState, usize, Option<SlideReport>), ModelError>),
-    Finished(Result<EngineRun, ModelError>),
+    Finished(Box<Result<EngineRun, ModelError>>),
 }
 
 /// The session of an engine whose world cannot leave the thread that built
@@ -326,7 +326,7 @@ where
                         }
                     }
                     Ask::Finish => {
-                        let _ = answer_tx.send(Answer::Finished(session.finish()));
+                        let _ = answer_tx.send(Answer::Finished(Box::new(session.finish())));
                         return;
                     }
                 }
@@ -402,7 +402,7 @@ impl EngineSession for Threaded {
             return Err(self.lost());
         }
         let run = match self.answer.recv() {
-            Ok(Answer::Finished(r)) => r,
+            Ok(Answer::Finished(r)) => *r,
             Ok(Answer::Advanced(_) | Answer::Released(_)) | Err(_) => Err(self.lost()),
         };
         if let Some(t) = self.thread.take() {
