@@ -250,3 +250,47 @@ fn answers_read_together_are_each_their_own() {
     assert_eq!(run.trajectory.samples, one_shot.trajectory.samples);
     shutdown_sessions();
 }
+
+/// The release: a protocol 1 adapter (one-shot, or replayed in a session)
+/// is refused a release problem naming the engine and the release, never
+/// run to the release's end; a protocol 3 session of the kit's
+/// pure_python releases with one `release` request after the pushes, and
+/// its run ends at rest (the last row the stop time, as the report says).
+#[test]
+fn a_release_is_asked_of_protocol_3_and_refused_by_protocol_1() {
+    let _g = serial();
+    let (mut p, options) = problem();
+    p.pushes.truncate(2);
+    p.release = Some(pushval_model::Release { max_duration: 5.0 });
+    let one = OutsideEngine::new(spec("plain_protocol1.py", ""), &options);
+    for r in [
+        one.run(&p, DT),
+        (&one as &dyn Engine).start(&p, DT).and_then(|mut s| {
+            for q in &p.pushes {
+                s.advance(q)?;
+            }
+            s.release(5.0)?;
+            s.finish()
+        }),
+    ] {
+        match r {
+            Err(e @ pushval_model::ModelError::NoRelease { .. }) => {
+                let text = e.to_string();
+                assert!(text.contains("stepper cannot release"), "{text}");
+            }
+            other => panic!("not refused: {:?}", other.map(|r| r.steps)),
+        }
+    }
+    let three = OutsideEngine::new(spec("pure_python.py", "session = true\n"), &options);
+    let run = three.run(&p, DT).unwrap();
+    let slide = run.trajectory.slide.clone().expect("a slide report");
+    let stop = slide.t_stop.expect("the plate stops");
+    assert_eq!(slide.t_release, p.duration());
+    assert_eq!(run.trajectory.samples.last().unwrap().t, stop);
+    // start, two advances, the release, finish.
+    assert_eq!(
+        run.diagnostics["session"]["requests"],
+        serde_json::json!([1, 2, 3, 4, 5])
+    );
+    shutdown_sessions();
+}
