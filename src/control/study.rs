@@ -575,10 +575,12 @@ fn write_outputs(
             num(r[4]),
             num(r[5]),
             num(r[6]),
-            match r[7] {
-                x if x == 1.0 => "rest".to_string(),
-                x if x == 0.0 => "release".to_string(),
-                _ => String::new(),
+            if r[7] == 1.0 {
+                "rest".to_string()
+            } else if r[7] == 0.0 {
+                "release".to_string()
+            } else {
+                String::new()
             },
             num(r[8]),
         ]);
@@ -699,6 +701,7 @@ fn law_line(problem: &Problem, engine: &dyn Engine, speed: f64) -> Option<String
     ))
 }
 
+#[allow(clippy::too_many_arguments)]
 fn readme(
     problem: &Problem,
     names: &[String],
