@@ -61,6 +61,9 @@ pub struct Axis {
     pub log: bool,
     /// Fixed range; None: fitted to the data with a 4 % margin.
     pub range: Option<(f64, f64)>,
+    /// Whether the axis has numbered ticks and grid lines (false for a
+    /// table drawn as a map: its cells carry their own labels).
+    pub ticks: bool,
 }
 
 impl Axis {
@@ -69,6 +72,7 @@ impl Axis {
             label: label.into(),
             log: false,
             range: None,
+            ticks: true,
         }
     }
     pub fn log(label: impl Into<String>) -> Self {
@@ -76,7 +80,14 @@ impl Axis {
             label: label.into(),
             log: true,
             range: None,
+            ticks: true,
         }
+    }
+    /// No numbered ticks and no grid lines.
+    #[must_use]
+    pub fn without_ticks(mut self) -> Self {
+        self.ticks = false;
+        self
     }
     #[must_use]
     pub fn range(mut self, lo: f64, hi: f64) -> Self {
@@ -595,18 +606,22 @@ where
         .build_cartesian_2d(x, y)
         .map_err(err)?;
     let fmt = |v: &f64| short(*v);
-    chart
-        .configure_mesh()
-        .x_desc(p.x.label.as_str())
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(p.x.label.as_str())
         .y_desc(p.y.label.as_str())
         .x_label_formatter(&fmt)
         .y_label_formatter(&fmt)
         .label_style((FONT, 14))
         .axis_desc_style((FONT, 16))
         .bold_line_style(RGBColor(225, 225, 225))
-        .light_line_style(RGBColor(244, 244, 244))
-        .draw()
-        .map_err(err)?;
+        .light_line_style(RGBColor(244, 244, 244));
+    if !p.x.ticks {
+        mesh.x_labels(0).disable_x_mesh();
+    }
+    if !p.y.ticks {
+        mesh.y_labels(0).disable_y_mesh();
+    }
+    mesh.draw().map_err(err)?;
     if !p.cells.is_empty() {
         chart
             .draw_series(

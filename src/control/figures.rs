@@ -39,13 +39,15 @@ pub(crate) fn success_figure(
     names: &[String],
     speeds: &[f64],
     summary: &BTreeMap<Group, (usize, usize, f64, f64)>,
+    failed: &BTreeMap<Group, usize>,
 ) -> Figure {
+    // A sequential ramp, worst to best, so the colours read in order.
     let colors = vec![
-        plot::RED_,
-        plot::ORANGE,
-        plot::OLIVE,
-        plot::CYAN_,
-        plot::GREEN_,
+        plotters::style::RGBColor(178, 24, 43),
+        plotters::style::RGBColor(239, 138, 98),
+        plotters::style::RGBColor(253, 219, 199),
+        plotters::style::RGBColor(166, 219, 160),
+        plotters::style::RGBColor(27, 120, 55),
     ];
     let scale = Scale::Classes(colors);
     let mut panels = Vec::new();
@@ -70,7 +72,13 @@ pub(crate) fn success_figure(
                         } else {
                             0.0
                         };
-                        (class, format!("{ok}/{total}"))
+                        // Runs that ended with an engine error count as
+                        // misses and are marked in the cell.
+                        let mark = match failed.get(&k).copied().unwrap_or(0) {
+                            0 => format!("{ok}/{total}"),
+                            f => format!("{ok}/{total} ({f} failed)"),
+                        };
+                        (class, mark)
                     }
                     _ => (f64::NAN, String::new()),
                 };
@@ -103,8 +111,12 @@ pub(crate) fn success_figure(
         }
         let panel = plot::heat_map(
             format!("goals reached at {v} m/s"),
-            Axis::lin("plan predictor · open loop or MPC · plant").range(0.0, 11.0),
-            Axis::lin("engine").range(0.0, n as f64 + 1.0),
+            Axis::lin("plan predictor · open loop or MPC · plant")
+                .range(0.0, 11.0)
+                .without_ticks(),
+            Axis::lin("engine")
+                .range(0.0, n as f64 + 1.0)
+                .without_ticks(),
             &cells,
             &with_white,
         )
@@ -113,7 +125,8 @@ pub(crate) fn success_figure(
     }
     let labels = ["< 25 %", "25–50 %", "50–75 %", "75–95 %", "≥ 95 %"];
     let notes = vec![
-        "goals reached (20 mm, 5°)".to_string(),
+        "goals reached (20 mm, 5°, at rest".to_string(),
+        "unless runs.csv says release)".to_string(),
         "dyn/kin: plan made on the".to_string(),
         "dynamic / kinematic model;".to_string(),
         "pert: plant μ × 0.8, I_cm × 1.2".to_string(),

@@ -619,6 +619,7 @@ fn write_outputs(
     // miss), so failures raise the median instead of leaving it.
     let med = |v: Vec<f64>| median(&v).unwrap_or(f64::NAN);
     let mut summary: BTreeMap<Group, (usize, usize, f64, f64)> = BTreeMap::new();
+    let mut failed_by_group: BTreeMap<Group, usize> = BTreeMap::new();
     for k in &order {
         let rs = &groups[k];
         let ok = rs.iter().filter(|r| r[0] == 1.0).count();
@@ -627,6 +628,7 @@ fn write_outputs(
         let ae = med(rs.iter().map(|r| err(r[2])).collect());
         let failed = rs.iter().filter(|r| r[6] == 1.0).count();
         summary.insert(k.clone(), (ok, rs.len(), pe, ae));
+        failed_by_group.insert(k.clone(), failed);
         success.row(&[
             k.0.clone(),
             num(f64::from_bits(k.1)),
@@ -648,7 +650,7 @@ fn write_outputs(
     dir.file("goals.csv", goals_csv.as_bytes())?;
     dir.figure(
         "success.svg",
-        &super::figures::success_figure(names, speeds, &summary),
+        &super::figures::success_figure(names, speeds, &summary, &failed_by_group),
     )?;
     let paths = super::figures::paths_figure(problem, SEGMENTS, names, goals, speeds)?;
     dir.figure("paths.svg", &paths)?;
