@@ -171,53 +171,143 @@ pub(crate) fn paths_figure(
     let mut p = problem.clone();
     p.pushes = plan.pushes.clone();
     p.sample_dt = p.duration() / 200.0;
-    let labels: Vec<&str> = names.iter().map(String::as_str).collect();
-    let styles = plot::family_styles(&labels);
-    let mut panel = Panel::new(
-        format!("goal 0 ({goal}) at {v} m/s: the dynamic plan replayed open loop"),
-        Axis::lin("x (m)"),
-        Axis::lin("y (m)"),
-    )
-    .legend(Legend::Outside)
-    .equal_aspect();
     let model = pushval_model::DynamicModel::default();
     let traj = pushval_model::Simulator::simulate(&model, &p)?;
-    panel = panel.series(
-        Series::new("dynamic model", plot::DARK, Stroke::Solid)
-            .width(3)
-            .points(traj.samples.iter().map(|s| (s.x, s.y)).collect()),
+    // The plate's outline: the hull of its support points in the body frame
+    // (about the centre of mass); the study's plate has one at each corner.
+    let hull = hull(
+        &problem
+            .body
+            .supports()
+            .map(|s| (s.position.x, s.position.y))
+            .collect::<Vec<_>>(),
     );
-    for (name, (color, stroke)) in names.iter().zip(styles) {
-        let e = crate::registry::entry(name)
-            .expect("listed")
-            .default_engine();
-        match e.run(&p, e.default_dt()) {
-            Ok(run) => {
-                panel = panel.series(
-                    Series::new(name.clone(), color, stroke)
-                        .points(run.trajectory.samples.iter().map(|s| (s.x, s.y)).collect()),
-                );
-            }
-            Err(err) => eprintln!("control-study: paths: {name}: {err}"),
+    let outline = |x: f64, y: f64, theta: f64| -> Vec<(f64, f64)> {
+        let (sn, cs) = theta.sin_cos();
+        hull.iter()
+            .chain(hull.first())
+            .map(|&(px, py)| (x + cs * px - sn * py, y + sn * px + cs * py))
+            .collect()
+    };
+    // Small multiples: one panel per engine family (the name before its
+    // first `_`), each with the model's path and the goal drawn as the
+    // plate's outline at the goal pose; every engine's final pose marked.
+    let family = |n: &str| n.split(['_', '[']).next().unwrap_or(n).to_string();
+    let mut families: Vec<(String, Vec<&String>)> = Vec::new();
+    for n in names {
+        let f = family(n);
+        match families.iter_mut().find(|(g, _)| *g == f) {
+            Some((_, v)) => v.push(n),
+            None => families.push((f, vec![n])),
         }
     }
-    // The goal: a cross of the plate's half-width, and its heading.
-    let a = 0.05;
-    let (s, c) = goal.theta.sin_cos();
-    panel = panel
-        .series(
-            Series::new("goal (heading)", plot::RED_, Stroke::Solid)
-                .width(3)
-                .points(vec![
-                    (goal.x, goal.y),
-                    (goal.x + 2.0 * a * c, goal.y + 2.0 * a * s),
-                ]),
+    let mut panels = Vec::new();
+    for (fam, members) in &families {
+        let labels: Vec<&str> = members.iter().map(|s| s.as_str()).collect();
+        let styles = plot::family_styles(&labels);
+        let mut panel = Panel::new(
+            format!("{fam}: goal 0 at {v} m/s, the dynamic plan open loop"),
+            Axis::lin("x (m)"),
+            Axis::lin("y (m)"),
         )
-        .series(Series::new("goal", plot::RED_, Stroke::Dots).points(vec![(goal.x, goal.y)]));
+        .legend(Legend::Outside)
+        .equal_aspect()
+        .series(
+            Series::new("dynamic model", plot::DARK, Stroke::Solid)
+                .width(3)
+                .points(traj.samples.iter().map(|s| (s.x, s.y)).collect()),
+        )
+        .series(
+            Series::new("goal pose", plot::RED_, Stroke::Solid)
+                .width(3)
+                .points(outline(goal.x, goal.y, goal.theta)),
+        );
+        for (name, (color, stroke)) in members.iter().zip(styles) {
+            let e = crate::registry::entry(name)
+                .expect("listed")
+                .default_engine();
+            match e.run(&p, e.default_dt()) {
+                Ok(run) => {
+                    let pts: Vec<(f64, f64)> =
+                        run.trajectory.samples.iter().map(|s| (s.x, s.y)).collect();
+                    panel = panel.series(Series::new((*name).clone(), color, stroke).points(pts));
+                    if let Some(l) = run.trajectory.samples.last() {
+                        panel = panel.series(
+                            Series::new(format!("{name}: final pose"), color, Stroke::Dotted)
+                                .points(outline(l.x, l.y, l.theta)),
+                        );
+                    }
+                }
+                Err(err) => eprintln!("control-study: paths: {name}: {err}"),
+            }
+        }
+        panels.push(panel);
+    }
+    let cols = 2u32;
+    let rows = (panels.len() as u32).div_ceil(cols).max(1);
     Ok(Figure {
-        size: (1400, 900),
-        cols: 1,
-        panels: vec![panel],
+        size: (1600, 520 * rows),
+        cols: cols as usize,
+        panels,
         key: None,
     })
+}
+
+/// The convex hull of `points` (counter-clockwise; Andrew's monotone chain:
+/// a handful of support points, so no geometry crate is worth it here).
+fn hull(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut p = points.to_vec();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut lower: Vec<(f64, f64)> = Vec::new();
+    for &q in &p {
+        while lower.len() >= 2 && cross(lower[lower.len() - 2], lower[lower.len() - 1], q) <= 0.0 {
+            lower.pop();
+        }
+        lower.push(q);
+    }
+    let mut upper: Vec<(f64, f64)> = Vec::new();
+    for &q in p.iter().rev() {
+        while upper.len() >= 2 && cross(upper[upper.len() - 2], upper[upper.len() - 1], q) <= 0.0 {
+            upper.pop();
+        }
+        upper.push(q);
+    }
+    lower.pop();
+    upper.pop();
+    lower.extend(upper);
+    lower
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hull;
+
+    /// The hull of a square's corners and its centre is the four corners,
+    /// counter-clockwise (positive signed area: the square's).
+    #[test]
+    fn the_hull_of_a_square_and_its_centre_is_the_square() {
+        let h = hull(&[
+            (1.0, 1.0),
+            (-1.0, -1.0),
+            (0.0, 0.0),
+            (1.0, -1.0),
+            (-1.0, 1.0),
+        ]);
+        assert_eq!(h.len(), 4, "{h:?}");
+        let area: f64 = (0..h.len())
+            .map(|i| {
+                let (a, b) = (h[i], h[(i + 1) % h.len()]);
+                a.0 * b.1 - b.0 * a.1
+            })
+            .sum::<f64>()
+            / 2.0;
+        assert_eq!(area, 4.0);
+    }
 }
