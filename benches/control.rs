@@ -187,6 +187,8 @@ fn cost_table() {
             },
             period: 0.02,
             reach,
+            adapt: false,
+            sensor: Default::default(),
         };
         let plant = PlantScale::PERTURBED.apply(&problem).unwrap();
         let dt = engine.default_dt();

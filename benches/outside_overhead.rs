@@ -594,6 +594,8 @@ fn main() {
             },
             period: PERIOD,
             reach: Reach::default(),
+            adapt: false,
+            sensor: Default::default(),
         };
         let plan_time = time(runs, || {
             plan_from_rest(&loop_problem, goal, spec.plan, spec.reach).is_some()

@@ -333,10 +333,25 @@ enum Command {
             allow_negative_numbers = true
         )]
         period: f64,
-        /// Perturb the engine's scene only: mu_scale=A,inertia_scale=B
-        /// [default: the file's scene].
-        #[arg(long, value_name = "mu_scale=A,inertia_scale=B")]
+        /// The plant's scene when it differs from FILE's:
+        /// mu_scale=A,inertia_scale=B scales FILE's, or a scenario file
+        /// gives its own object and supports (positions, mu, loads, mass,
+        /// I_cm; its outline, contact and centre of mass must equal FILE's)
+        /// [default: FILE's scene].
+        #[arg(long, value_name = "mu_scale=A,inertia_scale=B|FILE")]
         plant: Option<String>,
+        /// Adaptive MPC: every period estimate the plate's friction
+        /// (mu_scale, centre of friction, I_cm) from the readings and the
+        /// pushes applied, and plan on the estimate; writes
+        /// DIR/estimate.csv.
+        #[arg(long)]
+        adapt: bool,
+        /// What the controller reads the plant through: seeded Gaussian
+        /// noise and a delay, keys sigma_position=M, sigma_theta=RAD,
+        /// sigma_omega=RAD_S, sigma_velocity=M_S, latency=S, seed=N (each
+        /// optional) [default: exact and immediate].
+        #[arg(long, value_name = "KEY=VALUE,...")]
+        sensor: Option<String>,
     },
     /// Plans and MPC in every engine of the build and of the project:
     /// goals x speeds x engines x plan predictor x open loop or MPC x
@@ -767,7 +782,16 @@ fn main() -> ExitCode {
             engine,
             period,
             plant,
-        }) => pushval::control::cli::run(&goal.common(file), &engine, period, plant.as_deref()),
+            adapt,
+            sensor,
+        }) => pushval::control::cli::run(
+            &goal.common(file),
+            &engine,
+            period,
+            plant.as_deref(),
+            adapt,
+            sensor.as_deref(),
+        ),
         Some(Command::ControlStudy {
             out,
             quick,

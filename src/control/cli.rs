@@ -12,6 +12,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use pushval_control::mpc::{push_at, run_loop, LoopOutcome, LoopSpec, PlantScale};
 use pushval_control::plan::{describe_attempts, make_plan, Bounds, PlanSpec};
+use pushval_control::sensor::SensorSpec;
 use pushval_control::stats::median_p99;
 use pushval_control::{At, ControlError, Goal, Reach};
 use pushval_engine::Engine;
@@ -367,7 +368,7 @@ pub fn engine_of(
 fn applied_toml(
     p: &Parsed,
     file: &std::path::Path,
-    plant: &PlantScale,
+    plant: &Plant,
     plant_problem: &pushval_model::Problem,
     engine: &str,
     dt: f64,
@@ -382,7 +383,23 @@ fn applied_toml(
             Some(_) => anyhow::bail!("{}: `{key}` is not a table", file.display()),
         }
     };
-    if !plant.is_nominal() {
+    if let Plant::File { text, path, .. } = plant {
+        // The plant's own scene: its object and supports tables as its file
+        // gives them (the outline and contact are the same as the loop's).
+        let theirs: toml::Table =
+            toml::from_str(text).with_context(|| format!("{}: not TOML", path.display()))?;
+        for key in ["object", "supports"] {
+            match theirs.get(key) {
+                Some(v) => {
+                    doc.insert(key.into(), v.clone());
+                }
+                None => {
+                    doc.remove(key);
+                }
+            }
+        }
+    }
+    if let Some(plant) = plant.filter(|s| !s.is_nominal()) {
         // The plant's own scene: friction scaled at every support, the
         // inertia about the centre of mass given outright.
         let mut supports = table(&mut doc, "supports")?;
@@ -437,12 +454,138 @@ fn applied_toml(
     ))
 }
 
-/// `pushval loop`.
-pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow::Result<ExitCode> {
+/// The plant's scene: the file's scaled, or another file's.
+#[derive(Debug, Clone)]
+pub enum Plant {
+    /// `--plant mu_scale=A,inertia_scale=B` (or none: the file's scene).
+    Scale(PlantScale),
+    /// `--plant FILE`: the object and supports of another scenario.
+    File {
+        /// Its path.
+        path: PathBuf,
+        /// Its text.
+        text: String,
+        /// It, loaded.
+        sc: Box<pushval_scenario::Scenario>,
+    },
+}
+
+impl Plant {
+    /// `--plant`: `KEY=VALUE,…` scales the file's scene; anything else is a
+    /// scenario file whose outline, contact and centre of mass must equal
+    /// the loop file's (`file`, loaded as `sc`).
+    pub fn parse(
+        text: Option<&str>,
+        file: &std::path::Path,
+        sc: &pushval_scenario::Scenario,
+    ) -> anyhow::Result<Self> {
+        let Some(text) = text else {
+            return Ok(Plant::Scale(PlantScale::default()));
+        };
+        if text.contains('=') {
+            return Ok(Plant::Scale(parse_plant_scale(text)?));
+        }
+        let path = PathBuf::from(text);
+        let theirs = crate::registry::load(&path)?;
+        let body = std::fs::read_to_string(&path)
+            .with_context(|| format!("{}: cannot read", path.display()))?;
+        let same = |a: &[pushval_model::Vec2], b: &[pushval_model::Vec2]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(p, q)| (p - q).norm() <= 1e-12)
+        };
+        let differs = |key: &str, mine: String, other: String| {
+            anyhow::anyhow!(
+                "{}: {key}: the plant's must equal {}'s (the plant is another plate with the same outline and contact): {other} against {mine}",
+                path.display(),
+                file.display()
+            )
+        };
+        if !same(&theirs.polygon, &sc.polygon) {
+            return Err(differs(
+                "object.polygon",
+                format!(
+                    "{:?}",
+                    sc.polygon.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>()
+                ),
+                format!(
+                    "{:?}",
+                    theirs
+                        .polygon
+                        .iter()
+                        .map(|p| [p.x, p.y])
+                        .collect::<Vec<_>>()
+                ),
+            ));
+        }
+        if !same(&[theirs.contact], &[sc.contact]) {
+            return Err(differs(
+                "contact.point",
+                format!("[{}, {}]", sc.contact.x, sc.contact.y),
+                format!("[{}, {}]", theirs.contact.x, theirs.contact.y),
+            ));
+        }
+        if !same(&[theirs.center_of_mass], &[sc.center_of_mass]) {
+            return Err(differs(
+                "object.center_of_mass",
+                format!("[{}, {}]", sc.center_of_mass.x, sc.center_of_mass.y),
+                format!("[{}, {}]", theirs.center_of_mass.x, theirs.center_of_mass.y),
+            ));
+        }
+        Ok(Plant::File {
+            path,
+            text: body,
+            sc: Box::new(theirs),
+        })
+    }
+
+    /// The scale, when the plant is the file's scene scaled.
+    fn filter(&self, keep: impl Fn(&PlantScale) -> bool) -> Option<&PlantScale> {
+        match self {
+            Plant::Scale(s) if keep(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The plant's problem: `problem` (the loop's schedule, start and
+    /// release) on the plant's scene.
+    pub fn problem(
+        &self,
+        problem: &pushval_model::Problem,
+    ) -> anyhow::Result<pushval_model::Problem> {
+        match self {
+            Plant::Scale(s) => Ok(s.apply(problem)?),
+            Plant::File { sc, .. } => Ok(pushval_model::Problem {
+                body: sc.problem().body,
+                ..problem.clone()
+            }),
+        }
+    }
+
+    /// As `loop.json` gives it.
+    pub fn json(&self) -> serde_json::Value {
+        match self {
+            Plant::Scale(s) => json!(s),
+            Plant::File { path, sc, .. } => {
+                json!({"file": path.display().to_string(), "name": sc.name})
+            }
+        }
+    }
+}
+
+/// `pushval loop`: `plant` is `--plant`, `adapt` `--adapt`, `sensor`
+/// `--sensor`.
+pub fn run(
+    c: &Common,
+    engine: &str,
+    period: f64,
+    plant: Option<&str>,
+    adapt: bool,
+    sensor: Option<&str>,
+) -> anyhow::Result<ExitCode> {
     let p = parse(c)?;
-    let plant = match plant {
-        Some(t) => parse_plant_scale(t)?,
-        None => PlantScale::default(),
+    let plant = Plant::parse(plant, &c.file, &p.sc)?;
+    let sensor = match sensor {
+        Some(t) => SensorSpec::parse(t).map_err(|e| anyhow::anyhow!("--sensor: {e}"))?,
+        None => SensorSpec::default(),
     };
     let (engine, dt) = engine_of(&p.sc, engine)?;
     pushval_control::mpc::period_steps(period, dt).map_err(|e| flag_error(e, c))?;
@@ -450,9 +593,11 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         plan: p.spec,
         period,
         reach: p.reach,
+        adapt,
+        sensor,
     };
     let plant_problem = plant
-        .apply(&p.problem)
+        .problem(&p.problem)
         .with_context(|| format!("--plant: the plant's scene of {}", c.file.display()))?;
     let base = json!({
         "scenario": c.file.display().to_string(),
@@ -464,7 +609,9 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         "predictor": p.spec.predictor.as_str(),
         "speed": p.spec.speed,
         "at": p.spec.at.as_str(),
-        "plant": plant,
+        "plant": plant.json(),
+        "adapt": adapt,
+        "sensor": sensor,
     });
     let outcome = (|| -> anyhow::Result<(LoopOutcome, pushval_engine::EngineRun)> {
         let mut session = engine
@@ -493,6 +640,7 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
     };
     let timing = median_p99(&out.predictor_us);
     let cpu = median_p99(&out.predictor_cpu_us);
+    let est_cpu = median_p99(&out.estimator_cpu_us);
     let pushes: Vec<Push> = out.applied.iter().map(|a| a.push).collect();
     let l = &out.release;
     let judged = out.rest.unwrap_or(out.release);
@@ -515,6 +663,10 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         "plan_from_rest_converged": out.plan_converged,
         "engine_replayed_each_period": out.replayed,
         "engine_steps": run.steps,
+        "sensor_latency_s": out.latency,
+        "estimate": estimate_json(&out),
+        "estimator_cpu_us_median": est_cpu.map(|t| t.0),
+        "estimator_cpu_us_p99": est_cpu.map(|t| t.1),
     });
     if let (Some(d), serde_json::Value::Object(e)) = (doc.as_object_mut(), extra) {
         d.extend(e);
@@ -525,6 +677,9 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         trajectory_csv(&out, &run, engine.name()).as_bytes(),
     )?;
     dir.write("loop.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+    if adapt {
+        dir.write("estimate.csv", &estimate_csv(&out)?)?;
+    }
     let applied = applied_toml(
         &p,
         &c.out.join("applied.toml"),
@@ -553,6 +708,24 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         timing_text,
         if out.replayed { "; the engine cannot step: it re-ran the schedule applied so far every period" } else { "" }
     );
+    if let (Some(row), Some(id)) = (out.estimates.last(), out.identified) {
+        let [mu, cx, cy, i] = row.value;
+        let [smu, scx, scy, si] = row.std;
+        let not = |ok: bool| if ok { "" } else { " (not identified)" };
+        println!(
+            "estimate at {t:.3} s: mu_scale {mu:.4} ± {smu:.4}{a}, centre of friction ({x:.1}, {y:.1}) ± ({sx:.1}, {sy:.1}) mm{b}, I_cm {i:.5} ± {si:.5} kg m²{c}; {n} lack-of-fit episodes; estimator {cost} CPU median",
+            t = row.t,
+            x = cx * 1e3,
+            y = cy * 1e3,
+            sx = scx * 1e3,
+            sy = scy * 1e3,
+            a = not(id.mu_scale),
+            b = not(id.center_of_friction),
+            c = not(id.inertia_cm),
+            n = out.lack_of_fit,
+            cost = est_cpu.map_or("n/a".into(), |t| format!("{:.1} µs", t.0)),
+        );
+    }
     println!(
         "wrote {}, {} and {}",
         c.out.join("trajectory.csv").display(),
@@ -568,6 +741,49 @@ pub fn run(c: &Common, engine: &str, period: f64, plant: Option<&str>) -> anyhow
         );
         ExitCode::from(1)
     })
+}
+
+/// `loop.json`'s `estimate`: the last estimate with its std, which
+/// parameters the readings identified, and what no reading can tell.
+fn estimate_json(out: &LoopOutcome) -> serde_json::Value {
+    let (Some(row), Some(id)) = (out.estimates.last(), out.identified) else {
+        return serde_json::Value::Null;
+    };
+    json!({
+        "t": row.t,
+        "mu_scale": {"value": row.value[0], "std": row.std[0], "identified": id.mu_scale},
+        "center_of_friction": {"value": [row.value[1], row.value[2]], "std": [row.std[1], row.std[2]], "identified": id.center_of_friction},
+        "inertia_cm": {"value": row.value[3], "std": row.std[3], "identified": id.inertia_cm},
+        "lack_of_fit": out.lack_of_fit,
+        "not_identifiable": "how the friction is split among the supports beyond its total, centre and moment about the contact: pushing does not reveal it, yet the slide after the release depends on it",
+    })
+}
+
+/// `estimate.csv`: `t`, then each parameter and its std (the order of
+/// `pushval track`'s rows: centre of friction, I_cm, mu_scale).
+fn estimate_csv(out: &LoopOutcome) -> anyhow::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "t",
+        "center_of_friction_x",
+        "center_of_friction_x_std",
+        "center_of_friction_y",
+        "center_of_friction_y_std",
+        "inertia_cm",
+        "inertia_cm_std",
+        "mu_scale",
+        "mu_scale_std",
+    ])?;
+    for r in &out.estimates {
+        let order = [(1, 1), (2, 2), (3, 3), (0, 0)];
+        let mut row = vec![format!("{}", r.t)];
+        for (v, sd) in order {
+            row.push(format!("{}", r.value[v]));
+            row.push(format!("{}", r.std[sd]));
+        }
+        w.write_record(&row)?;
+    }
+    Ok(w.into_inner()?)
 }
 
 /// The plant's trajectory rows with the applied push (columns `speed`,

@@ -11,8 +11,8 @@ pub mod study;
 use anyhow::{bail, Context};
 use pushval_control::mpc::PlantScale;
 pub use pushval_control::{
-    gyration_length, mpc, plan, pose_errors, predict, push_cone, stats, At, ControlError, Goal,
-    ModelKind, Reach,
+    estimate, gyration_length, mpc, plan, pose_errors, predict, push_cone, sensor, stats, At,
+    ControlError, Goal, ModelKind, Reach,
 };
 
 /// Parses `--goal X,Y,THETA` (m, m, rad).

@@ -369,6 +369,8 @@ fn run_task(
                     plan: spec,
                     period: PERIOD,
                     reach,
+                    adapt: false,
+                    sensor: Default::default(),
                 };
                 let out = run_loop(problem, session.as_mut(), dt, goal, spec, &mut ())?;
                 let (med, p99) = median_p99(&out.predictor_us).unwrap_or((f64::NAN, f64::NAN));

@@ -222,6 +222,8 @@ fn mpc_reaches_on_a_perturbed_rapier2d_plant_where_the_open_loop_plan_misses() {
         plan: spec(1.0, Predictor::Dynamic),
         period: 0.02,
         reach,
+        adapt: false,
+        sensor: Default::default(),
     };
     let plant = PlantScale::PERTURBED.apply(&p).unwrap();
     let mut session = engine.start(&plant, dt).unwrap();

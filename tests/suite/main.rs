@@ -2,6 +2,7 @@
 //! the optimised test profile (see the README's test command).
 
 mod adapters;
+mod adaptive;
 mod anywhere;
 mod architecture;
 mod assumptions;

@@ -26,6 +26,9 @@ pub enum ControlError {
     /// The predictor's model failed.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The online estimator refused a reading or diverged.
+    #[error("the friction estimator: {0}")]
+    Estimator(#[from] pushval_model::track::TrackError),
     /// The plant (the engine session) failed while the loop drove it.
     #[error("the plant failed at t = {t:.4} s: {source}")]
     Plant {

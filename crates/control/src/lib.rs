@@ -15,9 +15,11 @@
 //! [`pushval_engine::EngineSession`] the caller owns.
 
 pub mod error;
+pub mod estimate;
 pub mod mpc;
 pub mod plan;
 pub mod predict;
+pub mod sensor;
 pub mod stats;
 
 use std::f64::consts::PI;

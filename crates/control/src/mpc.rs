@@ -20,8 +20,10 @@ use std::time::Instant;
 use pushval_engine::{EngineSession, EngineState};
 use pushval_model::{Body, ModelError, Problem, Push, Support, Vec2};
 
+use crate::estimate::{EstimateRow, Identified, OnlineEstimator};
 use crate::plan::{nearest, resample, straight_time, PlanSpec, Planner, Solution, GUESSES};
-use crate::predict::{Motion, Start};
+use crate::predict::{ModelPredictor, Motion, Predictor, Start};
+use crate::sensor::{Sensor, SensorSpec};
 use crate::{pose_errors, At, ControlError, Goal, Reach};
 
 /// How the plant differs from the predictor's scene.
@@ -89,6 +91,24 @@ pub struct LoopSpec {
     pub period: f64,
     /// What counts as reaching the goal.
     pub reach: Reach,
+    /// Estimate the plate's friction every period and plan on the estimate
+    /// (adaptive MPC); otherwise plan on the scene given.
+    pub adapt: bool,
+    /// What the controller reads the plant through.
+    pub sensor: SensorSpec,
+}
+
+impl LoopSpec {
+    /// Plain MPC with an exact sensor.
+    pub fn new(plan: PlanSpec, period: f64, reach: Reach) -> Self {
+        Self {
+            plan,
+            period,
+            reach,
+            adapt: false,
+            sensor: SensorSpec::default(),
+        }
+    }
 }
 
 /// One applied push of the loop.
@@ -105,7 +125,8 @@ pub struct Applied {
 pub struct Period<'a> {
     /// Periods done so far (1 for the first).
     pub index: usize,
-    /// The plant's state the re-plan started from.
+    /// What the controller read of the plant (through its sensor) before
+    /// the re-plan.
     pub state: EngineState,
     /// The plan after the re-plan (the pushes still to apply).
     pub plan: &'a [Push],
@@ -159,6 +180,17 @@ pub struct LoopOutcome {
     pub plan_converged: bool,
     /// Whether the plant re-ran its schedule at every period (it cannot step).
     pub replayed: bool,
+    /// The sensor's delay applied (s): whole plant steps.
+    pub latency: f64,
+    /// The estimate after each period's reading (adaptive only).
+    pub estimates: Vec<EstimateRow>,
+    /// The calling thread's CPU time of each period's estimator update and
+    /// scene rebuild (µs; adaptive only).
+    pub estimator_cpu_us: Vec<f64>,
+    /// Which parameters the last estimate identified (adaptive only).
+    pub identified: Option<Identified>,
+    /// Times the readings rejected the estimator's model (adaptive only).
+    pub lack_of_fit: usize,
 }
 
 /// The plan from rest for `goal` on `problem`.
@@ -221,6 +253,57 @@ pub fn open_loop(
 /// next period's warm start, so the search goes on.
 pub const STAGE_STEPS: usize = 6;
 
+/// The start of a re-plan at `now` (s) from a reading `st` taken at
+/// `st.t <= now`: the reading itself when it is current, else the reading
+/// carried forward over the pushes applied since, on `forward` (the
+/// controller's model, judged at the release).
+fn start_at(
+    scene: &Problem,
+    forward: &mut ModelPredictor,
+    st: &EngineState,
+    applied: &[Applied],
+    now: f64,
+) -> Result<Start, ControlError> {
+    let eps = 1e-9 * now.abs().max(1e-3);
+    if st.t >= now - eps {
+        return Ok(start_of(scene, st));
+    }
+    let pushes: Vec<Push> = applied
+        .iter()
+        .filter_map(|a| {
+            let from = a.t0.max(st.t);
+            let to = (a.t0 + a.push.duration).min(now);
+            (to - from > eps).then_some(Push {
+                duration: to - from,
+                ..a.push
+            })
+        })
+        .collect();
+    let Some(last) = pushes.last().copied() else {
+        return Ok(start_of(scene, st));
+    };
+    let from = if st.t <= eps {
+        Start::of_problem(scene)
+    } else {
+        start_of(scene, st)
+    };
+    let total: f64 = pushes.iter().map(|p| p.duration).sum();
+    let tr = forward.trajectory(&from, &pushes, total)?;
+    let end = tr
+        .samples
+        .last()
+        .ok_or(pushval_model::ModelError::EmptySchedule)?;
+    let at_end = EngineState {
+        t: now,
+        x: end.x,
+        y: end.y,
+        theta: end.theta,
+        omega: end.omega,
+        v_cm: pushval_engine::rigid_cm_velocity(scene, Some(&last), end.theta, end.omega),
+    };
+    Ok(start_of(scene, &at_end))
+}
+
 fn start_of(problem: &Problem, st: &EngineState) -> Start {
     Start {
         theta: st.theta,
@@ -233,8 +316,11 @@ fn start_of(problem: &Problem, st: &EngineState) -> Start {
 }
 
 /// Model-predictive control of `plant` (a session started on the plant's
-/// scene at step `dt`, s) towards `goal`, planned on `problem`'s scene.
-/// The caller owns the plant and finishes it.
+/// scene at step `dt`, s) towards `goal`, planned on `problem`'s scene (or,
+/// with [`LoopSpec::adapt`], on the scene estimated from the plant's
+/// readings, starting from `problem`'s). The controller reads the plant
+/// only through [`LoopSpec::sensor`]; success is judged on the plant's true
+/// state. The caller owns the plant and finishes it.
 pub fn run_loop(
     problem: &Problem,
     plant: &mut dyn EngineSession,
@@ -245,6 +331,26 @@ pub fn run_loop(
 ) -> Result<LoopOutcome, ControlError> {
     let k = period_steps(spec.period, dt)?;
     let period = k as f64 * dt;
+    spec.sensor.check()?;
+    // The delay in whole plant steps; each period is split where a later
+    // reading will look (the same offset in every period), so the state
+    // it reads was recorded exactly there.
+    let lag = (spec.sensor.latency / dt).round() as usize;
+    let latency = lag as f64 * dt;
+    let split = match lag % k {
+        0 => None,
+        r => Some(k - r),
+    };
+    let mut sensor = Sensor::new(spec.sensor, latency);
+    sensor.record(plant.state());
+    let mut estimator = if spec.adapt {
+        Some(OnlineEstimator::new(problem, &spec.sensor)?)
+    } else {
+        None
+    };
+    // What the controller believes: the file's scene, or the estimate's.
+    let mut scene = problem.clone();
+    let mut forward = ModelPredictor::new(problem, spec.plan.predictor).judged_at(At::Release);
     let (mut planner, first) = plan_from_rest(problem, goal, spec.plan, spec.reach)
         .ok_or_else(|| ControlError::PredictorFailed("from rest".into()))?;
     let plan_converged = first.converged;
@@ -264,9 +370,12 @@ pub fn run_loop(
     let mut t = 0.0;
     let mut predictor_us = Vec::new();
     let mut predictor_cpu_us = Vec::new();
+    let mut estimates = Vec::new();
+    let mut estimator_cpu_us = Vec::new();
     let mut steps = 0;
     let mut gave_up = false;
     let mut stage = 0usize;
+    let mut last_start = Start::of_problem(problem);
     loop {
         if t + remaining > give_up {
             // The plan keeps growing: the plant does not move as predicted.
@@ -284,12 +393,8 @@ pub fn run_loop(
         }
         if remaining <= period * (1.0 + 1e-9) {
             // The last stretch: its time on the plant's grid, re-solved
-            // there, then applied as it stands.
-            let last_start = if steps == 0 {
-                Start::of_problem(problem)
-            } else {
-                start_of(problem, &plant.state())
-            };
+            // there from the last start the controller had, then applied as
+            // it stands.
             let current = planner.solution_of(params.clone());
             let on_grid = planner
                 .on_grid(&last_start, &current, dt)
@@ -306,15 +411,47 @@ pub fn run_loop(
             duration: period,
             ..pushes[0]
         };
-        advance(plant, &push)?;
+        match split {
+            Some(o) => {
+                advance(
+                    plant,
+                    &Push {
+                        duration: o as f64 * dt,
+                        ..push
+                    },
+                )?;
+                sensor.record(plant.state());
+                advance(
+                    plant,
+                    &Push {
+                        duration: (k - o) as f64 * dt,
+                        ..push
+                    },
+                )?;
+            }
+            None => advance(plant, &push)?,
+        }
+        sensor.record(plant.state());
         applied.push(Applied { t0: t, push });
         t += period;
         remaining -= period;
         steps += 1;
-        let st = plant.state();
-        let start = start_of(problem, &st);
+        let st = sensor.read(t);
+        if let Some(e) = estimator.as_mut() {
+            let cpu = thread_cpu_time();
+            e.applied(&push);
+            e.measure(&st)?;
+            let body = e.body()?;
+            planner.predict.set_body(body.clone());
+            forward.set_body(body.clone());
+            scene.body = body;
+            estimator_cpu_us.push((thread_cpu_time() - cpu) * 1e6);
+            estimates.push(e.row());
+        }
         let clock = Instant::now();
         let cpu = thread_cpu_time();
+        let start = start_at(&scene, &mut forward, &st, &applied, t)?;
+        last_start = start;
         // As the time left shrinks, so does the number of pushes: each keeps
         // at least one period (down to one push: then the least-squares
         // pose nearest the goal).
@@ -399,6 +536,11 @@ pub fn run_loop(
         predictor_cpu_us,
         plan_converged,
         replayed: plant.replays(),
+        latency,
+        identified: estimator.as_ref().map(|e| e.identified()),
+        lack_of_fit: estimator.as_ref().map_or(0, |e| e.lack_of_fit()),
+        estimates,
+        estimator_cpu_us,
     })
 }
 

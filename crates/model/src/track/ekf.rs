@@ -174,6 +174,12 @@ impl Ekf {
         (self.s, self.p)
     }
 
+    /// Appends a push applied online (see [`TrackModel::extend`]): samples
+    /// up to the new end of the schedule may follow.
+    pub fn extend(&mut self, v: Vec2, duration: f64) {
+        self.model.extend(v, duration);
+    }
+
     /// Times the parameters were re-opened after a lack of fit.
     pub fn reopened(&self) -> usize {
         self.reopened

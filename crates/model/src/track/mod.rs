@@ -334,6 +334,33 @@ impl TrackModel {
         })
     }
 
+    /// The model with no pushes yet, for pushes decided online: each is
+    /// appended with [`TrackModel::extend`] as it is applied, before any
+    /// sample it acts on is given to an estimator. `problem`'s schedule is
+    /// ignored (its body, start and switching rule are used).
+    pub fn online(problem: &Problem, polygon: &[Vec2]) -> Result<Self, ModelError> {
+        let mut m = Self::new(problem, polygon)?;
+        m.segments.clear();
+        m.end = 0.0;
+        Ok(m)
+    }
+
+    /// Appends a push applied after the last one: pusher velocity `v`
+    /// (object frame, m/s) for `duration` s. A push with the velocity of the
+    /// one before it continues that one (no switch).
+    pub fn extend(&mut self, v: Vec2, duration: f64) {
+        if !(duration > 0.0) {
+            return;
+        }
+        if self.segments.last().is_none_or(|s| s.v != v) {
+            self.segments.push(Segment {
+                t_start: self.end,
+                v,
+            });
+        }
+        self.end += duration;
+    }
+
     /// The problem's own parameter values `[1, c0_x, c0_y, I_cm]`.
     pub fn nominal(&self) -> [f64; 4] {
         [1.0, self.c0.x, self.c0.y, self.inertia0]
