@@ -357,9 +357,16 @@ enum Command {
     /// goals x speeds x engines x plan predictor x open loop or MPC x
     /// nominal or perturbed plant; writes results/closed_loop/.
     ControlStudy {
-        /// Output folder (created if missing).
-        #[arg(long, default_value = "results/closed_loop")]
-        out: PathBuf,
+        /// Output folder (created if missing) [default: results/closed_loop,
+        /// with --adaptive results/closed_loop/adaptive].
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// The adaptive study: plants that move or split the friction,
+        /// driven open loop, by MPC, by adaptive MPC and by the oracle
+        /// (MPC on the plant's true scene), exact and noisy sensors, judged
+        /// at the release and at rest, 0.5 and 1 m/s.
+        #[arg(long)]
+        adaptive: bool,
         /// A few goals, one speed (for CI).
         #[arg(long)]
         quick: bool,
@@ -794,11 +801,20 @@ fn main() -> ExitCode {
         ),
         Some(Command::ControlStudy {
             out,
+            adaptive,
             quick,
             shard,
             merge,
             only,
-        }) => pushval::control::study::cli(&out, quick, shard, merge, only.as_deref()),
+        }) => {
+            if adaptive {
+                let out = out.unwrap_or_else(|| PathBuf::from("results/closed_loop/adaptive"));
+                pushval::control::adaptive::cli(&out, quick, shard, merge, only.as_deref())
+            } else {
+                let out = out.unwrap_or_else(|| PathBuf::from("results/closed_loop"));
+                pushval::control::study::cli(&out, quick, shard, merge, only.as_deref())
+            }
+        }
         Some(Command::Manifest { check, root }) => pushval::manifest::cli(&root, check),
         Some(Command::Init { force }) => pushval::init::cli(Path::new("."), force),
         Some(Command::Shipped { out, force }) => {

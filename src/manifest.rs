@@ -132,6 +132,15 @@ pub const RULES: &[Rule] = &[
         ],
     },
     Rule {
+        command: "pushval control-study --adaptive",
+        source: "src/control/adaptive.rs",
+        files: &[
+            "results/closed_loop/adaptive/success.csv",
+            "results/closed_loop/adaptive/runs.csv",
+            "results/closed_loop/adaptive/README.md",
+        ],
+    },
+    Rule {
         command: "cargo bench --bench control",
         source: "benches/control.rs",
         files: &["results/control_cost.csv"],

@@ -727,9 +727,14 @@ pub fn run(
         );
     }
     println!(
-        "wrote {}, {} and {}",
+        "wrote {}, {}{} and {}",
         c.out.join("trajectory.csv").display(),
         c.out.join("loop.json").display(),
+        if adapt {
+            format!(", {}", c.out.join("estimate.csv").display())
+        } else {
+            String::new()
+        },
         c.out.join("applied.toml").display()
     );
     Ok(if out.success {

@@ -4,6 +4,7 @@
 //! Here: the command-line words (parsing `--goal`, `--tolerance`, `--plant`,
 //! `--predictor`), the output folders and the study across engines.
 
+pub mod adaptive;
 pub mod cli;
 pub mod figures;
 pub mod study;

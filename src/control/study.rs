@@ -116,7 +116,7 @@ impl Task {
 const ROW: usize = 9;
 
 /// Whether `e` is an engine's refusal to release the plate.
-fn cannot_release(e: &anyhow::Error) -> bool {
+pub(crate) fn cannot_release(e: &anyhow::Error) -> bool {
     e.chain().any(|c| {
         matches!(
             c.downcast_ref::<pushval_model::ModelError>(),
@@ -682,7 +682,7 @@ fn write_outputs(
 
 /// The law's steady ω against Coulomb's for the scene's middle push at
 /// `speed`: (law name, law ω, Coulomb ω, class).
-fn law_line(problem: &Problem, engine: &dyn Engine, speed: f64) -> Option<String> {
+pub(crate) fn law_line(problem: &Problem, engine: &dyn Engine, speed: f64) -> Option<String> {
     let law = engine.law()?;
     let mut p = problem.clone();
     p.pushes = vec![Push {
