@@ -232,6 +232,22 @@ pub fn tasks(engines: &[String], speeds: &[f64], goals: usize) -> Vec<Task> {
 /// rest (1) or at the release (0: the engine cannot release), wall time (s).
 const ROW: usize = 8;
 
+/// Column `error` of a run whose plant the engine's scene cannot hold
+/// (refused when its session started): not applicable, not a failure.
+const UNSUPPORTED: f64 = 2.0;
+
+/// The engine refused the plant's scene at the start.
+#[derive(Debug)]
+struct Unsupported(String);
+
+impl std::fmt::Display for Unsupported {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the engine cannot hold this plant's scene: {}", self.0)
+    }
+}
+
+impl std::error::Error for Unsupported {}
+
 type Plans = BTreeMap<(u64, usize, At), Solution>;
 
 fn run_task(
@@ -253,7 +269,15 @@ fn run_task(
             at,
         };
         let plant = t.plant.apply(problem)?;
-        let mut session = engine.start(&plant, dt)?;
+        let mut session = match engine.start(&plant, dt) {
+            Ok(s) => s,
+            // An engine whose scene cannot hold this plate (one friction
+            // coefficient per body, say): not a run of this engine.
+            Err(e) if t.plant != PlantKind::Nominal => {
+                return Err(anyhow::Error::new(Unsupported(e.to_string())))
+            }
+            Err(e) => return Err(e.into()),
+        };
         let max_slide = problem.release.unwrap_or_default().max_duration;
         let row = match t.mode {
             Mode::Open => {
@@ -346,7 +370,11 @@ fn run_task(
         r => finish(r, t.at),
     };
     let mut row = result.unwrap_or_else(|e| {
-        eprintln!("control-study --adaptive: {}: {e:#}", t.key());
+        let unsupported = e.downcast_ref::<Unsupported>().is_some();
+        if !unsupported || t.goal == 0 {
+            eprintln!("control-study --adaptive: {}: {e:#}", t.key());
+        }
+        let flag = if unsupported { UNSUPPORTED } else { 1.0 };
         vec![
             0.0,
             f64::NAN,
@@ -354,7 +382,7 @@ fn run_task(
             f64::NAN,
             f64::NAN,
             f64::NAN,
-            1.0,
+            flag,
             f64::NAN,
         ]
     });
@@ -546,17 +574,19 @@ fn write_outputs(
             },
             num(r[8]),
         ]);
-        groups
-            .entry((
-                t.engine.clone(),
-                t.speed.to_bits(),
-                t.at,
-                t.mode,
-                t.plant,
-                t.noise,
-            ))
-            .or_default()
-            .push(r);
+        if r[6] != UNSUPPORTED {
+            groups
+                .entry((
+                    t.engine.clone(),
+                    t.speed.to_bits(),
+                    t.at,
+                    t.mode,
+                    t.plant,
+                    t.noise,
+                ))
+                .or_default()
+                .push(r);
+        }
     }
     dir.file("runs.csv", runs.as_bytes())?;
     let mut success = Csv::new(&[
@@ -603,11 +633,27 @@ fn write_outputs(
         .filter(|(t, r)| t.mode == Mode::Adaptive && r[3].is_finite())
         .map(|(_, r)| (r[3], r[4], r[5]))
         .collect();
-    let readme = readme(problem, names, speeds, &counts, &cost, rows, quick);
+    let unsupported: std::collections::BTreeSet<(String, PlantKind)> = list
+        .iter()
+        .zip(rows)
+        .filter(|(_, r)| r[6] == UNSUPPORTED)
+        .map(|(t, _)| (t.engine.clone(), t.plant))
+        .collect();
+    let readme = readme(
+        problem,
+        names,
+        speeds,
+        &counts,
+        &cost,
+        rows,
+        &unsupported,
+        quick,
+    );
     dir.file("README.md", readme.as_bytes())?;
     Ok(())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn readme(
     problem: &Problem,
     names: &[String],
@@ -615,6 +661,7 @@ fn readme(
     counts: &BTreeMap<Group, (usize, usize)>,
     cost: &[(f64, f64, f64)],
     rows: &[Vec<f64>],
+    unsupported: &std::collections::BTreeSet<(String, PlantKind)>,
     quick: bool,
 ) -> String {
     let get = |n: &str, v: f64, at: At, m: Mode, p: PlantKind, noise: bool| {
@@ -653,6 +700,17 @@ fn readme(
     }
     for n in names {
         s.push_str(&format!("## {n}\n\n"));
+        let refused: Vec<&str> = PlantKind::ALL
+            .into_iter()
+            .filter(|p| unsupported.contains(&(n.clone(), *p)))
+            .map(PlantKind::as_str)
+            .collect();
+        if !refused.is_empty() {
+            s.push_str(&format!(
+                "Its scene cannot hold the plants {} (its session refused them at the start; the study prints why): they are left out of its table (n/a).\n\n",
+                refused.join(", ")
+            ));
+        }
         if let Some(l) = crate::registry::entry(n)
             .and_then(|e| law_line(problem, e.default_engine().as_ref(), 1.0))
         {
@@ -668,6 +726,7 @@ fn readme(
                     let cell = |m: Mode| {
                         let c = |noise| match get(n, v, at, m, p, noise) {
                             Some((ok, tot)) => format!("{ok}/{tot}"),
+                            None if unsupported.contains(&(n.clone(), p)) => "n/a".into(),
                             None => "–".into(),
                         };
                         if m == Mode::Open {
@@ -695,7 +754,11 @@ fn readme(
             let gap = |at, noise| {
                 PlantKind::ALL
                     .into_iter()
-                    .filter(|p| p.moves_friction())
+                    .filter(|p| {
+                        p.moves_friction()
+                            && get(n, v, at, Mode::Adaptive, *p, noise).is_some()
+                            && get(n, v, at, Mode::Oracle, *p, noise).is_some()
+                    })
                     .map(|p| {
                         (
                             p,
