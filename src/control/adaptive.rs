@@ -567,10 +567,12 @@ fn write_outputs(
             num(r[4]),
             num(r[5]),
             num(r[6]),
-            match r[7] {
-                x if x == 1.0 => "rest".to_string(),
-                x if x == 0.0 => "release".to_string(),
-                _ => String::new(),
+            if r[7] == 1.0 {
+                "rest".to_string()
+            } else if r[7] == 0.0 {
+                "release".to_string()
+            } else {
+                String::new()
             },
             num(r[8]),
         ]);

@@ -290,3 +290,50 @@ fn loop_adapt_writes_estimate_csv_and_refuses_a_plant_of_another_outline() {
     let sc = pushval::registry::load(out.join("applied.toml")).unwrap();
     assert!((sc.supports[1].mu - 0.1).abs() < 1e-12);
 }
+
+#[test]
+fn the_quick_adaptive_study_runs_every_mode_plant_and_sensor_and_says_what_it_cannot_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("adaptive");
+    let o = pushval()
+        .args([
+            "control-study",
+            "--adaptive",
+            "--quick",
+            "--only",
+            "rapier2d,rapier3d",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let runs = std::fs::read_to_string(out.join("runs.csv")).unwrap();
+    // Per engine, goal and rule: open on 6 plants (exact only), MPC and
+    // adaptive on 6 plants × 2 sensors, the oracle on the 5 plants that
+    // differ × 2: 40 runs; 3 goals × 2 rules × 2 engines.
+    assert_eq!(runs.lines().count() - 1, 40 * 3 * 2 * 2);
+    for mode in ["open", "mpc", "adaptive", "oracle"] {
+        assert!(runs.contains(&format!(",{mode},")), "{mode}");
+    }
+    assert!(!runs.contains(",oracle,nominal,"));
+    let readme = std::fs::read_to_string(out.join("README.md")).unwrap();
+    // rapier3d's compound feet carry one coefficient: the plants that move
+    // or split the friction are not applicable there, and said to be.
+    let r3 = &readme[readme.find("## rapier3d").unwrap()..];
+    assert!(r3.contains("cannot hold the plants loads_side"), "{r3}");
+    assert!(r3.contains("| slippery_near | n/a |"), "{r3}");
+    // rapier2d applies Coulomb friction per support: adaptive MPC reaches
+    // the slippery foot off the line at the release, exact sensor.
+    let success = std::fs::read_to_string(out.join("success.csv")).unwrap();
+    let row = success
+        .lines()
+        .find(|l| l.starts_with("rapier2d,1,release,adaptive,slippery_near,exact,"))
+        .unwrap();
+    assert!(row.contains(",3,3,"), "{row}");
+}
