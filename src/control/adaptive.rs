@@ -769,13 +769,23 @@ fn readme(
                     })
                     .min_by_key(|x| x.1)
             };
+            // How far adaptive MPC falls short of the oracle (0: nowhere).
+            let short = |g: i64, p: PlantKind| {
+                if g >= 0 {
+                    "it reaches at least as many goals as the oracle on each".to_string()
+                } else {
+                    format!(
+                        "it falls at most {} goals short of the oracle (`{}`)",
+                        -g,
+                        p.as_str()
+                    )
+                }
+            };
             if let Some((p, g)) = gap(At::Release, false) {
                 lines.push(format!(
-                    "at {v} m/s, judged at the release, adaptive MPC is {} the oracle on every plant that moves or splits the friction (largest gap {} goals, `{}`){}",
-                    if g >= -2 { "within 2 goals of" } else { "more than 2 goals behind" },
-                    -g,
-                    p.as_str(),
-                    if g >= -2 { "" } else { ": the target is missed here" }
+                    "{v} m/s, judged at the release, plants that move or split the friction: {}; the target (within 2) is {}",
+                    short(g, p),
+                    if g >= -2 { "met" } else { "missed" }
                 ));
             }
             let (a, m) = (
@@ -783,7 +793,7 @@ fn readme(
                 ok(At::Release, Mode::Mpc, PlantKind::Nominal, false),
             );
             lines.push(format!(
-                "on the nominal plate at the release it reaches {a} where plain MPC reaches {m}{}",
+                "{v} m/s, the nominal plate at the release: adaptive MPC reaches {a}, plain MPC {m}{}",
                 if a >= m {
                     ""
                 } else {
@@ -796,22 +806,24 @@ fn readme(
                 ok(At::Rest, Mode::Oracle, PlantKind::Perturbed, false),
             );
             lines.push(format!(
-                "at rest on the uniform change it reaches {a} against plain MPC's {m} and the oracle's {o}"
+                "{v} m/s, the uniform change judged at rest: adaptive MPC reaches {a}, plain MPC {m}, the oracle {o}"
             ));
             if let Some((p, g)) = gap(At::Release, true) {
                 lines.push(format!(
-                    "with the noisy sensor at the release it is {} the oracle (largest gap {} goals, `{}`)",
-                    if g >= -4 { "within 4 goals of" } else { "more than 4 goals behind" },
-                    -g,
-                    p.as_str()
+                    "{v} m/s, noisy sensor, at the release: {}; the target (within 4) is {}",
+                    short(g, p),
+                    if g >= -4 { "met" } else { "missed" }
                 ));
             }
             if let Some((p, g)) = gap(At::Rest, false) {
-                lines.push(format!(
-                    "at rest its largest gap to the oracle is {} goals (`{}`): what it cannot see before it lets go is how the friction is split among the supports beyond its total, centre and moment, which the slide depends on",
-                    -g,
-                    p.as_str()
-                ));
+                lines.push(if g >= -2 {
+                    format!("{v} m/s, judged at rest, plants that move or split the friction: {}", short(g, p))
+                } else {
+                    format!(
+                        "{v} m/s, judged at rest, plants that move or split the friction: {}; the estimate explains the pushed motion but not how the friction is split among the supports beyond its total, centre and moment, and the slide after the release depends on that split",
+                        short(g, p)
+                    )
+                });
             }
         }
         for &v in speeds {

@@ -336,4 +336,14 @@ fn the_quick_adaptive_study_runs_every_mode_plant_and_sensor_and_says_what_it_ca
         .find(|l| l.starts_with("rapier2d,1,release,adaptive,slippery_near,exact,"))
         .unwrap();
     assert!(row.contains(",3,3,"), "{row}");
+    // Judged at rest the support under the contact matters: no pushed
+    // motion reveals it, and the scene keeps the file's value there (the
+    // true one on this plate), so adaptive MPC reaches the rest poses plain
+    // MPC misses.
+    let count = |key: &str| {
+        let l = success.lines().find(|l| l.starts_with(key)).unwrap();
+        l.split(',').nth(6).unwrap().parse::<usize>().unwrap()
+    };
+    assert_eq!(count("rapier2d,1,rest,adaptive,slippery_near,exact,"), 3);
+    assert_eq!(count("rapier2d,1,rest,mpc,slippery_near,exact,"), 0);
 }
