@@ -5,7 +5,7 @@ use pushval_model::{ModelError, Problem, Push};
 
 use super::slide::SlideOut;
 use super::{
-    PlateStep, PlateWorld, StepClock, StepLayout, StepLoop, StepPlan, Stepped, TailSteps,
+    Plate, PlateStep, PlateWorld, StepClock, StepLayout, StepLoop, StepPlan, Stepped, TailSteps,
     TailWeight, TAIL,
 };
 use crate::contact::LoadRecorder;
@@ -199,19 +199,7 @@ impl<W: PlateWorld> Stepping<W> {
             if k > 0 || j > 0 {
                 self.out.max_joint_drift = self.out.max_joint_drift.max(drift);
             }
-            self.world.step(h, t1)?;
-            self.out.steps += 1;
-            self.state = self.world.state(&self.state);
-            if !self.world.finite(&self.state) {
-                return Err(ModelError::NonFinite {
-                    t: t1,
-                    step: self.out.steps,
-                });
-            }
-            self.world.after_step(&self.state);
-            let p = self.world.plate(&self.state);
-            self.out.max_tilt = self.out.max_tilt.max(p.tilt);
-            self.out.max_lift = self.out.max_lift.max((p.z - cfg.z_rest).abs());
+            let p = self.step(h, t1)?;
             let in_tail = match cfg.tail {
                 TailSteps::ByTime => 0.5 * (t0 + t1) >= tail_time,
                 _ => k >= tail_from,
@@ -269,6 +257,26 @@ impl<W: PlateWorld> Stepping<W> {
         self.t_seg += push.duration;
         self.applied.push(*push);
         self.world.end_segment(acc_t, self.t_seg)
+    }
+
+    /// One engine step of length `h` (s) ending at `t1`, of a push or of
+    /// the slide: the step, the state read and checked, the largest tilt
+    /// and lift; the object after it.
+    pub(super) fn step(&mut self, h: f64, t1: f64) -> Result<Plate, ModelError> {
+        self.world.step(h, t1)?;
+        self.out.steps += 1;
+        self.state = self.world.state(&self.state);
+        if !self.world.finite(&self.state) {
+            return Err(ModelError::NonFinite {
+                t: t1,
+                step: self.out.steps,
+            });
+        }
+        self.world.after_step(&self.state);
+        let p = self.world.plate(&self.state);
+        self.out.max_tilt = self.out.max_tilt.max(p.tilt);
+        self.out.max_lift = self.out.max_lift.max((p.z - self.cfg.z_rest).abs());
+        Ok(p)
     }
 
     /// Advances by every push of `pushes` in order, then ends the loop

@@ -82,19 +82,7 @@ impl<W: PlateWorld> Stepping<W> {
             };
             let hk = t1 - t0;
             self.world.slide_step(&self.state, hk);
-            self.world.step(hk, t1)?;
-            self.out.steps += 1;
-            self.state = self.world.state(&self.state);
-            if !self.world.finite(&self.state) {
-                return Err(ModelError::NonFinite {
-                    t: t1,
-                    step: self.out.steps,
-                });
-            }
-            self.world.after_step(&self.state);
-            let p = self.world.plate(&self.state);
-            self.out.max_tilt = self.out.max_tilt.max(p.tilt);
-            self.out.max_lift = self.out.max_lift.max((p.z - self.cfg.z_rest).abs());
+            let p = self.step(hk, t1)?;
             let v_cm = self
                 .world
                 .cm_velocity(&self.state)
