@@ -17,6 +17,7 @@ use pushval::control::plan::{straight_time, PlanSpec, Planner};
 use pushval::control::predict::{Motion, Start};
 use pushval::control::study::{goals, scene};
 use pushval::control::{ModelKind as Predictor, Reach};
+use pushval::outdir::Csv;
 use pushval_engine::EngineState;
 use pushval_model::{DynamicModel, Simulator, Vec2};
 
@@ -207,25 +208,66 @@ fn cost_table() {
         .ok()
         .and_then(|l| l.split_whitespace().next().map(str::to_string))
         .unwrap_or_else(|| "NaN".into());
-    let csv = format!(
-        "quantity,value,unit,target,note\n\
-         plan_solve_median,{pm:.1},us,1000,\"{} plans from rest (20 study goals x 0.1/0.5/1 m/s), 6 pushes, each the median of 5 solves\"\n\
-         plan_solve_p99,{pp:.1},us,,\"same plans\"\n\
-         plan_rest_solve_median,{rm:.1},us,1000,\"the same plans aimed at rest (the slide to rest in every prediction), timed alternately with them\"\n\
-         plan_rest_solve_p99,{rp:.1},us,,\"same plans\"\n\
-         mpc_period_median,{mm:.1},us,100,\"{} re-plans of the dynamic predictor, rapier2d plant with mu x 0.8 and I_cm x 1.2, 20 goals at 1 m/s, period 0.02 s\"\n\
-         mpc_period_p99,{mp:.1},us,1000,\"same periods (a stalled warm start runs one stage of the fallback search: a fresh Jacobian, or one starting guess)\"\n\
-         mpc_period_cpu_median,{cm:.1},us,100,\"the same periods' thread CPU time (what the predictor computes; wall time adds the waits of a shared machine)\"\n\
-         mpc_period_cpu_p99,{cp:.1},us,1000,\"same\"\n\
-         load_average_1min,{load},processes,,\"the machine's 1-minute load average at the end (2 cores)\"\n\
-         mpc_goals_reached,{reached},goals,19,\"of the {} goals of those loops (final position within 20 mm, angle within 5 deg)\"\n",
-        plan_us.len(),
-        period_us.len(),
+    let us = |v: f64| format!("{v:.1}");
+    let mut csv = Csv::new(&["quantity", "value", "unit", "target", "note"]);
+    let mut row = |quantity: &str, value: String, unit: &str, target: &str, note: &str| {
+        csv.row(&[quantity, &value, unit, target, note]);
+    };
+    let plans = format!(
+        "{} plans from rest (20 study goals x 0.1/0.5/1 m/s), 6 pushes, each the median of 5 solves",
+        plan_us.len()
+    );
+    row("plan_solve_median", us(pm), "us", "1000", &plans);
+    row("plan_solve_p99", us(pp), "us", "", "same plans");
+    row(
+        "plan_rest_solve_median",
+        us(rm),
+        "us",
+        "1000",
+        "the same plans aimed at rest (the slide to rest in every prediction), timed alternately with them",
+    );
+    row("plan_rest_solve_p99", us(rp), "us", "", "same plans");
+    let periods = format!(
+        "{} re-plans of the dynamic predictor, rapier2d plant with mu x 0.8 and I_cm x 1.2, 20 goals at 1 m/s, period 0.02 s",
+        period_us.len()
+    );
+    row("mpc_period_median", us(mm), "us", "100", &periods);
+    row(
+        "mpc_period_p99",
+        us(mp),
+        "us",
+        "1000",
+        "same periods (a stalled warm start runs one stage of the fallback search: a fresh Jacobian, or one starting guess)",
+    );
+    row(
+        "mpc_period_cpu_median",
+        us(cm),
+        "us",
+        "100",
+        "the same periods' thread CPU time (what the predictor computes; wall time adds the waits of a shared machine)",
+    );
+    row("mpc_period_cpu_p99", us(cp), "us", "1000", "same");
+    row(
+        "load_average_1min",
+        load,
+        "processes",
+        "",
+        "the machine's 1-minute load average at the end (2 cores)",
+    );
+    let reached_note = format!(
+        "of the {} goals of those loops (final position within 20 mm, angle within 5 deg)",
         goals.len()
+    );
+    row(
+        "mpc_goals_reached",
+        reached.to_string(),
+        "goals",
+        "19",
+        &reached_note,
     );
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results/control_cost.csv");
     pushval::atomic::write_atomic(&path, csv.as_bytes()).unwrap();
-    eprint!("{csv}");
+    eprint!("{}", csv.text());
 }
 
 criterion_group!(benches, control);

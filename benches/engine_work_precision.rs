@@ -39,6 +39,7 @@
 use std::time::Duration;
 
 use pushval::harness::{analyse_segments, rel_err, tail_omega};
+use pushval::outdir::{records, Csv};
 use pushval::registry;
 use pushval_model::{DynamicModel, Simulator};
 
@@ -89,31 +90,29 @@ struct Row {
     clock: String,
 }
 
-/// The rows of a written `engine_work_precision.csv` (for `--replot`).
+/// The rows of a written `engine_work_precision.csv` (for `--replot` and
+/// `--merge`); a row without a number it needs is left out.
 fn read_rows(text: &str) -> Vec<Row> {
-    text.lines()
-        .skip(1)
-        .filter_map(|line| {
-            // The version is quoted and may hold commas: split around it.
-            let (engine, rest) = line.split_once(",\"")?;
-            let (version, rest) = rest.split_once("\",")?;
-            let f: Vec<&str> = rest.split(',').collect();
+    let recs = records(text).expect("engine_work_precision.csv is CSV");
+    recs.iter()
+        .filter_map(|r| {
+            let f = |k: &str| r.get(k).map(String::as_str);
+            let engine = f("engine")?;
             Some(Row {
                 engine: engine.to_string(),
-                version: version.to_string(),
-                dt: f.first()?.parse().ok()?,
-                cpu_per_sim_s: f.get(1)?.parse().ok()?,
-                omega_rel: f.get(2)?.parse().ok()?,
-                position: f.get(3)?.parse().ok()?,
-                steps: f.get(4)?.parse().ok()?,
+                version: f("version")?.to_string(),
+                dt: f("dt_s")?.parse().ok()?,
+                cpu_per_sim_s: f("cpu_s_per_simulated_s")?.parse().ok()?,
+                omega_rel: f("omega_steady_rel_err")?.parse().ok()?,
+                position: f("position_err_m")?.parse().ok()?,
+                steps: f("steps")?.parse().ok()?,
                 // Columns added with the `[body]` rows; rows written before
                 // them come from run 1, by engines without a
                 // `friction_velocity` option (theirs is the default mode).
-                kinematics: f
-                    .get(5)
-                    .map_or_else(|| default_kinematics(engine), |k| k.to_string()),
-                run: f.get(6).and_then(|r| r.parse().ok()).unwrap_or(1),
-                clock: f.get(7).map_or("thread_cpu".into(), |c| c.to_string()),
+                kinematics: f("kinematics")
+                    .map_or_else(|| default_kinematics(engine), str::to_string),
+                run: f("run").and_then(|r| r.parse().ok()).unwrap_or(1),
+                clock: f("clock").unwrap_or("thread_cpu").to_string(),
             })
         })
         .collect()
@@ -318,23 +317,31 @@ fn main() {
         return;
     }
     let rows = if merge { merged(old_rows, rows) } else { rows };
-    let mut csv = String::from(
-        "engine,version,dt_s,cpu_s_per_simulated_s,omega_steady_rel_err,position_err_m,steps,kinematics,run,clock\n",
-    );
+    let mut csv = Csv::new(&[
+        "engine",
+        "version",
+        "dt_s",
+        "cpu_s_per_simulated_s",
+        "omega_steady_rel_err",
+        "position_err_m",
+        "steps",
+        "kinematics",
+        "run",
+        "clock",
+    ]);
     for r in &rows {
-        csv.push_str(&format!(
-            "{},\"{}\",{:.6e},{:.4e},{:.4e},{:.4e},{},{},{},{}\n",
-            r.engine,
-            r.version,
-            r.dt,
-            r.cpu_per_sim_s,
-            r.omega_rel,
-            r.position,
-            r.steps,
-            r.kinematics,
-            r.run,
-            r.clock
-        ));
+        csv.row(&[
+            r.engine.clone(),
+            r.version.clone(),
+            format!("{:.6e}", r.dt),
+            format!("{:.4e}", r.cpu_per_sim_s),
+            format!("{:.4e}", r.omega_rel),
+            format!("{:.4e}", r.position),
+            r.steps.to_string(),
+            r.kinematics.clone(),
+            r.run.to_string(),
+            r.clock.clone(),
+        ]);
     }
     let mut names: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();
     names.dedup();
@@ -342,9 +349,15 @@ fn main() {
         .iter()
         .filter(|r| r.omega_rel <= TARGET)
         .min_by(|a, b| a.cpu_per_sim_s.total_cmp(&b.cpu_per_sim_s));
-    let mut summary = String::from(
-        "engine,kinematics,run,cheapest_dt_at_1e-3_s,cheapest_cpu_s_per_simulated_s_at_1e-3,cpu_ratio_to_cheapest,cost_exponent_b\n",
-    );
+    let mut table = Csv::new(&[
+        "engine",
+        "kinematics",
+        "run",
+        "cheapest_dt_at_1e-3_s",
+        "cheapest_cpu_s_per_simulated_s_at_1e-3",
+        "cpu_ratio_to_cheapest",
+        "cost_exponent_b",
+    ]);
     for name in &names {
         let mine: Vec<&Row> = rows.iter().filter(|r| r.engine == *name).collect();
         let best = mine
@@ -364,18 +377,20 @@ fn main() {
         let b = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
             / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
         let first = mine[0];
-        summary.push_str(&format!(
-            "{name},{},{},{},{},{},{b:.3}\n",
-            first.kinematics,
-            first.run,
+        table.row(&[
+            name.to_string(),
+            first.kinematics.clone(),
+            first.run.to_string(),
             best.map_or("".into(), |r| format!("{:.6e}", r.dt)),
             best.map_or("".into(), |r| format!("{:.4e}", r.cpu_per_sim_s)),
-            best.zip(cheapest).map_or("".into(), |(r, c)| format!(
-                "{:.1}",
-                r.cpu_per_sim_s / c.cpu_per_sim_s
-            )),
-        ));
+            best.zip(cheapest).map_or("".into(), |(r, c)| {
+                format!("{:.1}", r.cpu_per_sim_s / c.cpu_per_sim_s)
+            }),
+            format!("{b:.3}"),
+        ]);
     }
+    // The rows, then `#` comment lines: what the columns mean, the runs.
+    let mut summary = table.text().to_string();
     summary.push_str(
         "# kinematics: model = the engine reads the model's contact kinematics (support velocities from the commanded \
          contact velocity plus omega x (p_i - p_c), pusher re-pinned onto the contact point), engine = its own body velocities\n",

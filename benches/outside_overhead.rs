@@ -794,15 +794,13 @@ fn main() {
         ));
     }
 
-    let mut csv_text = String::from("quantity,median,min,unit,note\n");
+    let mut table = pushval::outdir::Csv::new(&["quantity", "median", "min", "unit", "note"]);
     for (name, med, min, unit, note) in &rows {
-        csv_text.push_str(&format!(
-            "{name},{med:.6},{min:.6},{unit},\"{}\"\n",
-            note.replace('"', "'")
-        ));
+        let (med, min) = (format!("{med:.6}"), format!("{min:.6}"));
+        table.row(&[name.as_str(), &med, &min, unit, note]);
     }
     let path = root().join("results/outside_overhead.csv");
-    pushval::atomic::write_atomic(&path, csv_text.as_bytes()).unwrap();
+    pushval::atomic::write_atomic(&path, table.as_bytes()).unwrap();
     eprintln!("wrote {}", path.display());
 
     // The in-process parts under criterion (its own statistics and report).

@@ -11,6 +11,7 @@
 use std::hint::black_box;
 use std::time::Duration;
 
+use pushval::outdir::{field_num, records, Csv};
 use pushval_model::{
     Body, DynamicModel, Integrator, KinematicModel, LimitSurfaceModel, Problem, Push,
     SegmentDynamics, Simulator, Support, Vec2,
@@ -148,34 +149,30 @@ fn main() {
     // 4. Uniform pressure: the cheapest discretisation for an error in ω*,
     // from `cargo bench --bench support_discretisation`.
     if let Ok(text) = std::fs::read_to_string(root.join("results/support_discretisation.csv")) {
-        let recs: Vec<Vec<String>> = text
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(str::to_string).collect())
-            .collect();
+        let recs = records(&text).expect("support_discretisation.csv is CSV");
         for target in [1e-3, 1e-6] {
             let cheapest = |rule: &str| {
                 recs.iter()
                     .filter(|r| {
-                        r[0] == rule
-                            && r[3].parse::<f64>().unwrap() == 1.0
-                            && r[5].parse::<f64>().unwrap() <= target
+                        r["rule"] == rule
+                            && field_num(r, "speed") == 1.0
+                            && field_num(r, "rel_err") <= target
                     })
-                    .min_by_key(|r| r[2].parse::<usize>().unwrap())
+                    .min_by_key(|r| r["supports"].parse::<usize>().unwrap())
                     .cloned()
             };
             if let (Some(g), Some(q)) = (cheapest("grid"), cheapest("gauss_legendre")) {
                 rows.push(Row {
                     skip: "support_discretisation",
                     scene: "uniform-pressure square, 1 m/s".into(),
-                    without: format!("uniform grid, {} supports", g[2]),
-                    without_s: g[6].parse().unwrap(),
-                    with: format!("Gauss-Legendre, {} supports", q[2]),
-                    with_s: q[6].parse().unwrap(),
+                    without: format!("uniform grid, {} supports", g["supports"]),
+                    without_s: field_num(&g, "steady_time_s"),
+                    with: format!("Gauss-Legendre, {} supports", q["supports"]),
+                    with_s: field_num(&q, "steady_time_s"),
                     note: format!(
                         "cheapest of each rule with steady-omega error <= {target:e} \
                          (support_discretisation.csv: grid {}, Gauss {})",
-                        g[5], q[5]
+                        g["rel_err"], q["rel_err"]
                     ),
                 });
             }
@@ -223,25 +220,32 @@ fn main() {
         });
     }
 
-    let mut csv = String::from("skip,scene,without,without_s,with,with_s,ratio,note\n");
+    let mut csv = Csv::new(&[
+        "skip",
+        "scene",
+        "without",
+        "without_s",
+        "with",
+        "with_s",
+        "ratio",
+        "note",
+    ]);
     for r in &rows {
-        let q = |s: &str| format!("\"{}\"", s.replace('"', "'"));
-        csv.push_str(&format!(
-            "{},{},{},{:.4e},{},{:.4e},{:.2},{}\n",
-            r.skip,
-            q(&r.scene),
-            q(&r.without),
-            r.without_s,
-            q(&r.with),
-            r.with_s,
-            r.without_s / r.with_s,
-            q(&r.note)
-        ));
+        csv.row(&[
+            r.skip.to_string(),
+            r.scene.clone(),
+            r.without.clone(),
+            format!("{:.4e}", r.without_s),
+            r.with.clone(),
+            format!("{:.4e}", r.with_s),
+            format!("{:.2}", r.without_s / r.with_s),
+            r.note.clone(),
+        ]);
     }
     let dir = root.join("results");
     std::fs::create_dir_all(&dir).unwrap();
     pushval::atomic::write_atomic(&dir.join("skips.csv"), csv.as_bytes()).unwrap();
-    print!("{csv}");
+    print!("{}", csv.text());
 }
 
 /// One half of a support set that is mirror-symmetric about the x axis of the

@@ -15,6 +15,7 @@ use std::num::NonZeroUsize;
 use std::time::Instant;
 
 use gauss_quad::GaussLegendre;
+use pushval::outdir::Csv;
 use pushval_model::{Body, Push, SegmentDynamics, Support, Vec2};
 
 const HALF: f64 = 0.125;
@@ -76,7 +77,15 @@ fn omega(b: &Body, v: f64) -> f64 {
 }
 
 fn main() {
-    let mut csv = String::from("rule,per_axis,supports,speed,omega_steady,rel_err,steady_time_s\n");
+    let mut csv = Csv::new(&[
+        "rule",
+        "per_axis",
+        "supports",
+        "speed",
+        "omega_steady",
+        "rel_err",
+        "steady_time_s",
+    ]);
     for v in [0.2, 1.0] {
         let reference = omega(&gauss(64), v);
         let mut run = |name: &str, n: usize, b: Body| {
@@ -87,11 +96,16 @@ fn main() {
                 w = omega(&b, v);
             }
             let t = t0.elapsed().as_secs_f64() / reps as f64;
-            csv.push_str(&format!(
-                "{name},{n},{},{v},{w:.15e},{:.3e},{t:.3e}\n",
-                b.len(),
-                ((w - reference) / reference).abs()
-            ));
+            let err = ((w - reference) / reference).abs();
+            csv.row(&[
+                name.to_string(),
+                n.to_string(),
+                b.len().to_string(),
+                v.to_string(),
+                format!("{w:.15e}"),
+                format!("{err:.3e}"),
+                format!("{t:.3e}"),
+            ]);
         };
         for n in [2, 4, 8, 16, 32, 64, 128] {
             run("grid", n, grid(n));
@@ -103,5 +117,5 @@ fn main() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
     std::fs::create_dir_all(&dir).unwrap();
     pushval::atomic::write_atomic(&dir.join("support_discretisation.csv"), csv.as_bytes()).unwrap();
-    print!("{csv}");
+    print!("{}", csv.text());
 }

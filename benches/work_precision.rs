@@ -25,6 +25,7 @@ use std::time::Duration;
 
 use ode_solvers::{Dop853, Dopri5, OutputType, System, Vector4};
 use pushval::harness::{analyse_segments, rel_err, tail_omega, SegmentInfo};
+use pushval::outdir::{csv_line, Csv};
 use pushval_model::{
     DynamicModel, Integrator, Problem, Rotor, SegmentDynamics, Simulator, Switching, Trajectory,
     Vec2,
@@ -405,21 +406,26 @@ fn main() {
         }
     }
     eprintln!();
-    let mut csv = String::from(
-        "method,family,setting,rhs_evals,median_s,position_err_m,omega_steady_rel_err\n",
-    );
+    let mut csv = Csv::new(&[
+        "method",
+        "family",
+        "setting",
+        "rhs_evals",
+        "median_s",
+        "position_err_m",
+        "omega_steady_rel_err",
+    ]);
     for r in &rows {
-        csv.push_str(&format!(
-            "{},{},{},{},{:.6e},{:.3e},{}\n",
-            r.method,
-            r.family,
-            r.setting,
+        csv.row(&[
+            r.method.clone(),
+            r.family.clone(),
+            r.setting.clone(),
             r.rhs_evals.map_or(String::new(), |n| n.to_string()),
-            r.median_s,
-            r.position_err,
+            format!("{:.6e}", r.median_s),
+            format!("{:.3e}", r.position_err),
             r.omega_rel_err
-                .map_or(String::new(), |e| format!("{e:.3e}"))
-        ));
+                .map_or(String::new(), |e| format!("{e:.3e}")),
+        ]);
     }
     let dir = root.join("results");
     std::fs::create_dir_all(&dir).unwrap();
@@ -428,7 +434,7 @@ fn main() {
     pushval::atomic::write_atomic(&dir.join("work_precision.csv"), csv.as_bytes()).unwrap();
     pushval::atomic::write_atomic(&dir.join("work_precision.svg"), figure(&rows).as_bytes())
         .unwrap();
-    print!("{csv}");
+    print!("{}", csv.text());
 }
 
 /// Maximum position error the speed target is set at (m).
@@ -478,12 +484,32 @@ fn target_comparison(
     ta.sort();
     tb.sort();
     let (ma, mb) = (ta[runs / 2].as_secs_f64(), tb[runs / 2].as_secs_f64());
-    let mut out =
-        String::from("target_position_err_m,method,tol,rhs_evals,position_err_m,median_s\n");
+    // Records with `#` comment lines between them: written a line at a time.
+    let line = |name: &str, tol: f64, n: usize, pe: f64, m: f64| {
+        let (tol, pe, m) = (
+            format!("{tol:.3e}"),
+            format!("{pe:.3e}"),
+            format!("{m:.6e}"),
+        );
+        csv_line(&[
+            &format!("{TARGET_ERR:e}"),
+            name,
+            &tol,
+            &n.to_string(),
+            &pe,
+            &m,
+        ])
+    };
+    let mut out = csv_line(&[
+        "target_position_err_m",
+        "method",
+        "tol",
+        "rhs_evals",
+        "position_err_m",
+        "median_s",
+    ]);
     for (name, (tol, n, pe), m) in [("pushval DOP853", a, ma), ("ode_solvers Dop853", b, mb)] {
-        out.push_str(&format!(
-            "{TARGET_ERR:e},{name},{tol:.3e},{n},{pe:.3e},{m:.6e}\n"
-        ));
+        out.push_str(&line(name, tol, n, pe, m));
     }
     out.push_str(&format!("# speed-up at the target: {:.2}x\n", mb / ma));
     // Asked for the final state alone, as a predictor asks, at the same
@@ -511,14 +537,9 @@ fn target_comparison(
     ta.sort();
     tb.sort();
     let (fma, fmb) = (ta[runs / 2].as_secs_f64(), tb[runs / 2].as_secs_f64());
-    out.push_str(&format!(
-        "{TARGET_ERR:e},pushval DOP853 final state,{:.3e},{},{ea:.3e},{fma:.6e}\n",
-        a.0, fa.stats.rhs_evals
-    ));
-    out.push_str(&format!(
-        "{TARGET_ERR:e},ode_solvers Dop853 final state,{:.3e},{nb},{eb:.3e},{fmb:.6e}\n",
-        b.0
-    ));
+    let na = fa.stats.rhs_evals;
+    out.push_str(&line("pushval DOP853 final state", a.0, na, ea, fma));
+    out.push_str(&line("ode_solvers Dop853 final state", b.0, nb, eb, fmb));
     out.push_str(&format!(
         "# speed-up at the target, final state only (the same tolerances, no samples, the peer without dense output): {:.2}x\n",
         fmb / fma

@@ -97,6 +97,16 @@ impl Csv {
     }
 }
 
+/// One CSV record as a line of text, quoted as [`Csv`] quotes (for a file
+/// that mixes records with `#` comment lines).
+pub fn csv_line<S: AsRef<str>>(fields: &[S]) -> String {
+    let mut line = Csv {
+        w: csv::Writer::from_writer(Vec::new()),
+    };
+    line.row(fields);
+    line.text().to_string()
+}
+
 /// One CSV table's rows by column name, as read back from its text.
 pub type Records = Vec<std::collections::BTreeMap<String, String>>;
 

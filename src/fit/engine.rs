@@ -257,6 +257,30 @@ pub fn degenerate_reason(row: &[f64]) -> String {
     )
 }
 
+/// What `coulomb_fit.csv` says of a row besides its numbers: the
+/// parameters fitted, the verdict (`failed` where the fit did not run) and
+/// why it failed or is degenerate (its commas read as `;`, as they always
+/// have).
+pub fn judged(row: &[f64]) -> [String; 3] {
+    let fitted = match (row[14] == 1.0, row[15] == 1.0) {
+        (true, true) => "mu_scale center_of_friction inertia_cm",
+        (false, true) => "mu_scale inertia_cm",
+        (true, false) => "mu_scale center_of_friction",
+        _ => "mu_scale",
+    };
+    let verdict = if row[0].is_nan() {
+        "failed"
+    } else {
+        verdict(row)
+    };
+    let reason = match verdict {
+        "failed" => failure_reason(row).unwrap_or_default(),
+        "degenerate" => degenerate_reason(row),
+        _ => String::new(),
+    };
+    [fitted.into(), verdict.into(), reason.replace(',', ";")]
+}
+
 /// `[position, θ]` thresholds of a row: `max(10 e, 1e-6)`.
 pub fn thresholds(row: &[f64]) -> [f64; 2] {
     [row[11], row[12]].map(|e| (THRESHOLD_FACTOR * e).max(1e-6))

@@ -80,15 +80,12 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
             .into_iter()
             .zip(cell_errors(r))
         {
-            if let Some(e) = e {
-                let mark = String::new();
-                cells.push(MapCell {
-                    x,
-                    y,
-                    value: class(e),
-                    mark,
-                });
-            }
+            cells.extend(e.map(|e| MapCell {
+                x,
+                y,
+                value: class(e),
+                mark: String::new(),
+            }));
         }
         let color = match r.get("class").map(String::as_str) {
             Some("locked") => Some(DARK),
@@ -138,25 +135,24 @@ pub fn map_figure(model: &str, csv: &str) -> anyhow::Result<Figure> {
         "1e-2 – 1e-1",
         "≥ 1e-1",
     ];
-    let mut notes: Vec<String> = [
+    let refs: &[&str] = if panels.len() == 3 {
+        &[
+            "engine's law on the problem's",
+            "loads (middle), on the run's",
+            "own loads (right)",
+        ]
+    } else {
+        &["engine's law (right)"]
+    };
+    let notes: Vec<String> = [
         "relative steady-ω error",
         "|ω_engine − ω_ref| / |ω_ref|,",
         "ref: Coulomb (left), the",
     ]
-    .map(String::from)
-    .into();
-    if panels.len() == 3 {
-        notes.extend(
-            [
-                "engine's law on the problem's",
-                "loads (middle), on the run's",
-                "own loads (right)",
-            ]
-            .map(String::from),
-        );
-    } else {
-        notes.push("engine's law (right)".into());
-    }
+    .iter()
+    .chain(refs)
+    .map(|n| n.to_string())
+    .collect();
     let mut key = scale.key("error", &labels, &notes);
     key.entries.push(("undefined".to_string(), GREY));
     key.outlined = vec![

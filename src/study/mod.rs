@@ -38,9 +38,7 @@ use pushval_engine::EngineOptions;
 use crate::outdir::Writer;
 use crate::parallel::par_rows;
 use crate::shard::{grid_hash, grid_name, Parts, Shard};
-pub use plan::{
-    class_code, class_name, models, Plan, Setup, SweepPlan, Task, LAW_RUN, LOADS, RUN_WIDTH,
-};
+pub use plan::{models, Plan, Setup, SweepPlan, Task};
 pub use plate::err;
 pub use readme::opt;
 
@@ -101,9 +99,8 @@ pub fn run_model(model: &str, dir: &Path, opts: &Options) -> anyhow::Result<Summ
         hash: grid_hash(&keys),
     };
     let shard = match opts.shard {
-        Some(s) => Some(s),
         None if !opts.merge => Shard::from_env()?,
-        None => None,
+        given => given,
     };
     if let Some(shard) = shard {
         let idx = shard.indices(&keys);
@@ -128,8 +125,8 @@ pub fn run_model(model: &str, dir: &Path, opts: &Options) -> anyhow::Result<Summ
     };
     let mut w = Writer::new(dir)?;
     readme::write(&plan, &tasks, &rows, &mut w)?;
-    let notes: Vec<String> = plan.failure_note().into_iter().collect();
-    for n in &notes {
+    let note = plan.failure_note();
+    if let Some(n) = &note {
         eprintln!("{n}");
     }
     // Every run failed: nothing was measured, whatever was written.
@@ -143,7 +140,7 @@ pub fn run_model(model: &str, dir: &Path, opts: &Options) -> anyhow::Result<Summ
     if runs.count() > 0 && !measured {
         bail!(
             "study {model}: no engine run gave a steady omega; every cell is blank ({})",
-            notes.join("; ")
+            note.unwrap_or_default()
         );
     }
     Ok(Summary {
@@ -162,16 +159,7 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
-    if name == "index" {
-        // Only the index, from the model folders as they are.
-        let mut w = Writer::new(&root)?;
-        readme::index(&root, &all, opts.quick, &mut w)?;
-        return Ok(Summary {
-            files: w.into_written(),
-            ..Summary::default()
-        });
-    }
-    if name != "all" {
+    if !matches!(name, "all" | "index") {
         if !all.iter().any(|m| m == name) {
             bail!("unknown model `{name}`; known: {}, all", all.join(", "));
         }
@@ -182,7 +170,8 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
         return run_model(name, &dir, opts);
     }
     let mut sum = Summary::default();
-    for m in &all {
+    // `index`: only the index, from the model folders as they are.
+    for m in all.iter().filter(|_| name == "all") {
         let e = crate::registry::engine(m, &EngineOptions::default());
         if let Err(why) = e.availability() {
             sum.notes.push(format!(
@@ -202,7 +191,7 @@ pub fn run(name: &str, opts: &Options) -> anyhow::Result<Summary> {
         sum.files.extend(one.files);
         sum.tasks += one.tasks;
     }
-    if opts.shard.is_none() && (opts.merge || Shard::from_env()?.is_none()) {
+    if name == "index" || (opts.shard.is_none() && (opts.merge || Shard::from_env()?.is_none())) {
         let mut w = Writer::new(&root)?;
         readme::index(&root, &all, opts.quick, &mut w)?;
         sum.files.extend(w.into_written());

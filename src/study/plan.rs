@@ -6,10 +6,10 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::bail;
-use pushval_engine::{tail_loads, tail_mean_omega, Engine, EngineOptions, LawClass};
+use pushval_engine::{Engine, EngineOptions, LawClass};
 use pushval_model::{Problem, Push};
 
-use crate::harness::law::{law_on_run_loads, whole_period_omega};
+use crate::harness::law::{run_row, RUN_WIDTH};
 
 use super::plate::{frs, paper_plate, phis, speed_of, PHI_TABLE, TABLE_SPEEDS};
 use super::spec::{self, Spec};
@@ -46,24 +46,6 @@ pub enum Task {
     Sweep { w: usize, i: usize, v: usize },
 }
 
-/// Supports whose loads a row carries (the plate's four).
-pub const LOADS: usize = 4;
-
-/// Values of a run's row: ω of the engine, of Coulomb and of the law
-/// (rad/s), the law's class code ([`class_code`]) and its rest moments,
-/// then [`LOADS`] support loads measured by the engine and as many
-/// predicted by the law (N; NaN where unknown), the engine's angle at the
-/// end of the run (rad), then what the run's own loads give
-/// ([`LAW_RUN`]): the law's ω on them (tail mean, rad/s), the RMS of the
-/// engine's ω against it over the tail (rad/s), the largest rise (m) and the
-/// share of steps with a support out of contact, and the smallest and
-/// largest per-step load of any support (N).
-pub const RUN_WIDTH: usize = 14 + 2 * LOADS;
-
-/// Index in a run's row of `omega_law_run`; `law_run_rms`, `max_rise_m`,
-/// `contact_lost_share`, `load_min` and `load_max` follow it.
-pub const LAW_RUN: usize = 8 + 2 * LOADS;
-
 /// A sweep of the study file, ready to run.
 pub struct SweepPlan {
     pub spec: spec::Sweep,
@@ -93,25 +75,6 @@ impl SweepPlan {
         let e = &self.engines[if self.engines.len() > 1 { i } else { 0 }];
         (p.0, p.1, p.2, p.3, e.as_ref())
     }
-}
-
-/// The code of a class in a row: 0 turns, 1 locked, 2 semi-stable; NaN none.
-pub fn class_code(c: Option<LawClass>) -> [f64; 4] {
-    match c {
-        None => [f64::NAN; 4],
-        Some(LawClass::Turns) => [0.0, f64::NAN, f64::NAN, f64::NAN],
-        Some(LawClass::Locked) => [1.0, f64::NAN, f64::NAN, f64::NAN],
-        Some(LawClass::SemiStable { moment, lock, hold }) => [2.0, moment, lock, hold],
-    }
-}
-
-/// The class name of a code (empty for none).
-pub fn class_name(code: f64) -> &'static str {
-    ["turns", "locked", "semi_stable"]
-        .into_iter()
-        .enumerate()
-        .find(|(i, _)| *i as f64 == code)
-        .map_or("", |(_, n)| n)
 }
 
 /// A model's study: its setups, steps and task list.
@@ -160,27 +123,23 @@ impl Plan {
             bail!("the model `{model}` is not in this build: {why}");
         }
         // Every `[engine]` key of the file must be one the model reads:
-        // (where the file names it, the key).
-        let mut keys: Vec<(String, &str)> = spec
-            .engine
-            .keys()
-            .map(|k| (format!("engine.{k}"), k.as_str()))
+        // (where the file names it, the key), from each `[engine]` table.
+        let variants = spec.variant.iter().enumerate();
+        let sweeps = spec.sweep.iter().enumerate();
+        let tables = std::iter::once((String::new(), &spec.engine))
+            .chain(variants.map(|(i, v)| (format!("variant[{i}]."), &v.engine)))
+            .chain(
+                sweeps
+                    .clone()
+                    .map(|(i, w)| (format!("sweep[{i}]."), &w.engine)),
+            );
+        let mut keys: Vec<(String, &str)> = tables
+            .flat_map(|(at, t)| {
+                t.keys()
+                    .map(move |k| (format!("{at}engine.{k}"), k.as_str()))
+            })
             .collect();
-        for (i, v) in spec.variant.iter().enumerate() {
-            keys.extend(
-                v.engine
-                    .keys()
-                    .map(|k| (format!("variant[{i}].engine.{k}"), k.as_str())),
-            );
-        }
-        for (i, w) in spec.sweep.iter().enumerate() {
-            keys.extend(
-                w.engine
-                    .keys()
-                    .map(|k| (format!("sweep[{i}].engine.{k}"), k.as_str())),
-            );
-            keys.extend(w.key().map(|k| (format!("sweep[{i}].over"), k)));
-        }
+        keys.extend(sweeps.filter_map(|(i, w)| Some((format!("sweep[{i}].over"), w.key()?))));
         if let Some((at, k)) = keys.iter().find(|(_, k)| !engine.accepts_option(k)) {
             bail!(
                 "{}: key `{at}`: the model `{model}` reads no [engine] key `{k}` (it reads: {})",
@@ -382,12 +341,23 @@ impl Plan {
                     phi,
                 });
             }
-            return run_row(engine, &p, dt, sw.tail, &self.failures);
+            return self.run(engine, &p, dt, sw.tail);
         }
         let (speed, phi, dt, s) = self.push(t);
         let setup = &self.setups[s];
         let p = paper_plate(speed, phi, self.t_run, setup.supports_half);
-        run_row(setup.engine.as_ref(), &p, dt, self.tail, &self.failures)
+        self.run(setup.engine.as_ref(), &p, dt, self.tail)
+    }
+
+    /// A run's row ([`run_row`]), its failure counted.
+    fn run(&self, engine: &dyn Engine, p: &Problem, dt: f64, tail: f64) -> Vec<f64> {
+        let (row, failed) = run_row(engine, p, dt, tail);
+        if let Some(e) = failed {
+            let mut f = self.failures.lock().expect("not poisoned");
+            f.0 += 1;
+            f.1.get_or_insert_with(|| format!("v_c {} m/s, dt {dt} s: {e}", p.pushes[0].speed));
+        }
+        row
     }
 
     /// The note on the engine runs that failed (their rows are blank), if
@@ -410,73 +380,4 @@ impl Plan {
             _ => RUN_WIDTH,
         }
     }
-}
-
-/// A run's row ([`RUN_WIDTH`] values): the engine's tail-mean ω and loads,
-/// Coulomb's ω*, the law's ω, class and loads.
-fn run_row(
-    engine: &dyn Engine,
-    p: &Problem,
-    dt: f64,
-    tail: f64,
-    failures: &std::sync::Mutex<(usize, Option<String>)>,
-) -> Vec<f64> {
-    let run = engine
-        .run(p, dt)
-        .inspect_err(|e| {
-            let mut f = failures.lock().expect("not poisoned");
-            f.0 += 1;
-            f.1.get_or_insert_with(|| format!("v_c {} m/s, dt {dt} s: {e}", p.pushes[0].speed));
-        })
-        .ok();
-    // The last segment: the push, or the rest after a stop, where ω is the
-    // mean |ω| over the tail (a signed mean hides a chattering stop).
-    let seg = p.pushes.len() - 1;
-    let law = engine.law();
-    let period = law.and_then(|l| l.angle_period(p));
-    let omega = run
-        .as_ref()
-        .and_then(|r| {
-            if seg == 0 {
-                let whole = period.and_then(|a| whole_period_omega(p, &r.trajectory, tail, a));
-                return whole.or_else(|| tail_mean_omega(p, &r.trajectory, tail)[0]);
-            }
-            let t1 = p.segment_times()[seg].1;
-            let w: Vec<f64> = r
-                .trajectory
-                .samples
-                .iter()
-                .filter(|s| s.t >= t1 - tail * p.pushes[seg].duration)
-                .map(|s| s.omega.abs())
-                .collect();
-            Some(w.iter().sum::<f64>() / w.len() as f64)
-        })
-        .unwrap_or(f64::NAN);
-    let coulomb = pushval_engine::coulomb_steady(p, seg).unwrap_or(f64::NAN);
-    let steady = law.and_then(|l| l.steady(p, seg, dt));
-    let mut row = vec![omega, coulomb, steady.map_or(f64::NAN, |l| l.omega)];
-    row.extend(class_code(steady.map(|l| l.class)));
-    for loads in [
-        run.as_ref().and_then(tail_loads),
-        law.and_then(|l| l.loads(p, seg, dt)),
-    ] {
-        let loads = loads.unwrap_or_default();
-        row.extend((0..LOADS).map(|k| loads.get(k).copied().unwrap_or(f64::NAN)));
-    }
-    let end = run.as_ref().and_then(|r| r.trajectory.samples.last());
-    row.push(end.map_or(f64::NAN, |s| s.theta));
-    let contact = run.as_ref().and_then(|r| Some((r, r.contact.as_ref()?)));
-    let (law_run, rms) = match (contact, law) {
-        (Some((r, c)), Some(law)) => law_on_run_loads(law, p, seg, dt, tail, r, c),
-        _ => (f64::NAN, f64::NAN),
-    };
-    row.extend([
-        law_run,
-        rms,
-        contact.map_or(f64::NAN, |(_, c)| c.max_rise_m),
-        contact.map_or(f64::NAN, |(_, c)| c.contact_lost_share),
-        contact.map_or(f64::NAN, |(_, c)| c.load_range[0]),
-        contact.map_or(f64::NAN, |(_, c)| c.load_range[1]),
-    ]);
-    row
 }

@@ -7,10 +7,10 @@ use std::path::Path;
 use anyhow::Context;
 
 use super::figure::cell_errors;
-use super::plan::{class_name, Plan, Task, LAW_RUN, LOADS};
+use super::plan::{Plan, Task};
 use super::plate::{err, frs, phis, PHI_TABLE, TABLE_SPEEDS};
 use crate::fit::engine as fit;
-use crate::harness::law::law_integrates;
+use crate::harness::law::{class_name, law_integrates, LAW_RUN, LOADS};
 use crate::outdir::{field_num as num, records, Csv, Records, Writer};
 
 /// Shares of a map's cells: `(cells, within 1e-2 of Coulomb, with a law,
@@ -80,36 +80,42 @@ fn locked_turning(map: &Records) -> Option<String> {
     ))
 }
 
+/// `v` written by `f`, `–` where undefined (README cells).
+fn dash(v: f64, f: impl Fn(f64) -> String) -> String {
+    if v.is_finite() {
+        f(v)
+    } else {
+        "–".into()
+    }
+}
+
 /// A record's per-step load range, `min – max` (N), `–` where unknown.
 fn load_range(r: &std::collections::BTreeMap<String, String>) -> String {
-    match (num(r, "load_min"), num(r, "load_max")) {
-        (a, b) if a.is_finite() && b.is_finite() => format!("{a:.3} – {b:.3}"),
-        _ => "–".into(),
-    }
+    let (lo, hi) = (num(r, "load_min"), num(r, "load_max"));
+    // The sum is finite where both are.
+    dash(lo + hi, |_| format!("{lo:.3} – {hi:.3}"))
 }
 
-/// A share as a percentage, `–` where undefined.
+/// A share as a percentage.
 fn share(v: f64) -> String {
-    if v.is_finite() {
-        format!("{:.2} %", 100.0 * v)
-    } else {
-        "–".into()
-    }
+    dash(v, |v| format!("{:.2} %", 100.0 * v))
 }
 
-/// `f` to 4 significant digits, `–` where undefined.
+/// `v` to 4 significant digits.
 fn sig(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v:.4e}")
-    } else {
-        "–".into()
-    }
+    dash(v, |v| format!("{v:.4e}"))
 }
 
-/// A table's header: `lead`, then the columns of `tail` (a group of
-/// columns several tables share).
-fn head(lead: &[&'static str], tail: &[&'static str]) -> Vec<&'static str> {
-    [lead, tail].concat()
+/// The header of a run's table: `lead`, [`RUN_HEAD`], `class`, `tail`.
+fn run_head(lead: &[&'static str], tail: &[&'static str]) -> Vec<&'static str> {
+    [lead, &RUN_HEAD, &["class"], tail].concat()
+}
+
+/// A run's fields after `lead`: those of [`RUN_HEAD`], then its class.
+fn run_cells(mut lead: Vec<String>, r: &[f64]) -> Vec<String> {
+    lead.extend(run_fields(r));
+    lead.push(class_name(r[3]).into());
+    lead
 }
 
 /// The columns of the engine's, Coulomb's and the law's ω.
@@ -137,26 +143,12 @@ fn law_run_fields(r: &[f64]) -> impl Iterator<Item = String> + '_ {
 }
 
 fn map_csv(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], setup: usize) -> Csv {
-    let mut csv = Csv::new(&head(
-        &[
-            "froude",
-            "phi",
-            "omega_engine",
-            "omega_coulomb",
-            "omega_law",
-            "class",
-        ],
-        &LAW_RUN_HEAD,
-    ));
+    let mut csv = Csv::new(&run_head(&["froude", "phi"], &LAW_RUN_HEAD));
     for (t, r) in tasks.iter().zip(rows) {
         if let Task::Map { s: k, i, j } = *t {
             if k == setup {
-                let mut f = vec![
-                    frs(plan.quick)[i].to_string(),
-                    phis(plan.quick)[j].to_string(),
-                ];
-                f.extend(run_fields(r));
-                f.push(class_name(r[3]).into());
+                let lead = [frs(plan.quick)[i], phis(plan.quick)[j]];
+                let mut f = run_cells(lead.map(|x| x.to_string()).into(), r);
                 f.extend(law_run_fields(r));
                 csv.row(&f);
             }
@@ -175,7 +167,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             .map(|(t, r)| (*t, r))
             .collect()
     };
-    let mut paper = Csv::new(&head(&head(&["speed"], &RUN_HEAD), &LAW_RUN_HEAD));
+    let mut paper = Csv::new(&[&["speed"][..], &RUN_HEAD, &LAW_RUN_HEAD].concat());
     for (t, r) in rows_of(&|t| matches!(t, Task::Table { s: 0, .. })) {
         if let Task::Table { v, .. } = t {
             let mut f = vec![TABLE_SPEEDS[v].to_string()];
@@ -200,10 +192,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
                       lead: &dyn Fn(&Task) -> Vec<String>,
                       first: &[&'static str]| {
         let tail = ["change", "observed_order", "richardson"];
-        let mut csv = Csv::new(&head(
-            &head(&head(first, &["dt"]), &RUN_HEAD),
-            &head(&["class"], &tail),
-        ));
+        let mut csv = Csv::new(&run_head(&[first, &["dt"]].concat(), &tail));
         let rs = rows_of(sel);
         for (n, (t, r)) in rs.iter().enumerate() {
             let same = |m: usize| n >= m && lead(&rs[n - m].0) == lead(t);
@@ -222,10 +211,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
                 _ => f64::NAN,
             };
             let rich = r[0] + change / (ratio.powf(p) - 1.0);
-            let mut f = lead(t);
-            f.push(dt.to_string());
-            f.extend(run_fields(r));
-            f.push(class_name(r[3]).into());
+            let mut f = run_cells([lead(t), vec![dt.to_string()]].concat(), r);
             f.extend([change, order, rich].map(opt));
             csv.row(&f);
         }
@@ -247,9 +233,9 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
         w.file("creep.csv", c.as_bytes())?;
     }
     let lead = ["variant", "options", "supports_half", "phi", "dt", "speed"];
-    let mut variants = Csv::new(&head(
-        &head(&head(&lead, &RUN_HEAD), &head(&["class"], &LAW_RUN_HEAD)),
-        &["theta_end"],
+    let mut variants = Csv::new(&run_head(
+        &lead,
+        &[&LAW_RUN_HEAD[..], &["theta_end"]].concat(),
     ));
     let mut variant_maps = Vec::new();
     for (k, s) in plan.setups.iter().enumerate().skip(1) {
@@ -261,7 +247,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
             .collect();
         for (t, r) in rows_of(&|t| matches!(t, Task::Table { s, .. } if *s == k)) {
             if let Task::Table { v, .. } = t {
-                let mut f = vec![
+                let lead = vec![
                     s.name.clone(),
                     // One field: its commas read as `;` (as they always have).
                     options.join(" ").replace(',', ";"),
@@ -270,8 +256,7 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
                     s.dt.to_string(),
                     TABLE_SPEEDS[v].to_string(),
                 ];
-                f.extend(run_fields(r));
-                f.push(class_name(r[3]).into());
+                let mut f = run_cells(lead, r);
                 f.extend(law_run_fields(r));
                 f.push(opt(r[LAW_RUN - 1]));
                 variants.row(&f);
@@ -286,32 +271,12 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     if plan.setups.len() > 1 {
         w.file("variants.csv", variants.as_bytes())?;
     }
-    let mut fits = Csv::new(&head(
-        &head(&["schedule"], &fit::COLUMNS),
-        &["verdict", "reason"],
-    ));
+    let mut fits = Csv::new(&[&["schedule"][..], &fit::COLUMNS, &["verdict", "reason"]].concat());
     for (t, r) in rows_of(&|t| matches!(t, Task::Fit { .. })) {
         if let Task::Fit { k } = t {
-            let fitted = match (r[14] == 1.0, r[15] == 1.0) {
-                (true, true) => "mu_scale center_of_friction inertia_cm",
-                (false, true) => "mu_scale inertia_cm",
-                (true, false) => "mu_scale center_of_friction",
-                _ => "mu_scale",
-            };
-            let verdict = if r[0].is_nan() {
-                "failed"
-            } else {
-                fit::verdict(r)
-            };
-            let reason = match verdict {
-                "failed" => fit::failure_reason(r).unwrap_or_default(),
-                "degenerate" => fit::degenerate_reason(r),
-                _ => String::new(),
-            };
             let mut f = vec![fit::SCHEDULES[k].to_string()];
             f.extend(r.iter().take(fit::WIDTH - 3).map(|v| opt(*v)));
-            // The reason's commas read as `;` (as they always have).
-            f.extend([fitted.into(), verdict.into(), reason.replace(',', ";")]);
+            f.extend(fit::judged(r));
             fits.row(&f);
         }
     }
@@ -334,13 +299,9 @@ pub fn write(plan: &Plan, tasks: &[Task], rows: &[Vec<f64>], w: &mut Writer) -> 
     w.file("README.md", text.as_bytes())
 }
 
-/// `v` to 3 decimals, `–` where undefined.
+/// `v` to 3 decimals.
 fn dec3(v: &f64) -> String {
-    if v.is_finite() {
-        format!("{v:.3}")
-    } else {
-        "–".into()
-    }
+    dash(*v, |v| format!("{v:.3}"))
 }
 
 /// `[engine]` options as TOML reads them: `k = v, …`.
@@ -368,13 +329,11 @@ fn sweeps(
         let has_loads = sel
             .iter()
             .any(|(_, r)| r[7..7 + 2 * LOADS].iter().any(|v| v.is_finite()));
-        let mut columns: Vec<String> = head(
-            &head(&["value", "speed", "phi", "dt", "theta0"], &RUN_HEAD),
-            &["class", "err_vs_coulomb", "err_vs_law", "theta_end"],
-        )
-        .iter()
-        .map(|c| c.to_string())
-        .collect();
+        let tail = ["err_vs_coulomb", "err_vs_law", "theta_end"];
+        let mut columns: Vec<String> = run_head(&["value", "speed", "phi", "dt", "theta0"], &tail)
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
         if has_loads {
             for who in ["engine", "law"] {
                 columns.extend((1..=LOADS).map(|k| format!("load_{who}_{k}")));
@@ -513,6 +472,7 @@ fn readme(
     let law = e
         .law()
         .map_or("none declared".to_string(), |l| l.law_name().to_string());
+    let p = super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None);
     let _ = write!(
         s,
         "Model: {}. Engine law in closed form: {law}. Scene: the seed paper's plate (0.25 m square, 1 kg, μ = 0.5 on four corner supports), \
@@ -520,7 +480,7 @@ fn readme(
         e.description(),
         plan.t_run,
         100.0 * plan.tail,
-        match e.law().and_then(|l| l.angle_period(&super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None))) {
+        match e.law().and_then(|l| l.angle_period(&p)) {
             Some(a) => format!(
                 ", cut to the whole number of the law's periods in the object's angle ({a:.4} rad) that the tail turns through, where it turns through one or more"
             ),
@@ -540,10 +500,7 @@ fn readme(
     // A law with dynamics is integrated along the run's loads where the
     // engine measured them (the rows' rise), else taken quasi-statically.
     let integrated = paper.iter().any(|r| num(r, "max_rise_m").is_finite())
-        && e.law().is_some_and(|l| {
-            let p = super::plate::paper_plate(0.5, PHI_TABLE, plan.t_run, None);
-            law_integrates(l, &p, 0, plan.dt)
-        });
+        && e.law().is_some_and(|l| law_integrates(l, &p, 0, plan.dt));
     let _ = write!(
         s,
         "## Paper plate (`paper_plate.csv`)\n\nφ = π/4 + 0.3 = {PHI_TABLE:.4} rad. Error against Coulomb: relative to ω*; against the law: relative, or |ω|/|ω*| where the law holds ω = 0.\n\n\
@@ -628,11 +585,7 @@ fn readme(
                 num(r, "dt"),
                 sig(num(r, "omega_engine")),
                 sig(num(r, "change")),
-                if num(r, "observed_order").is_finite() {
-                    format!("{:.2}", num(r, "observed_order"))
-                } else {
-                    "–".into()
-                },
+                dash(num(r, "observed_order"), |o| format!("{o:.2}")),
                 sig(num(r, "richardson"))
             );
         }

@@ -138,13 +138,15 @@ impl Spec {
             )),
             _ => Ok(()),
         };
+        let share = |key: &str, v: Option<f64>| match v {
+            Some(t) if !(t > 0.0 && t <= 1.0) => {
+                Err((key.to_string(), format!("must be in (0, 1], got {t}")))
+            }
+            _ => Ok(()),
+        };
         pos("dt", self.dt)?;
         pos("t_run", self.t_run)?;
-        if let Some(t) = self.tail {
-            if !(t > 0.0 && t <= 1.0) {
-                return Err(("tail".into(), format!("must be in (0, 1], got {t}")));
-            }
-        }
+        share("tail", self.tail)?;
         for (key, l) in [
             ("ladder", &self.ladder),
             ("ladder_quick", &self.ladder_quick),
@@ -209,11 +211,7 @@ impl Spec {
             pos(&at("dt"), w.dt)?;
             pos(&at("t_run"), w.t_run)?;
             pos(&at("stop"), w.stop)?;
-            if let Some(t) = w.tail {
-                if !(t > 0.0 && t <= 1.0) {
-                    return Err((at("tail"), format!("must be in (0, 1], got {t}")));
-                }
-            }
+            share(&at("tail"), w.tail)?;
         }
         Ok(())
     }

@@ -104,6 +104,11 @@ impl Columns {
     /// `supports` supports: `t,x,y,theta,omega` required (compact rows
     /// carry ω), `rise`, every `load_i` and `steps` read where present.
     pub fn of(header: &str, supports: usize) -> Result<Self, String> {
+        // Split as the text rows' header is ([`pushval_model::format`]:
+        // names between commas, trimmed, never quoted), not with a CSV
+        // reader: an answer is a stream of lines (text rows, compact lines,
+        // `#end N`) read as it arrives under a cap, and one header must mean
+        // the same columns to both kinds of row.
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
         for (i, n) in names.iter().enumerate() {
             if names[..i].contains(n) {
