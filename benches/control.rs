@@ -9,6 +9,10 @@
 //! after a 0.02 s period on a plant with μ × 0.8 (the dynamic model as the
 //! plant), so the warm start has something to correct.
 //!
+//! The cost table (`results/control_cost.csv`) adds adaptive MPC's period
+//! (the estimator's update and the re-plan on the estimate) at 50 Hz and
+//! 1 kHz on a plate with one slippery foot.
+//!
 //! `cargo bench --bench control`
 
 use criterion::{criterion_group, BatchSize, BenchmarkId, Criterion};
@@ -199,6 +203,44 @@ fn cost_table() {
         period_cpu_us.extend(out.predictor_cpu_us);
         reached += usize::from(out.success);
     }
+    // Adaptive MPC on a plate with one slippery foot (the adaptive study's
+    // `slippery_near`), judged at the release, at 50 Hz (20 goals) and at
+    // 1 kHz (the first 5): every period's estimator update and re-plan,
+    // thread CPU time, pooled.
+    let slippery = pushval::control::adaptive::PlantKind::SlipperyNear
+        .apply(&problem)
+        .unwrap();
+    let adaptive_loops = |period: f64, goals: &[pushval::control::Goal]| {
+        let (mut per, mut est, mut ok) = (Vec::new(), Vec::new(), 0usize);
+        for goal in goals {
+            let spec = LoopSpec {
+                plan: PlanSpec {
+                    segments: 6,
+                    speed: 1.0,
+                    predictor: Predictor::Dynamic,
+                    at: pushval::control::At::Release,
+                },
+                period,
+                reach,
+                adapt: true,
+                sensor: Default::default(),
+            };
+            let dt = engine.default_dt();
+            let mut session = engine.start(&slippery, dt).unwrap();
+            let out = run_loop(&problem, session.as_mut(), dt, *goal, spec, &mut ()).unwrap();
+            per.extend(
+                out.predictor_cpu_us
+                    .iter()
+                    .zip(&out.estimator_cpu_us)
+                    .map(|(p, e)| p + e),
+            );
+            est.extend(out.estimator_cpu_us);
+            ok += usize::from(out.success);
+        }
+        (per, est, ok)
+    };
+    let (ad_per, ad_est, ad_ok) = adaptive_loops(0.02, &goals);
+    let (khz_per, khz_est, khz_ok) = adaptive_loops(0.001, &goals[..5]);
     let nan = (f64::NAN, f64::NAN);
     let (pm, pp) = median_p99(&plan_us).unwrap_or(nan);
     let (rm, rp) = median_p99(&rest_us).unwrap_or(nan);
@@ -247,6 +289,30 @@ fn cost_table() {
         "the same periods' thread CPU time (what the predictor computes; wall time adds the waits of a shared machine)",
     );
     row("mpc_period_cpu_p99", us(cp), "us", "1000", "same");
+    let (am, ap) = median_p99(&ad_per).unwrap_or(nan);
+    let (em, ep) = median_p99(&ad_est).unwrap_or(nan);
+    let adaptive = format!(
+        "{} periods of adaptive MPC (estimator update and re-plan, thread CPU), rapier2d plant with one slippery foot, 20 goals at 1 m/s, period 0.02 s, {ad_ok} reached",
+        ad_per.len()
+    );
+    row("adaptive_period_cpu_median", us(am), "us", "100", &adaptive);
+    row("adaptive_period_cpu_p99", us(ap), "us", "1000", "same periods");
+    row(
+        "adaptive_estimator_cpu_median",
+        us(em),
+        "us",
+        "",
+        "the estimator alone in those periods",
+    );
+    row("adaptive_estimator_cpu_p99", us(ep), "us", "", "same");
+    let (km, kp) = median_p99(&khz_per).unwrap_or(nan);
+    let (kem, _) = median_p99(&khz_est).unwrap_or(nan);
+    let khz = format!(
+        "{} periods of the same adaptive MPC at 1 kHz (period 0.001 s), the first 5 goals, {khz_ok} reached; the estimator alone {kem:.1} us median",
+        khz_per.len()
+    );
+    row("adaptive_1khz_period_cpu_median", us(km), "us", "1000", &khz);
+    row("adaptive_1khz_period_cpu_p99", us(kp), "us", "1000", "same periods");
     row(
         "load_average_1min",
         load,
