@@ -454,6 +454,9 @@ impl TailCursor {
         gamma[0] = C::new(1.0, 0.0);
         let n_alpha = n;
         let n = if n == 0 { 0 } else { ORDER };
+        // γ_{m−1}, held apart from the array so the chain need not wait
+        // for it to be stored and read back.
+        let mut last = gamma[0];
         for m in 1..=n {
             // The terms k ≥ 2 (γ_{m−2} and older) in four partial sums, then
             // k = 1: the serial chain from γ_{m−1} to γ_m is one product,
@@ -475,8 +478,9 @@ impl TailCursor {
             {
                 *a += gamma[m - k - l] * ta[k + l - 1];
             }
-            let acc = ((acc4[0] + acc4[1]) + (acc4[2] + acc4[3])) + gamma[m - 1] * ta[0];
-            gamma[m] = C::new(acc.im, -acc.re) * INV[m];
+            let acc = ((acc4[0] + acc4[1]) + (acc4[2] + acc4[3])) + last * ta[0];
+            last = C::new(acc.im, -acc.re) * INV[m];
+            gamma[m] = last;
         }
         let n = (n_alpha..=n)
             .rev()
