@@ -312,8 +312,8 @@ impl SettleRule {
         // Cheap screen before solving for ξ (|ξ| is within 1.25 |δ₀| wherever
         // the series is of any use).
         let dd = 1.25 * d.abs();
-        if self.a[k - 1].abs() * dd.powi(k as i32) + self.a[k - 2].abs() * dd.powi(k as i32 - 1)
-            > allowed
+        let dd_km1 = dd.powi(k as i32 - 1);
+        if (self.a[k - 1].abs() * dd + self.a[k - 2].abs()) * dd_km1 > allowed
         {
             return None;
         }
