@@ -313,8 +313,7 @@ impl SettleRule {
         // the series is of any use).
         let dd = 1.25 * d.abs();
         let dd_km1 = dd.powi(k as i32 - 1);
-        if (self.a[k - 1].abs() * dd + self.a[k - 2].abs()) * dd_km1 > allowed
-        {
+        if (self.a[k - 1].abs() * dd + self.a[k - 2].abs()) * dd_km1 > allowed {
             return None;
         }
         tail.alpha = series_for(&self.a, k, d)?;
