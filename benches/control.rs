@@ -296,7 +296,13 @@ fn cost_table() {
         ad_per.len()
     );
     row("adaptive_period_cpu_median", us(am), "us", "100", &adaptive);
-    row("adaptive_period_cpu_p99", us(ap), "us", "1000", "same periods");
+    row(
+        "adaptive_period_cpu_p99",
+        us(ap),
+        "us",
+        "1000",
+        "same periods",
+    );
     row(
         "adaptive_estimator_cpu_median",
         us(em),
@@ -311,8 +317,20 @@ fn cost_table() {
         "{} periods of the same adaptive MPC at 1 kHz (period 0.001 s), the first 5 goals, {khz_ok} reached; the estimator alone {kem:.1} us median",
         khz_per.len()
     );
-    row("adaptive_1khz_period_cpu_median", us(km), "us", "1000", &khz);
-    row("adaptive_1khz_period_cpu_p99", us(kp), "us", "1000", "same periods");
+    row(
+        "adaptive_1khz_period_cpu_median",
+        us(km),
+        "us",
+        "1000",
+        &khz,
+    );
+    row(
+        "adaptive_1khz_period_cpu_p99",
+        us(kp),
+        "us",
+        "1000",
+        "same periods",
+    );
     row(
         "load_average_1min",
         load,

@@ -190,6 +190,24 @@ impl SegmentDynamics {
         }
     }
 
+    /// [`SegmentDynamics::reset_along`] for another push on the body `self`
+    /// was last reset for, with the same reading of the inertial term: only
+    /// what depends on the push is recomputed (the speed, the direction,
+    /// `k` and the `s_i`); the per-support arrays of the body stay. The
+    /// result is the one `reset_along` gives, bit for bit.
+    pub(crate) fn repush(&mut self, push: &Push, dir: Vec2, term: InertialTerm) {
+        let sign = match term {
+            InertialTerm::Derived => 1.0,
+            InertialTerm::Flipped => -1.0,
+        };
+        self.speed = push.speed;
+        self.dir = dir;
+        self.k = sign * self.mass * push.speed * self.contact.dot(&dir);
+        for ((s, rx), ry) in self.s.iter_mut().zip(&self.rx).zip(&self.ry) {
+            *s = cross(&Vec2::new(*rx, *ry), &dir);
+        }
+    }
+
     /// Pusher speed (m/s).
     pub fn speed(&self) -> f64 {
         self.speed

@@ -172,20 +172,39 @@ fn linearising_map_in(
 /// `α_k = a_k ξ^k` for the deviation `d = h(ξ)` (Newton's method from
 /// `ξ = d`); `None` where `h` is not safely invertible there.
 pub(crate) fn series_for(a: &[f64; ORDER], order: usize, d: f64) -> Option<[f64; ORDER]> {
+    // (k + 1) a_k, the coefficients of h'.
+    let da: [f64; ORDER] = std::array::from_fn(|k| (k + 1) as f64 * a[k]);
     let mut xi = d;
     let mut converged = false;
     for _ in 0..30 {
-        let (mut h, mut dh) = (0.0, 0.0);
-        for k in (0..order).rev() {
-            h = (h + a[k]) * xi;
-            dh = dh * xi + (k + 1) as f64 * a[k];
+        // h(ξ) = ξ Σ a_k ξ^k and h'(ξ) = Σ (k + 1) a_k ξ^k, each as its even
+        // and odd terms in ξ²: four Horner chains of half the length side
+        // by side (an iteration waits on their latency, not their work).
+        let x2 = xi * xi;
+        let (mut he, mut ho, mut de, mut dd) = (0.0, 0.0, 0.0, 0.0);
+        let mut k = order;
+        if k % 2 == 1 {
+            k -= 1;
+            he = a[k];
+            de = da[k];
         }
+        while k >= 2 {
+            k -= 2;
+            ho = ho * x2 + a[k + 1];
+            he = he * x2 + a[k];
+            dd = dd * x2 + da[k + 1];
+            de = de * x2 + da[k];
+        }
+        let h = xi * (he + xi * ho);
+        let dh = de + xi * dd;
         if !(dh > 0.25) {
             return None;
         }
         let step = (h - d) / dh;
         xi -= step;
-        if step.abs() <= 4e-16 * xi.abs() {
+        // Newton converges quadratically: a step this small leaves an
+        // error of the order of its square, far below rounding.
+        if step.abs() <= 1e-9 * xi.abs() {
             converged = true;
             break;
         }
@@ -293,27 +312,22 @@ impl SettleRule {
         // Cheap screen before solving for ξ (|ξ| is within 1.25 |δ₀| wherever
         // the series is of any use).
         let dd = 1.25 * d.abs();
-        if self.a[k - 1].abs() * dd.powi(k as i32) + self.a[k - 2].abs() * dd.powi(k as i32 - 1)
-            > allowed
-        {
+        let dd_km1 = dd.powi(k as i32 - 1);
+        if (self.a[k - 1].abs() * dd + self.a[k - 2].abs()) * dd_km1 > allowed {
             return None;
         }
         tail.alpha = series_for(&self.a, k, d)?;
         let al = &tail.alpha;
         let cut = al[k - 1].abs() + al[k - 2].abs();
-        let rate: f64 = al
-            .iter()
-            .enumerate()
-            .rev()
-            .map(|(k, a)| -((k + 1) as f64) * a / self.tau)
-            .sum();
-        let residual = rate - seg.omega_dot(w);
-        let eps_inf: f64 = al
-            .iter()
-            .enumerate()
-            .rev()
-            .map(|(k, a)| a * self.tau / (k + 1) as f64)
-            .sum();
+        // δ̇ = −Σ k α_k / τ and ε∞ = τ Σ α_k / k at the start (1/k from
+        // the table: no division per term).
+        let (mut ka, mut ak) = (0.0, 0.0);
+        for (j, a) in al[..k].iter().enumerate().rev() {
+            ka += (j + 1) as f64 * a;
+            ak += a * INV[j + 1];
+        }
+        let residual = -ka / self.tau - seg.omega_dot(w);
+        let eps_inf = ak * self.tau;
         (cut.max(self.tau * residual.abs()) <= allowed && eps_inf.abs() <= 0.5).then_some(tail)
     }
 }
@@ -423,7 +437,8 @@ impl TailCursor {
             .iter()
             .rposition(|a| *a != 0.0)
             .map_or(0, |k| k + 1);
-        let beta: [f64; ORDER] = std::array::from_fn(|k| tail.alpha[k] * tau / (k + 1) as f64);
+        // β_k = α_k τ/k by the table of 1/k: no division per term.
+        let beta: [f64; ORDER] = std::array::from_fn(|k| tail.alpha[k] * tau * INV[k + 1]);
         let eps_inf: f64 = beta[..n].iter().rev().sum();
         let (s0, c0) = (tail.theta + eps_inf).sin_cos();
         let rot_inf = C::new(c0, s0);
@@ -438,31 +453,46 @@ impl TailCursor {
         gamma[0] = C::new(1.0, 0.0);
         let n_alpha = n;
         let n = if n == 0 { 0 } else { ORDER };
+        // γ_{m−1}, held apart from the array so the chain need not wait
+        // for it to be stored and read back.
+        let mut last = gamma[0];
         for m in 1..=n {
-            // Four partial sums in registers: a quarter of the serial chain.
+            // The terms k ≥ 2 (γ_{m−2} and older) in four partial sums, then
+            // k = 1: the serial chain from γ_{m−1} to γ_m is one product,
+            // one sum and the scaling. The terms run to k = n_alpha only
+            // (τ α_k is zero beyond).
             let mut acc4 = [C::new(0.0, 0.0); 4];
-            let mut k = 1;
-            while k + 3 <= m {
+            let top = m.min(n_alpha);
+            let mut k = 2;
+            while k + 3 <= top {
                 for (l, a) in acc4.iter_mut().enumerate() {
                     *a += gamma[m - k - l] * ta[k + l - 1];
                 }
                 k += 4;
             }
-            for (l, a) in acc4.iter_mut().enumerate().take(m + 1 - k) {
+            for (l, a) in acc4
+                .iter_mut()
+                .enumerate()
+                .take((top + 1).saturating_sub(k))
+            {
                 *a += gamma[m - k - l] * ta[k + l - 1];
             }
-            let acc = (acc4[0] + acc4[1]) + (acc4[2] + acc4[3]);
-            gamma[m] = C::new(acc.im, -acc.re) * INV[m];
+            let acc = ((acc4[0] + acc4[1]) + (acc4[2] + acc4[3])) + last * ta[0];
+            last = C::new(acc.im, -acc.re) * INV[m];
+            gamma[m] = last;
         }
         let n = (n_alpha..=n)
             .rev()
             .find(|&m| m == n_alpha || gamma[m].norm_sqr() > 1e-40)
             .unwrap_or(0);
         // κ_m = W γ_m / z_m, 1/z_m = conj(z_m)/|z_m|²; the divisions are
-        // independent of each other, so they go first.
-        let rate: [f64; ORDER] = std::array::from_fn(|k| (k + 1) as f64 / tau);
-        let inv_z2: [f64; ORDER] =
-            std::array::from_fn(|k| 1.0 / (rate[k] * rate[k] + tail.omega * tail.omega));
+        // independent of each other, so they go first, one per term in use.
+        let inv_tau = 1.0 / tau;
+        let rate: [f64; ORDER] = std::array::from_fn(|k| (k + 1) as f64 * inv_tau);
+        let mut inv_z2 = [0.0; ORDER];
+        for (iz, r) in inv_z2.iter_mut().zip(&rate).take(n) {
+            *iz = 1.0 / (r * r + tail.omega * tail.omega);
+        }
         let mut kappa = [C::new(0.0, 0.0); ORDER];
         let mut sum_kappa = C::new(0.0, 0.0);
         for m in (1..=n).rev() {

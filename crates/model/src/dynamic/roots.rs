@@ -33,7 +33,7 @@ impl SegmentDynamics {
             // Monotone: one sign change in [−bound, bound] at most.
             let (lo, hi) = (-bound, bound);
             if g(lo) > 0.0 && g(hi) < 0.0 {
-                roots.push(self.refine(lo, hi));
+                roots.push(self.refine((lo, g(lo)), (hi, g(hi))));
             } else if g(lo) == 0.0 || g(hi) == 0.0 {
                 roots.push(if g(lo) == 0.0 { lo } else { hi });
             }
@@ -52,7 +52,7 @@ impl SegmentDynamics {
                 if a == 0.0 {
                     roots.push(grid[j]);
                 } else if a * b < 0.0 {
-                    roots.push(self.refine(grid[j], grid[j + 1]));
+                    roots.push(self.refine((grid[j], a), (grid[j + 1], b)));
                 }
             }
             if vals[grid.len() - 1] == 0.0 {
@@ -127,20 +127,24 @@ impl SegmentDynamics {
         if g0 == 0.0 {
             return Some(self.classify(omega));
         }
-        // A root within rounding of ω is the state itself (as in `attractor`).
-        let h = 1e-12 * (1.0 + omega.abs());
-        let (gl, gh) = (self.moment(omega - h), self.moment(omega + h));
-        if (gl > 0.0) != (gh > 0.0) && gl != 0.0 && gh != 0.0 {
-            return Some(self.classify(self.refine(omega - h, omega + h)));
-        }
         let up = g0 > 0.0;
-        if self.k <= 0.0 {
+        if self.k > 0.0 {
+            // A root within rounding of ω is the state itself (as in
+            // `attractor`). (With k ≤ 0, G decreases: its one root lies
+            // ahead, and the first bracket below holds it even within
+            // rounding.)
+            let h = 1e-12 * (1.0 + omega.abs());
+            let (gl, gh) = (self.moment(omega - h), self.moment(omega + h));
+            if (gl > 0.0) != (gh > 0.0) && gl != 0.0 && gh != 0.0 {
+                return Some(self.classify(self.refine((omega - h, gl), (omega + h, gh))));
+            }
+        } else {
             // G is monotone: its one root lies ahead. Steps from ω growing
             // by doubling from a tenth of v/r_min bracket it; past 2⁶⁰ times
             // that scale there is none (the full scan's bound stops sooner).
             let mut h = 0.1 * self.speed / self.r_min().max(1e-300);
             let dir = if up { 1.0 } else { -1.0 };
-            let mut prev = omega;
+            let (mut prev, mut gprev) = (omega, g0);
             for _ in 0..64 {
                 let w = omega + dir * h;
                 let gw = self.moment(w);
@@ -148,10 +152,9 @@ impl SegmentDynamics {
                     return Some(self.classify(w));
                 }
                 if (gw > 0.0) != up {
-                    let (lo, hi) = if up { (prev, w) } else { (w, prev) };
-                    return Some(self.classify(self.refine(lo, hi)));
+                    return Some(self.classify(self.refine((prev, gprev), (w, gw))));
                 }
-                prev = w;
+                (prev, gprev) = (w, gw);
                 h *= 2.0;
             }
             return None;
@@ -195,8 +198,7 @@ impl SegmentDynamics {
                 return Some(self.classify(w));
             }
             if (gw > 0.0) != (gprev > 0.0) {
-                let (lo, hi) = if up { (prev, w) } else { (w, prev) };
-                return Some(self.classify(self.refine(lo, hi)));
+                return Some(self.classify(self.refine((prev, gprev), (w, gw))));
             }
             (prev, gprev) = (w, gw);
         }
@@ -246,10 +248,10 @@ impl SegmentDynamics {
     /// Stops when the bracket is a few ulps wide or `|G|` is down to its
     /// rounding floor (a few ε times the moments summed): near ω* = 0 the
     /// bracket's relative width never gets there. `g(lo)` and `g(hi)` have
-    /// opposite signs.
-    fn refine(&self, mut lo: f64, mut hi: f64) -> f64 {
+    /// opposite signs; the caller passes them with the ends, `(ω, G(ω))`
+    /// (either end first).
+    fn refine(&self, (mut lo, mut glo): (f64, f64), (mut hi, mut ghi): (f64, f64)) -> f64 {
         let g = |w: f64| self.moment(w);
-        let (mut glo, mut ghi) = (g(lo), g(hi));
         let mut side = 0i8;
         let mut width = (hi - lo).abs();
         let mut slow = 0;

@@ -98,6 +98,37 @@ fn a_reset_segment_is_a_fresh_one() {
     }
 }
 
+/// A segment given another push on the same body (only the push's part
+/// redone, as a run does from one segment to the next) is the segment made
+/// afresh for that push, under either reading of the inertial term.
+#[test]
+fn a_repushed_segment_is_a_fresh_one() {
+    let b = body(&[(0.1, 0.08), (0.12, -0.07), (-0.05, 0.02), (0.0, -0.1)]);
+    let first = Push {
+        duration: 1.0,
+        speed: 0.2,
+        phi: -1.1,
+    };
+    let push = Push {
+        duration: 0.5,
+        speed: 0.7,
+        phi: 0.4,
+    };
+    for term in [InertialTerm::Derived, InertialTerm::Flipped] {
+        let mut seg = SegmentDynamics::with_inertial_term(&b, &first, term);
+        seg.repush(&push, push.direction(), term);
+        let fresh = SegmentDynamics::with_inertial_term(&b, &push, term);
+        assert_eq!(seg.inertial_slope(), fresh.inertial_slope());
+        assert_eq!(seg.speed(), fresh.speed());
+        for w in [-3.0, -0.2, 0.0, 0.5, 4.0] {
+            assert_eq!(seg.omega_dot(w), fresh.omega_dot(w), "ω {w}");
+            assert_eq!(seg.moment_slope(w), fresh.moment_slope(w), "ω {w}");
+            assert_eq!(seg.pusher_force(w), fresh.pusher_force(w), "ω {w}");
+        }
+        assert_eq!(seg.steady_states(), fresh.steady_states());
+    }
+}
+
 /// A push through the centre of a support set that is mirror-symmetric
 /// about the push line has its steady state at ω = 0 (the mirror image
 /// of a turning motion turns the other way), from either side and

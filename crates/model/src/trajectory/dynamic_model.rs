@@ -90,7 +90,8 @@ impl DynamicModel {
     /// `omega`: the root ω tends to (a runaway or a pivot is recorded in
     /// `checker`), the runaway limit, the series tail's hand-over rule.
     /// `r_min`: the shortest nonzero distance from the contact to a support (m).
-    /// `spare`: the previous segment's dynamics, whose arrays are reused;
+    /// `spare`: the previous segment's dynamics on the same `body` and
+    /// inertial term, of which only the push's part is redone;
     /// `dir`: the push direction `n_φ`.
     #[allow(clippy::too_many_arguments)]
     fn segment(
@@ -107,8 +108,9 @@ impl DynamicModel {
         checker: &mut Checker,
     ) -> SegmentRun {
         let dynamics = match spare {
+            // The previous segment's, on the same body: only the push changes.
             Some(mut d) => {
-                d.reset_along(body, push, dir, self.inertial_term);
+                d.repush(push, dir, self.inertial_term);
                 d
             }
             None => SegmentDynamics::with_inertial_term(body, push, self.inertial_term),
