@@ -69,6 +69,8 @@ pub struct Resolved {
     /// What the row must say without failing: the order not observed, the
     /// ladder that missed its target and what that means for the verdict.
     pub notes: Vec<String>,
+    /// With a `[release]`: the stop time's tolerance (always auto).
+    pub stop_time: Option<super::rest::StopTolerance>,
 }
 
 impl Resolved {
@@ -105,6 +107,7 @@ impl Resolved {
             "observed_order_on": self.order.as_ref().map(|o| o.on.clone()),
             "estimate_order": self.order.as_ref().map(|o| o.estimate_order),
             "notes": self.notes,
+            "stop_time": self.stop_time.as_ref().map_or(serde_json::Value::Null, |t| t.json()),
         })
     }
 }
@@ -235,6 +238,7 @@ pub fn resolve(sc: &Scenario, estimate: Option<&DtEstimate>, model_error: Figure
         dt: None,
         order: None,
         notes: Vec::new(),
+        stop_time: None,
     }
 }
 
@@ -389,7 +393,8 @@ pub fn model_error(problem: &Problem, reference: &Trajectory, model_tol: f64) ->
         theta_max: 0.0,
         omega_steady_rel: 0.0,
     };
-    for (a, b) in loose.samples.iter().zip(&reference.samples) {
+    let pairs = super::rest::paired(&loose, reference).unwrap_or_default();
+    for (a, b) in pairs {
         f.position_max = f
             .position_max
             .max(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt());
