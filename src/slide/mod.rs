@@ -162,6 +162,9 @@ pub struct EngineRow {
     pub law: Option<(String, String)>,
     /// Its default step (s).
     pub dt: f64,
+    /// The order in the step it declares for a problem with a release
+    /// (`order_for`).
+    pub declared_order: f64,
     pub status: Status,
 }
 
@@ -267,6 +270,7 @@ pub fn measure(quick: bool) -> anyhow::Result<Study> {
             name: entry.name.clone(),
             law: declared_law(&entry.name),
             dt: engine.default_dt(),
+            declared_order: engine.order_for(&scene),
             status,
         });
         rows.append(&mut r);

@@ -65,7 +65,7 @@ pub fn engine_gaps(study: &Study, name: &str, h: f64) -> (Gaps, Gaps) {
 }
 
 /// The released engines' rests against the model's, at each engine's
-/// step: rest-position gap against the model's slide distance, angle gap
+/// step: where each comes to rest beside the model, the rest-position gap against the model's slide distance, angle gap
 /// against the model's turn, stop-time gap against the model's stop time.
 pub fn figure(study: &Study) -> Figure {
     let released: Vec<&super::EngineRow> = study
@@ -90,6 +90,47 @@ pub fn figure(study: &Study) -> Figure {
             Axis::log("|engine's stop time - model's| (s)"),
         ),
     ];
+    // Where each comes to rest, beside the model, at the slide's own scale.
+    let mut map = Panel::new(
+        "rest positions (throws from the origin)",
+        Axis::lin("x (m)"),
+        Axis::lin("y (m)"),
+    )
+    .equal_aspect();
+    let first = |r: &&Row| {
+        released
+            .first()
+            .is_some_and(|e| r.engine == e.name && r.dt == e.dt)
+    };
+    map.series.push(
+        Series::new("dynamic model", plot::DARK, Stroke::Dots)
+            .width(5)
+            .points(
+                study
+                    .rows
+                    .iter()
+                    .filter(first)
+                    .filter_map(|r| r.model.map(|m| (m.x, m.y)))
+                    .collect(),
+            ),
+    );
+    for (k, e) in released.iter().enumerate() {
+        map.series.push(
+            Series::new(
+                e.name.clone(),
+                plot::PALETTE[k % plot::PALETTE.len()],
+                Stroke::Dots,
+            )
+            .points(
+                study
+                    .rows
+                    .iter()
+                    .filter(|r| r.engine == e.name && r.dt == e.dt)
+                    .filter_map(|r| r.engine_rest.map(|m| (m.x, m.y)))
+                    .collect(),
+            ),
+        );
+    }
     for (k, e) in released.iter().enumerate() {
         let color = plot::PALETTE[k % plot::PALETTE.len()];
         let rows: Vec<&Row> = study
@@ -117,12 +158,13 @@ pub fn figure(study: &Study) -> Figure {
                 .push(Series::new(label.clone(), color, Stroke::Dots).points(s));
         }
     }
+    panels.insert(0, map);
     for p in &mut panels {
         p.legend = Legend::Outside;
     }
     Figure {
-        size: (1500, 520),
-        cols: 3,
+        size: (1300, 1000),
+        cols: 2,
         panels,
         key: None,
     }
@@ -182,7 +224,81 @@ fn engine_paragraph(study: &Study, e: &super::EngineRow) -> String {
         (false, true) => ": the gap shrinks with the step, so at these throws its law acts on the slide as Coulomb's does; its gap is its step's.".to_string(),
         (false, false) => ": the gap does not shrink with the step, so it is the engine's friction law's, not its step's: the law above is not Coulomb's at the problem's loads, and the plate stops elsewhere.".to_string(),
     });
+    if shrinks && e.declared_order > order + 0.5 {
+        s.push_str(&format!(
+            " It declares order {} for a problem with a release, but its slide converges at order {order:.2}: a gate on a thrown plate would refuse its auto tolerances until its declaration says {}.",
+            e.declared_order,
+            order.round().max(1.0)
+        ));
+    }
     s
+}
+
+/// The largest distance (m) and angle (rad) between the rests of engines
+/// `a` and `b` at step `h` over the throws both measured.
+fn between(study: &Study, a: &str, b: &str, h: f64) -> (f64, f64) {
+    let rows = |n: &str| -> Vec<&Row> {
+        study
+            .rows
+            .iter()
+            .filter(|r| r.engine == n && r.dt == h)
+            .collect()
+    };
+    let (ra, rb) = (rows(a), rows(b));
+    let mut out = (0.0f64, 0.0f64);
+    for x in &ra {
+        let Some(y) = rb.iter().find(|y| y.throw == x.throw) else {
+            continue;
+        };
+        if let (Some(p), Some(q)) = (x.engine_rest, y.engine_rest) {
+            out.0 = out.0.max((p.x - q.x).hypot(p.y - q.y));
+            out.1 = out.1.max((p.theta - q.theta).abs());
+        }
+    }
+    out
+}
+
+/// The sentence on the engines that declare Coulomb's law, against one
+/// another and against the model (None with fewer than two at one step).
+fn coulomb_paragraph(study: &Study) -> Option<String> {
+    let coulomb: Vec<&super::EngineRow> = study
+        .engines
+        .iter()
+        .filter(|e| e.status == Status::Released)
+        .filter(|e| e.law.as_ref().is_some_and(|l| l.0 == "coulomb"))
+        .collect();
+    let first = coulomb.first()?;
+    let same: Vec<&&super::EngineRow> = coulomb.iter().filter(|e| e.dt == first.dt).collect();
+    if same.len() < 2 {
+        return None;
+    }
+    let mut d = (0.0f64, 0.0f64);
+    for (i, a) in same.iter().enumerate() {
+        for b in &same[i + 1..] {
+            let x = between(study, &a.name, &b.name, first.dt);
+            d = (d.0.max(x.0), d.1.max(x.1));
+        }
+    }
+    let to_model = same
+        .iter()
+        .map(|e| engine_gaps(study, &e.name, e.dt).0.position_max)
+        .fold(0.0, f64::max);
+    let names: Vec<&str> = same.iter().map(|e| e.name.as_str()).collect();
+    Some(format!(
+        "The {} engines that declare `coulomb` ({}) come to rest within {} m and {} rad of one another on every throw at dt = {} s, {} than any of them comes to the model ({} m at most){}.",
+        same.len(),
+        names.join(", "),
+        sci(d.0),
+        sci(d.1),
+        first.dt,
+        if d.0 < to_model { "closer" } else { "no closer" },
+        sci(to_model),
+        if d.0 < 1e-2 * to_model {
+            "; in rest.svg their dots lie on one another"
+        } else {
+            ""
+        }
+    ))
 }
 
 /// The generated README.md.
@@ -190,13 +306,13 @@ pub fn readme(study: &Study) -> String {
     let g = &study.grid;
     let list = |v: &[f64]| {
         v.iter()
-            .map(|x| format!("{x}"))
+            .map(|x| format!("{}", (x * 1e4).round() / 1e4))
             .collect::<Vec<_>>()
             .join(", ")
     };
     let mut s = String::from("# The slide to rest in every engine\n\n");
     s.push_str(&format!(
-        "Written by `pushval slide-study{}`. The seed's plate (scenario `{}`: 0.25 m square, 1 kg, mu 0.5 on its four corners) is thrown from rest pose 0 with speeds {} m/s, spins {} rad/s and directions {} rad ({} throws), with no pusher, and slides to rest. The dynamic model locates each stop as an event; each engine runs at its default step dt and at dt/2, and the rest rule of its session (speed below 1e-5 m/s for 10 steps) gives its stop time. `throws.csv` has one row per engine, step and throw; `engines.csv` one row per engine; `rest.svg` draws each engine's gaps at its step.\n\n",
+        "Written by `pushval slide-study{}`. The seed's plate (scenario `{}`: 0.25 m square, 1 kg, mu 0.5 on its four corners) is thrown from the origin at angle 0 with speeds {} m/s, spins {} rad/s and directions {} rad ({} throws), with no pusher, and slides to rest. The dynamic model locates each stop as an event; each engine runs at its default step dt and at dt/2, and the rest rule of its session (speed below 1e-5 m/s for 10 steps) gives its stop time. `throws.csv` has one row per engine, step and throw; `engines.csv` one row per engine; `rest.svg` draws each engine's gaps at its step.\n\n",
         if study.quick { " --quick" } else { "" },
         super::SCENE.trim_end_matches(".toml"),
         list(&g.speeds),
@@ -212,6 +328,10 @@ pub fn readme(study: &Study) -> String {
     s.push_str("## Engines that let go\n\n");
     for e in &released {
         s.push_str(&engine_paragraph(study, e));
+        s.push_str("\n\n");
+    }
+    if let Some(p) = coulomb_paragraph(study) {
+        s.push_str(&p);
         s.push_str("\n\n");
     }
     let refused: Vec<_> = study
