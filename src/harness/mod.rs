@@ -22,9 +22,9 @@ pub use dt::{
     choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, trajectory_order, Convergence,
     DtChoice, DtEstimate, DtSource, TrajectoryOrder, DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
 };
-pub use rest::{paired, rest_of, Rest, RestDiff, StopTolerance};
+pub use rest::{paired, rest_of, Rest, RestDiff};
 pub use segments::{analyse_segments, analyse_segments_with, tail_omega, SegmentInfo, SETTLED_REL};
-pub use tolerance::{Catches, Figures, Resolved, CATCH_PROBE};
+pub use tolerance::{Catches, Figures, Resolved, StopTolerance, CATCH_PROBE};
 
 /// Settings of a harness run.
 #[derive(Debug, Clone, Copy)]
@@ -536,8 +536,9 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
         res.catches = Some(catchable(sc, &segments, &reference, &res.value));
         let at = |dt: f64| done.iter().find(|r| r.dt == dt).map(|r| &r.trajectory);
         if let (Some(fine), Some(coarse)) = (at(choice.dt), at(2.0 * choice.dt)) {
-            let stop_model_error = rest::stop_model_error(&problem, &reference, opts.model_tol);
-            if let Some((stop, problem_text)) = rest::stop_tolerance(
+            let stop_model_error =
+                tolerance::stop_model_error(&problem, &reference, opts.model_tol);
+            if let Some((stop, problem_text)) = tolerance::stop_tolerance(
                 sc,
                 &problem,
                 &reference,

@@ -3,7 +3,7 @@
 
 use crate::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
-use super::{Row, Status, Study};
+use super::measure::{EngineRow, Row, Status, Study, SCENE};
 
 /// Values below this are drawn at it on the figure's log axes.
 const FLOOR: f64 = 1e-12;
@@ -68,7 +68,7 @@ pub fn engine_gaps(study: &Study, name: &str, h: f64) -> (Gaps, Gaps) {
 /// step: where each comes to rest beside the model, the rest-position gap against the model's slide distance, angle gap
 /// against the model's turn, stop-time gap against the model's stop time.
 pub fn figure(study: &Study) -> Figure {
-    let released: Vec<&super::EngineRow> = study
+    let released: Vec<&EngineRow> = study
         .engines
         .iter()
         .filter(|e| e.status == Status::Released)
@@ -179,7 +179,7 @@ fn sci(v: f64) -> String {
 }
 
 /// What one engine's numbers say about its stop, from its declared law.
-fn engine_paragraph(study: &Study, e: &super::EngineRow) -> String {
+fn engine_paragraph(study: &Study, e: &EngineRow) -> String {
     let (law_name, law_about) = e
         .law
         .clone()
@@ -261,14 +261,14 @@ fn between(study: &Study, a: &str, b: &str, h: f64) -> (f64, f64) {
 /// The sentence on the engines that declare Coulomb's law, against one
 /// another and against the model (None with fewer than two at one step).
 fn coulomb_paragraph(study: &Study) -> Option<String> {
-    let coulomb: Vec<&super::EngineRow> = study
+    let coulomb: Vec<&EngineRow> = study
         .engines
         .iter()
         .filter(|e| e.status == Status::Released)
         .filter(|e| e.law.as_ref().is_some_and(|l| l.0 == "coulomb"))
         .collect();
     let first = coulomb.first()?;
-    let same: Vec<&&super::EngineRow> = coulomb.iter().filter(|e| e.dt == first.dt).collect();
+    let same: Vec<&&EngineRow> = coulomb.iter().filter(|e| e.dt == first.dt).collect();
     if same.len() < 2 {
         return None;
     }
@@ -314,7 +314,7 @@ pub fn readme(study: &Study) -> String {
     s.push_str(&format!(
         "Written by `pushval slide-study{}`. The seed's plate (scenario `{}`: 0.25 m square, 1 kg, mu 0.5 on its four corners) is thrown from the origin at angle 0 with speeds {} m/s, spins {} rad/s and directions {} rad ({} throws), with no pusher, and slides to rest. The dynamic model locates each stop as an event; each engine runs at its default step dt and at dt/2, and the rest rule of its session (speed below 1e-5 m/s for 10 steps) gives its stop time. `throws.csv` has one row per engine, step and throw; `engines.csv` one row per engine; `rest.svg` draws each engine's gaps at its step.\n\n",
         if study.quick { " --quick" } else { "" },
-        super::SCENE.trim_end_matches(".toml"),
+        SCENE.trim_end_matches(".toml"),
         list(&g.speeds),
         list(&g.spins),
         list(&g.directions),
