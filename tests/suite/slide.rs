@@ -238,3 +238,33 @@ fn slide_study_rows_agree_with_the_model_within_the_step() {
     let engines = pushval::outdir::records(engines_csv(&study).text()).unwrap();
     assert_eq!(engines.len(), study.engines.len());
 }
+
+/// A gated engine that cannot let go is not applicable to a thrown plate:
+/// its row is neither a pass nor a failure, names the release, and the
+/// scenario's other gate still decides.
+#[test]
+fn a_gated_engine_that_cannot_let_go_is_not_applicable() {
+    let mut sc = load(&root().join("scenarios/thrown-square.toml"));
+    sc.gate = vec!["rapier2d".into(), "rapier2d_impulse_disk".into()];
+    if !sc.models.iter().any(|m| m == "rapier2d_impulse_disk") {
+        sc.models.push("rapier2d_impulse_disk".into());
+    }
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let c = report
+        .comparisons
+        .iter()
+        .find(|c| c.model == "rapier2d_impulse_disk")
+        .unwrap();
+    assert_eq!(c.pass, None, "{c:?}");
+    let e = c.error.as_deref().unwrap();
+    assert!(
+        e.starts_with("not applicable") && e.contains("release"),
+        "{e}"
+    );
+    assert!(report.pass());
+    let junit = pushval::output::junit(std::slice::from_ref(&report));
+    assert!(
+        junit.contains("<skipped message=\"not applicable"),
+        "{junit}"
+    );
+}
