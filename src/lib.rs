@@ -20,6 +20,7 @@ pub mod report;
 pub mod scenario_dir;
 pub mod shard;
 pub mod shipped;
+pub mod slide;
 pub mod stress;
 pub mod study;
 pub mod track;

@@ -215,6 +215,19 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Throw the plate on a grid of throws (speed, spin, direction) in every
+    /// engine of the build that can let go, and measure where and when each
+    /// comes to rest against the dynamic model, at its default step and at
+    /// half of it; write OUT/throws.csv, OUT/engines.csv, OUT/rest.svg and
+    /// OUT/README.md.
+    SlideStudy {
+        /// Output folder (replaced whole when the study succeeds).
+        #[arg(long, default_value = "results/slide")]
+        out: PathBuf,
+        /// Reduced grid (for tests): 1 speed, 2 spins, 2 directions.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Measure the gate's power: the smallest model error of each kind the
     /// gate of every scenario in scenarios/ (and `compare`) catches, for the
     /// engines those scenarios gate (a project's own, from the pushval.toml
@@ -880,6 +893,7 @@ fn main() -> ExitCode {
             },
         }),
         Some(Command::TrackStudy { out, quick }) => pushval::track::study::cli(&out, quick),
+        Some(Command::SlideStudy { out, quick }) => pushval::slide::cli(&out, quick),
         Some(Command::Engines) => {
             print!("{}", pushval::engines_table());
             Ok(ExitCode::SUCCESS)

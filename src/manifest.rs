@@ -120,6 +120,16 @@ pub const RULES: &[Rule] = &[
         ],
     },
     Rule {
+        command: "pushval slide-study",
+        source: "src/slide",
+        files: &[
+            "results/slide/throws.csv",
+            "results/slide/engines.csv",
+            "results/slide/rest.svg",
+            "results/slide/README.md",
+        ],
+    },
+    Rule {
         command: "pushval control-study",
         source: "src/control/study.rs",
         files: &[

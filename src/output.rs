@@ -8,12 +8,21 @@
 //!                  "omega_kinematic", "omega_limit_surface", "omega_steady", "tau",
 //!                  "steady_states": [{"omega", "stability", "tau"}] }],
 //!   "models": { MODEL: { "position_max", "theta_max", "omega_steady_rel_max",
-//!                        "pass", "gated", "settings", "wall_time_s", ... } },
+//!                        "pass", "gated", "settings", "wall_time_s",
+//!                        "rest": {"t", "x", "y", "theta"} | null,
+//!                        "rest_against_model": {"position", "theta", "stop_time"} | null,
+//!                        ... } },
 //!   "assumptions": { "all_hold", "pulling", "contact_slip", "force_limit",
 //!                    "sticking", "pulling_impulse", "runaway", "max_force", ... } }
 //! ```
 //! SI units (m, rad, s, rad/s, N). Numbers that do not exist are `null`; no
-//! NaN or infinity is ever written.
+//! NaN or infinity is ever written. `rest` is where and when the model came
+//! to rest after a `[release]` (null without one, or when it did not stop
+//! within `max_duration`); `rest_against_model` is that rest against the
+//! dynamic model's (distance in m, angle in rad, the stop time's
+//! difference in s, the run's minus the model's). On a gated row the rest
+//! pose is held to the position and angle tolerances and the stop time to
+//! `tolerance.stop_time`.
 //!
 //! # `trajectory.csv`
 //! The one trajectory format ([`pushval_model::format`], which `compare`,
@@ -107,6 +116,14 @@ pub fn summary(report: &ScenarioReport) -> Value {
                     "omega_steady_rel_max_richardson2": num(v.richardson2_rel_max),
                 })),
                 "steps": run.map(|r| r.trajectory.stats.steps),
+                "rest": run
+                    .and_then(|r| crate::harness::rest_of(&r.trajectory))
+                    .map_or(Value::Null, |r| r.json()),
+                "rest_against_model": c.rest.as_ref().map_or(Value::Null, |r| json!({
+                    "position": num(r.position),
+                    "theta": num(r.theta),
+                    "stop_time": num(r.stop_time),
+                })),
             }),
         );
     }
@@ -290,6 +307,25 @@ pub fn table(reports: &[ScenarioReport]) -> String {
                     fmt_e(t.value.omega_steady_rel),
                     src(2)
                 ));
+            }
+            if let Some(rest) = &c.rest {
+                match (rest.run, c.model == "dynamic") {
+                    (Some(_), true) => {}
+                    (Some(a), false) => notes.push(format!(
+                        "rest at t = {:.4} s, {} m, {} rad and {:+.2e} s from the model's{}",
+                        a.t,
+                        fmt_e(rest.position),
+                        fmt_e(rest.theta),
+                        rest.stop_time,
+                        c.tolerance.as_ref().and_then(|t| t.stop_time).map_or(
+                            String::new(),
+                            |s| format!(" (stop-time tolerance {} s)", fmt_e(s.value))
+                        )
+                    )),
+                    (None, _) => {
+                        notes.push("did not stop within the release's max_duration".into())
+                    }
+                }
             }
             if c.model == "dynamic" && !flags.is_empty() {
                 notes.push(format!("assumptions fail: {}", flags.join(", ")));

@@ -201,11 +201,13 @@ pub fn dt_estimate(
     let k = 1.0 / (2f64.powf(order) - 1.0);
     let mut position_max: f64 = 0.0;
     let mut theta_max: f64 = 0.0;
-    for (a, b) in coarse.samples.iter().zip(&fine.samples) {
+    // Through a slide the two runs may stop at different times.
+    let pairs = super::rest::paired(coarse, fine).unwrap_or_default();
+    for (a, b) in &pairs {
         position_max = position_max.max(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt());
         theta_max = theta_max.max((a.theta - b.theta).abs());
     }
-    if coarse.samples.len() != fine.samples.len() {
+    if pairs.is_empty() {
         position_max = f64::INFINITY;
         theta_max = f64::INFINITY;
     }
@@ -248,7 +250,7 @@ pub fn choose_engine_dt(
     problem: &Problem,
     segments: &[SegmentInfo],
 ) -> Result<(DtChoice, Vec<EngineRun>), ModelError> {
-    let order = engine.order();
+    let order = engine.order_for(problem);
     let targets = ladder_targets(sc, DT_FRACTION);
     let start = Instant::now();
     if let Some(dt) = sc.engine.dt {
@@ -291,7 +293,8 @@ pub fn choose_engine_dt(
         for r in [a, b] {
             match r {
                 Ok(r) => runs.push(r),
-                Err(e @ ModelError::Adapter(_)) => return Err(e),
+                // No rung will do better: the engine cannot run the problem.
+                Err(e @ (ModelError::Adapter(_) | ModelError::NoRelease { .. })) => return Err(e),
                 Err(_) => {}
             }
         }
@@ -313,7 +316,7 @@ pub fn choose_engine_dt(
         let (a, b) = match pair {
             Ok(p) => p,
             // The engine could not run at all: no rung will do better.
-            Err(e @ ModelError::Adapter(_)) => return Err(e),
+            Err(e @ (ModelError::Adapter(_) | ModelError::NoRelease { .. })) => return Err(e),
             Err(e) => {
                 last_err = Some(e);
                 continue;
@@ -391,13 +394,12 @@ impl TrajectoryOrder {
 }
 
 /// Largest centre-of-mass distance and angle difference between two runs
-/// at their common samples; None when their samples differ in number.
+/// at their common samples (through a slide, each run's rest standing in
+/// past its stop); None when they cannot be paired.
 fn max_differences(a: &Trajectory, b: &Trajectory) -> Option<[f64; 2]> {
-    if a.samples.len() != b.samples.len() {
-        return None;
-    }
+    let pairs = super::rest::paired(a, b)?;
     let mut d = [0.0f64; 2];
-    for (s, r) in a.samples.iter().zip(&b.samples) {
+    for (s, r) in pairs {
         d[0] = d[0].max(((s.x - r.x).powi(2) + (s.y - r.y).powi(2)).sqrt());
         d[1] = d[1].max((s.theta - r.theta).abs());
     }
@@ -513,7 +515,7 @@ pub fn engine_convergence(
     };
     let mid = at(2.0 * h)?;
     let coarse = at(4.0 * h)?;
-    let order = engine.order();
+    let order = engine.order_for(problem);
     let mut ladder: Vec<(f64, &Trajectory)> = done.iter().map(|r| (r.dt, &r.trajectory)).collect();
     ladder.extend([(h, fine), (2.0 * h, &mid), (4.0 * h, &coarse)]);
     let t = ladder_targets(sc, DT_FRACTION);

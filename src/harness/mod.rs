@@ -14,6 +14,7 @@ use crate::registry;
 mod dt;
 mod figures;
 pub mod law;
+pub mod rest;
 mod segments;
 pub mod tolerance;
 
@@ -21,8 +22,9 @@ pub use dt::{
     choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, trajectory_order, Convergence,
     DtChoice, DtEstimate, DtSource, TrajectoryOrder, DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
 };
+pub use rest::{paired, rest_of, Rest, RestDiff};
 pub use segments::{analyse_segments, analyse_segments_with, tail_omega, SegmentInfo, SETTLED_REL};
-pub use tolerance::{Catches, Figures, Resolved, CATCH_PROBE};
+pub use tolerance::{Catches, Figures, Resolved, StopTolerance, CATCH_PROBE};
 
 /// Settings of a harness run.
 #[derive(Debug, Clone, Copy)]
@@ -77,6 +79,8 @@ pub struct Comparison {
     pub convergence: Option<Convergence>,
     /// Gated rows: the tolerances asserted and where they came from.
     pub tolerance: Option<Resolved>,
+    /// With a `[release]`: the run's rest against the model's.
+    pub rest: Option<RestDiff>,
 }
 
 /// Everything a scenario run produced.
@@ -178,16 +182,21 @@ pub fn compare_trajectory(
     steady: SteadyRead,
     tol: Option<&Figures>,
 ) -> Comparison {
+    let problem = sc.problem();
+    // Runs through a slide stop at different times: past its stop the
+    // shorter one is compared by its rest.
+    let pairs = paired(tr, reference).unwrap_or_default();
     let mut position_max: f64 = 0.0;
     let mut theta_max: f64 = 0.0;
-    for (a, b) in tr.samples.iter().zip(&reference.samples) {
+    for (a, b) in &pairs {
         position_max = position_max.max(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt());
         theta_max = theta_max.max((a.theta - b.theta).abs());
     }
-    if tr.samples.len() != reference.samples.len() {
+    if pairs.is_empty() {
         position_max = f64::INFINITY;
         theta_max = f64::INFINITY;
     }
+    let rest = rest::rest_diff(&problem, reference, tr);
     let mut omega_rel: Option<f64> = None;
     let mut steady_errors: Vec<(usize, f64)> = Vec::new();
     for s in segments.iter().filter(|s| s.settles()) {
@@ -208,7 +217,7 @@ pub fn compare_trajectory(
         // Where each failing figure first exceeds its tolerance: the first
         // sample time and its segment (a switch time belongs to the segment
         // it starts), or the first settled segment past the steady tolerance.
-        let times = sc.problem().segment_times();
+        let times = problem.segment_times();
         let segment_of = |t: f64| {
             times
                 .iter()
@@ -216,12 +225,15 @@ pub fn compare_trajectory(
                 .unwrap_or(times.len().saturating_sub(1))
         };
         let first = |exceeds: &dyn Fn(&Sample, &Sample) -> bool| {
-            tr.samples
+            pairs
                 .iter()
-                .zip(&reference.samples)
                 .find(|(a, b)| exceeds(a, b))
                 .map_or(String::new(), |(a, _)| {
-                    format!(" (first at t = {:.3} s, segment {})", a.t, segment_of(a.t))
+                    if a.t >= times.last().map_or(0.0, |t| t.1) && problem.release.is_some() {
+                        format!(" (first at t = {:.3} s, in the slide)", a.t)
+                    } else {
+                        format!(" (first at t = {:.3} s, segment {})", a.t, segment_of(a.t))
+                    }
                 })
         };
         if !(position_max <= tol.position_max) {
@@ -253,6 +265,9 @@ pub fn compare_trajectory(
             }
         }
     }
+    if let (Some(tol), Some(r)) = (tol, &rest) {
+        failed.extend(rest_failures(r, tol));
+    }
     Comparison {
         model: name.into(),
         position_max,
@@ -263,6 +278,41 @@ pub fn compare_trajectory(
         error: None,
         convergence: None,
         tolerance: None,
+        rest,
+    }
+}
+
+/// Why a run's rest fails the gate: it did not stop where the model did,
+/// or its rest pose is farther from the model's than the position and
+/// angle tolerances (the stop time is held to its own tolerance in
+/// [`run_scenario`]).
+fn rest_failures(r: &RestDiff, tol: &Figures) -> Vec<String> {
+    match (r.run, r.reference) {
+        (None, Some(m)) => vec![format!(
+            "the plate did not stop within the release's max_duration; the model stops at t = {:.4} s",
+            m.t
+        )],
+        (Some(a), None) => vec![format!(
+            "the plate stopped at t = {:.4} s; the model is still moving at the release's max_duration",
+            a.t
+        )],
+        (None, None) => Vec::new(),
+        (Some(_), Some(_)) => {
+            let mut out = Vec::new();
+            if !(r.position <= tol.position_max) {
+                out.push(format!(
+                    "rest position {:.3e} m from the model's > {:.3e} m",
+                    r.position, tol.position_max
+                ));
+            }
+            if !(r.theta <= tol.theta_max) {
+                out.push(format!(
+                    "rest angle {:.3e} rad from the model's > {:.3e} rad",
+                    r.theta, tol.theta_max
+                ));
+            }
+            out
+        }
     }
 }
 
@@ -365,6 +415,9 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
     let mut runs: Vec<ModelRun> = Vec::new();
     let mut unavailable: Vec<(String, String)> = Vec::new();
     let mut failures: Vec<(String, String)> = Vec::new();
+    // Engines that cannot let go, on a problem with a release: not
+    // applicable to it (neither a pass nor a failed run).
+    let mut no_release: Vec<(String, String)> = Vec::new();
     // Per gated engine: the engine, its time step and the runs its choice made.
     let mut gated_runs: Vec<(Box<dyn Engine>, DtChoice, Vec<EngineRun>)> = Vec::new();
     for name in names {
@@ -438,6 +491,9 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             // An engine that could not run at all (an outside process that
             // failed, timed out or wrote malformed rows) is an input error.
             Err(e @ ModelError::Adapter(_)) => return Err(e),
+            Err(e @ ModelError::NoRelease { .. }) => {
+                no_release.push((name.to_string(), e.to_string()));
+            }
             Err(e) => failures.push((name.to_string(), e.to_string())),
         }
     }
@@ -478,6 +534,26 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             .extend(tolerance::ladder_note(&res, choice.met, &choice.targets));
         res.order = Some(order);
         res.catches = Some(catchable(sc, &segments, &reference, &res.value));
+        let at = |dt: f64| done.iter().find(|r| r.dt == dt).map(|r| &r.trajectory);
+        if let (Some(fine), Some(coarse)) = (at(choice.dt), at(2.0 * choice.dt)) {
+            let stop_model_error =
+                tolerance::stop_model_error(&problem, &reference, opts.model_tol);
+            if let Some((stop, problem_text)) = tolerance::stop_tolerance(
+                sc,
+                &problem,
+                &reference,
+                choice.dt,
+                coarse,
+                fine,
+                res.order
+                    .as_ref()
+                    .map_or(choice.order, |o| o.estimate_order),
+                stop_model_error,
+            ) {
+                res.stop_time = Some(stop);
+                res.problems.extend(problem_text);
+            }
+        }
         gates.push((engine.name().to_string(), conv, res));
     }
     let mut comparisons: Vec<Comparison> = runs
@@ -491,6 +567,19 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
                 if !res.problems.is_empty() {
                     c.failed.extend(res.problems.iter().cloned());
                     c.pass = Some(false);
+                }
+                if let (Some(stop), Some(rest)) = (&res.stop_time, &c.rest) {
+                    if rest.run.is_some() && rest.reference.is_some()
+                        && !(rest.stop_time.abs() <= stop.value)
+                    {
+                        c.failed.push(format!(
+                            "stop time {:+.3e} s from the model's (t = {:.4} s): more than {:.3e} s",
+                            rest.stop_time,
+                            rest.reference.map_or(f64::NAN, |m| m.t),
+                            stop.value
+                        ));
+                        c.pass = Some(false);
+                    }
                 }
                 c.convergence = Some(conv.clone());
                 c.tolerance = Some(res.clone());
@@ -516,6 +605,23 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             error: Some(e),
             convergence: None,
             tolerance: None,
+            rest: None,
+        });
+    }
+    for (name, why) in no_release {
+        comparisons.push(Comparison {
+            model: name,
+            position_max: f64::NAN,
+            theta_max: f64::NAN,
+            omega_steady_rel_max: None,
+            pass: None,
+            failed: vec![],
+            error: Some(format!(
+                "not applicable: the scenario releases the plate and {why}"
+            )),
+            convergence: None,
+            tolerance: None,
+            rest: None,
         });
     }
     for (name, why) in unavailable {
@@ -529,6 +635,7 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             error: Some(format!("not available in this build: {why}")),
             convergence: None,
             tolerance: None,
+            rest: None,
         });
     }
     Ok(ScenarioReport {

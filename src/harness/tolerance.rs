@@ -12,6 +12,7 @@ use pushval_scenario::{Limit, Scenario};
 use super::dt::{Convergence, DtEstimate, DtSource, TrajectoryOrder};
 use super::figures::limits;
 pub use super::figures::{ladder_targets, Figures, AUTO_TARGET};
+use super::rest::rest_of;
 
 /// An `"auto"` tolerance is this multiple of the engine's self-convergence
 /// estimate (itself not trusted below [`AUTO_TARGET`]): the estimate assumes
@@ -69,6 +70,8 @@ pub struct Resolved {
     /// What the row must say without failing: the order not observed, the
     /// ladder that missed its target and what that means for the verdict.
     pub notes: Vec<String>,
+    /// With a `[release]`: the stop time's tolerance (always auto).
+    pub stop_time: Option<StopTolerance>,
 }
 
 impl Resolved {
@@ -105,6 +108,7 @@ impl Resolved {
             "observed_order_on": self.order.as_ref().map(|o| o.on.clone()),
             "estimate_order": self.order.as_ref().map(|o| o.estimate_order),
             "notes": self.notes,
+            "stop_time": self.stop_time.as_ref().map_or(serde_json::Value::Null, |t| t.json()),
         })
     }
 }
@@ -235,6 +239,7 @@ pub fn resolve(sc: &Scenario, estimate: Option<&DtEstimate>, model_error: Figure
         dt: None,
         order: None,
         notes: Vec::new(),
+        stop_time: None,
     }
 }
 
@@ -389,7 +394,8 @@ pub fn model_error(problem: &Problem, reference: &Trajectory, model_tol: f64) ->
         theta_max: 0.0,
         omega_steady_rel: 0.0,
     };
-    for (a, b) in loose.samples.iter().zip(&reference.samples) {
+    let pairs = super::rest::paired(&loose, reference).unwrap_or_default();
+    for (a, b) in pairs {
         f.position_max = f
             .position_max
             .max(((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt());
@@ -406,4 +412,131 @@ pub fn model_error(problem: &Problem, reference: &Trajectory, model_tol: f64) ->
         f.omega_steady_rel = f.omega_steady_rel.max(e);
     }
     f
+}
+
+/// The stop time's tolerance for a gated engine, with what it came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopTolerance {
+    /// The tolerance on `|t_stop(run) − t_stop(model)|` (s).
+    pub value: f64,
+    /// The engine's self-convergence estimate of its stop time at its
+    /// step, `|t(2h) − t(h)| / (2^p − 1)` (s); infinite when one of the two
+    /// runs did not stop.
+    pub estimate: f64,
+    /// The step h (s): the rest rule reads the stop at a step's end, so no
+    /// estimate below it is trusted.
+    pub resolution: f64,
+    /// The dynamic model's own error in its stop time (s): its distance from
+    /// a run at a 100 times looser tolerance.
+    pub model_error: f64,
+    /// The most the tolerance may be (s): the time in which the plate, at
+    /// its speed when released, covers the position ceiling.
+    pub ceiling: f64,
+}
+
+impl StopTolerance {
+    /// The record in summary.json.
+    pub fn json(&self) -> serde_json::Value {
+        use crate::outdir::json_num as num;
+        serde_json::json!({
+            "value": num(self.value),
+            "source": "auto",
+            "rule": format!("auto = {AUTO_FACTOR} x max(engine self-convergence estimate of its stop time at its dt, dt) + model error; never above the ceiling (position ceiling / the plate's speed at the release; the row fails instead)"),
+            "engine_estimate": num(self.estimate),
+            "resolution": num(self.resolution),
+            "model_error": num(self.model_error),
+            "ceiling": num(self.ceiling),
+        })
+    }
+}
+
+/// The plate's speed when the pusher lets go (m/s): `|v_cm| + |ω| L`, `L`
+/// the farthest support from the centre of mass (the rest rule's speed).
+/// `omega` is ω at the release (the model's).
+pub fn release_speed(problem: &Problem, omega: f64) -> f64 {
+    let body = &problem.body;
+    let v = match problem.pushes.last() {
+        // The contact moves with the pusher: v_cm = v_c n_φ − ω D p_c (object frame).
+        Some(p) => {
+            let pc = body.contact();
+            p.velocity() - omega * pushval_model::Vec2::new(-pc.y, pc.x)
+        }
+        None => problem.initial.velocity,
+    };
+    let reach = body
+        .supports()
+        .map(|s| s.position.norm())
+        .fold(0.0, f64::max);
+    v.norm() + omega.abs() * reach
+}
+
+/// The stop time's tolerance for an engine of order `order` whose runs at
+/// `h` and `2h` are `fine` and `coarse`; with the sentence that fails the
+/// row when the engine's accuracy cannot back it below its ceiling. None
+/// when the problem has no release or the model did not stop.
+#[allow(clippy::too_many_arguments)]
+pub fn stop_tolerance(
+    sc: &Scenario,
+    problem: &Problem,
+    reference: &Trajectory,
+    h: f64,
+    coarse: &Trajectory,
+    fine: &Trajectory,
+    order: f64,
+    model_error: f64,
+) -> Option<(StopTolerance, Option<String>)> {
+    problem.release?;
+    rest_of(reference)?;
+    let estimate = match (rest_of(coarse), rest_of(fine)) {
+        (Some(c), Some(f)) => (c.t - f.t).abs() / (2f64.powf(order) - 1.0),
+        _ => f64::INFINITY,
+    };
+    let omega0 = reference
+        .samples
+        .iter()
+        .rev()
+        .find(|s| s.t <= reference.slide.as_ref().map_or(0.0, |s| s.t_release) + 1e-12)
+        .map_or(problem.initial.omega, |s| s.omega);
+    let speed = release_speed(problem, omega0);
+    let ceiling = if speed > 0.0 {
+        sc.tolerance.auto_ceiling[0] / speed
+    } else {
+        f64::INFINITY
+    };
+    let auto = AUTO_FACTOR * estimate.max(h) + model_error;
+    let problem_text = (!(auto <= ceiling)).then(|| {
+        format!(
+            "the engine cannot back an auto stop_time at dt = {h:.4e} s: {AUTO_FACTOR} x max(its self-convergence estimate {estimate:.2e} s, dt) + model error {model_error:.2e} s = {auto:.2e} s is above the stop-time ceiling {ceiling:.2e} s (the position ceiling {:.2e} m at the release speed {speed:.3} m/s); set a finer [engine] dt",
+            sc.tolerance.auto_ceiling[0]
+        )
+    });
+    Some((
+        StopTolerance {
+            value: auto.min(ceiling),
+            estimate,
+            resolution: h,
+            model_error,
+            ceiling,
+        },
+        problem_text,
+    ))
+}
+
+/// The dynamic model's own error in its stop time (s): its distance from a
+/// run at a 100 times looser tolerance; 0 when either does not stop.
+pub fn stop_model_error(problem: &Problem, reference: &Trajectory, model_tol: f64) -> f64 {
+    if problem.release.is_none() {
+        return 0.0;
+    }
+    let loose = DynamicModel {
+        integrator: Integrator::Dop853 {
+            tol: 100.0 * model_tol,
+        },
+        ..Default::default()
+    }
+    .simulate(problem);
+    match (loose.ok().as_ref().and_then(rest_of), rest_of(reference)) {
+        (Some(a), Some(b)) => (a.t - b.t).abs(),
+        _ => 0.0,
+    }
 }

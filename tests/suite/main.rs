@@ -26,6 +26,7 @@ mod report;
 mod scenarios;
 mod sessions;
 mod sessions_parity;
+mod slide;
 mod stress;
 mod study;
 mod track;

@@ -123,6 +123,12 @@ pub struct EngineInfo {
     /// The order of accuracy in the time step the model's steady ω and
     /// trajectory show (measured: see the adapter's README).
     pub order: f64,
+    /// The order in the time step its free slide shows when the problem
+    /// has a release (measured: see the adapter's README); None: the same as
+    /// [`EngineInfo::order`]. A slide's friction is integrated once per step
+    /// and its stop read at a step's end, so it may converge more slowly
+    /// than the pushes do.
+    pub release_order: Option<f64>,
     /// The time step used when neither the scenario nor the ladder sets one (s).
     pub default_dt: f64,
     /// The `[engine]` keys the model reads, besides `dt`.
@@ -154,6 +160,7 @@ impl EngineInfo {
             version: format!("{} {}", engine_crate.name, engine_crate.version),
             engine_crate,
             order,
+            release_order: None,
             default_dt,
             options: OptionKeys::Listed(&[]),
             gateable: true,
@@ -172,6 +179,13 @@ impl EngineInfo {
     #[must_use]
     pub fn with_version(mut self, version: impl Into<String>) -> Self {
         self.version = version.into();
+        self
+    }
+
+    /// The order its free slide shows ([`EngineInfo::release_order`]).
+    #[must_use]
+    pub fn with_release_order(mut self, order: f64) -> Self {
+        self.release_order = Some(order);
         self
     }
 
@@ -269,6 +283,16 @@ impl dyn Engine + '_ {
     /// [`EngineInfo::order`].
     pub fn order(&self) -> f64 {
         self.info().order
+    }
+    /// The order the ladder assumes for `problem`: [`EngineInfo::release_order`]
+    /// when the problem has a release and the engine declares one, else
+    /// [`EngineInfo::order`].
+    pub fn order_for(&self, problem: &Problem) -> f64 {
+        let info = self.info();
+        match (problem.release, info.release_order) {
+            (Some(_), Some(p)) => p,
+            _ => info.order,
+        }
     }
     /// [`EngineInfo::gateable`].
     pub fn gateable(&self) -> bool {

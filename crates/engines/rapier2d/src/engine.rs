@@ -68,7 +68,11 @@ impl Rapier2dModel {
                 order,
                 settings.dt,
             )
-            .with_options(OptionKeys::Listed(keys)),
+            .with_options(OptionKeys::Listed(keys))
+            // The slide's implicit Coulomb impulses take each support's slip
+            // direction at the step's end and the stop is read at a step's
+            // end: first order whatever the push's mode (README, "The slide").
+            .with_release_order(1.0),
             settings,
         }
     }
