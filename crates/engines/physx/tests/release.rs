@@ -105,8 +105,8 @@ const PUSHES: [Push; 2] = [
 /// its first `n` steps (`T = n h`) the plate moves on with the velocity it
 /// had: friction slows the centre of mass by at most `a_max` (m/s²), so the
 /// displacement differs from `v T` by at most `a_max T²` (twice the
-/// semi-implicit Euler bound `½ a T² (1 + 1/n)`). Returns the pushed state
-/// and the session after a full release (`stops`: whether it must rest).
+/// semi-implicit Euler bound `½ a T² (1 + 1/n)`). A full release from the
+/// same push must then come to rest when `stops`.
 fn continues_from_the_pushed_state(e: &dyn Engine, h: f64, a_max: f64, stops: bool) {
     let p = problem(PUSHES.to_vec(), Initial::default());
     let t = 10.0 * h;
