@@ -56,6 +56,16 @@ The scene
   step. This is the MuJoCo adapter's carriage (mujoco_push.py) in joints.
 * Settling: before the first push the plate rests 0.2 s with the pusher
   still; its height then is the rest height the rise is measured from.
+* The release (protocol 3's release; the step receives no push): a plant
+  cannot lose a joint once finalized, so the plate is rebuilt alone, a free
+  body, with its pose and spatial velocity carried over (a plate thrown
+  without pushes gets its initial velocity and omega there), and slides on
+  its feet to rest under the approximation's friction. TAMSI, Lagged and
+  Similar regularise Coulomb's law below the stiction tolerance v_s
+  (friction mu N u / v_s there) and solve it implicitly in the velocities,
+  so near the stop the slip decays (time constant about v_s / (mu g),
+  0.2 ms at the defaults) instead of reversing: no chattering; SAP's convex
+  friction is implicit too.
 
 Options (command line; a scenario's [engine] table overrides them with the
 same names: stiction_tolerance, relaxation_time, hunt_crossley_dissipation,
@@ -156,6 +166,7 @@ class DrakePush(Engine):
     """The plate on point feet in Drake's MultibodyPlant (discrete)."""
 
     name = "drake_push.py"
+    can_release = True
 
     @classmethod
     def add_arguments(cls, parser):
@@ -208,9 +219,10 @@ class DrakePush(Engine):
     # ------------------------------------------------------------------
     # The scene
 
-    def build(self, h):
+    def build(self, h, released=False):
         """Builds the diagram with time step h (s); returns nothing, sets
-        self.diagram, self.plant, self.context, self.plant_context."""
+        self.diagram, self.plant, self.context, self.plant_context.
+        ``released``: the plate alone, a free body (no pusher chain)."""
         p, s = self.problem, self.settings
         G, M, MBP, T = self.geometry, self.dmath, self.mbp, self.tree
         np = self.np
@@ -235,19 +247,22 @@ class DrakePush(Engine):
         def inertia(mass, ixx, iyy, izz):
             return T.SpatialInertia.MakeFromCentralInertia(mass, np.zeros(3), T.RotationalInertia(ixx, iyy, izz))
 
-        bx = plant.AddRigidBody("carriage_x", pusher, inertia(mc, mc, mc, mc))
-        by = plant.AddRigidBody("carriage_y", pusher, inertia(mc, mc, mc, mc))
-        tip = plant.AddRigidBody("tip", pusher, inertia(mt, mt * 1e-4, mt * 1e-4, mt * 1e-4))
         plate = plant.AddRigidBody("plate", obj, inertia(m, 0.5 * i_z, 0.5 * i_z, i_z))
-        jx = plant.AddJoint(T.PrismaticJoint("x", plant.world_frame(), bx.body_frame(), [1.0, 0.0, 0.0]))
-        jy = plant.AddJoint(T.PrismaticJoint("y", bx.body_frame(), by.body_frame(), [0.0, 1.0, 0.0]))
-        jz = plant.AddJoint(T.PrismaticJoint("z", by.body_frame(), tip.body_frame(), [0.0, 0.0, 1.0]))
-        rc = p.contact_offset
-        contact_frame = plant.AddFrame(
-            T.FixedOffsetFrame("contact", plate.body_frame(), M.RigidTransform([rc[0], rc[1], 0.0])))
-        ball = plant.AddJoint(T.BallRpyJoint("ball", tip.body_frame(), contact_frame))
+        joints = None
+        if not released:
+            bx = plant.AddRigidBody("carriage_x", pusher, inertia(mc, mc, mc, mc))
+            by = plant.AddRigidBody("carriage_y", pusher, inertia(mc, mc, mc, mc))
+            tip = plant.AddRigidBody("tip", pusher, inertia(mt, mt * 1e-4, mt * 1e-4, mt * 1e-4))
+            jx = plant.AddJoint(T.PrismaticJoint("x", plant.world_frame(), bx.body_frame(), [1.0, 0.0, 0.0]))
+            jy = plant.AddJoint(T.PrismaticJoint("y", bx.body_frame(), by.body_frame(), [0.0, 1.0, 0.0]))
+            jz = plant.AddJoint(T.PrismaticJoint("z", by.body_frame(), tip.body_frame(), [0.0, 0.0, 1.0]))
+            rc = p.contact_offset
+            contact_frame = plant.AddFrame(
+                T.FixedOffsetFrame("contact", plate.body_frame(), M.RigidTransform([rc[0], rc[1], 0.0])))
+            ball = plant.AddJoint(T.BallRpyJoint("ball", tip.body_frame(), contact_frame))
+            joints = (jx, jy, jz, ball)
+            plant.gravity_field().set_enabled(pusher, False)
         plant.gravity_field().set_gravity_vector([0.0, 0.0, -p.gravity])
-        plant.gravity_field().set_enabled(pusher, False)
 
         # Contact: ground rigid, feet compliant; μ combined to the support's.
         mus = [sup.mu for sup in p.supports]
@@ -281,7 +296,7 @@ class DrakePush(Engine):
         self.context = self.simulator.get_mutable_context()
         self.plant_context = plant.GetMyMutableContextFromRoot(self.context)
         self.n = 0
-        self.body_plate, self.joints = plate, (jx, jy, jz, ball)
+        self.body_plate, self.joints = plate, joints
         self.h = h
         self.inspector = _sg.model_inspector()
         self.sg = _sg
@@ -310,11 +325,31 @@ class DrakePush(Engine):
 
     def rebuild(self, h):
         """A new plant with step h, the state carried over."""
+        if self.joints is None:
+            self.let_go(h)
+            return
         q = self.plant.GetPositions(self.plant_context).copy()
         v = self.plant.GetVelocities(self.plant_context).copy()
         self.build(h)
         self.plant.SetPositions(self.plant_context, q)
         self.plant.SetVelocities(self.plant_context, v)
+
+    def let_go(self, h, throw=None):
+        """The plate alone (a free body, the pusher chain gone) in a new
+        plant with step h, its pose and spatial velocity carried over;
+        ``throw`` (vx, vy, omega) replaces its horizontal velocity and its
+        spin about the vertical."""
+        plant, pc = self.plant, self.plant_context
+        X = plant.EvalBodyPoseInWorld(pc, self.body_plate)
+        V = plant.EvalBodySpatialVelocityInWorld(pc, self.body_plate)
+        w, v = V.rotational().copy(), V.translational().copy()
+        if throw is not None:
+            v[0], v[1], w[2] = throw
+        from pydrake.multibody.math import SpatialVelocity
+
+        self.build(h, released=True)
+        self.plant.SetFreeBodyPose(self.plant_context, self.body_plate, X)
+        self.plant.SetFreeBodySpatialVelocity(self.plant_context, self.body_plate, SpatialVelocity(w, v))
 
     # ------------------------------------------------------------------
     # Diagnostics
@@ -419,9 +454,14 @@ class DrakePush(Engine):
                                  f"(relative {abs(nk - sup.normal_force) / sup.normal_force:.2e}), mu {sup.mu}\n")
         # 2. The start: moving with the first push at ω, or at rest (the
         # first step's velocity change is then the start's switch).
-        p0 = problem.pushes[0]
+        p0 = problem.pushes[0] if problem.pushes else None
         self.keep_omega = ini.from_rest and problem.switching == "continuous"
-        if not ini.from_rest:
+        # A plate thrown (no pushes) gets its initial velocity and ω at the
+        # release, the first step.
+        self.throw = (*ini.velocity, ini.omega) if p0 is None else None
+        if p0 is None:
+            w = ini.omega
+        elif not ini.from_rest:
             w = ini.omega
             cvx, cvy = p0.world_velocity(yaw)
             self.set_carriage(cvx, cvy)
@@ -464,11 +504,14 @@ class DrakePush(Engine):
         self.set_carriage(vx, vy)
 
     def step(self, push, h):
-        if abs(h - self.h) > 1e-12 * self.h:
+        if push is None and self.joints is not None:
+            self.let_go(h, self.throw)
+        elif abs(h - self.h) > 1e-12 * self.h:
             self.rebuild(h)
-        _com, yaw, wz, _v, _w = self.pose()
-        cvx, cvy = push.world_velocity(yaw + 0.5 * h * wz)
-        self.drive(cvx, cvy)
+        if push is not None:
+            _com, yaw, wz, _v, _w = self.pose()
+            cvx, cvy = push.world_velocity(yaw + 0.5 * h * wz)
+            self.drive(cvx, cvy)
         try:
             self.advance()
         except RuntimeError as e:

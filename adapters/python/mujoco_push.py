@@ -28,6 +28,17 @@ by side on one problem:
     it), 100 iterations, impratio 1, no noslip, contact solref 0.02 1 and
     solimp 0.9 0.95 0.001 0.5 2.
 
+Released (protocol 3's release; the step receives no push), the connect is
+turned off (data.eq_active) and the carriage stopped: the plate slides on its
+feet under MuJoCo's soft contact friction until at rest. Sliding, a foot's
+friction is the cone's bound (elliptic: mu N against the slip; pyramidal: the
+diamond |f1| + |f2| <= mu N of the world axes); near the stop friction is a
+soft constraint, the slip decaying as du/dt = -u/tau, tau = d_max
+timeconst/(2 d) (10 to 10.6 ms here), so it never reverses (no chattering)
+but the rest comes about 70 ms after Coulomb's stop (as in
+crates/engines/mujoco). A plate thrown without pushes starts the slide with
+its initial velocity and omega.
+
 Options:
   --cone pyramidal|elliptic   MuJoCo's friction cone (default pyramidal)
 """
@@ -150,8 +161,11 @@ class MujocoPush(Engine):
         # For the record (pushval shows an adapter's stderr only on errors).
         print(f"mujoco_push.py: MuJoCo {mujoco.mj_versionString()}, {self.args.cone} cone", file=sys.stderr)
 
+    can_release = True
+
     def reset(self, problem):
         mujoco = self.mj
+        self.released = False
         dt = problem.dt
         n = len(problem.supports)
         forces = [s.friction for s in problem.supports]
@@ -175,9 +189,13 @@ class MujocoPush(Engine):
         # 2. The start.
         pc = problem.contact_offset
         ini = problem.initial
-        p0 = problem.pushes[0]
+        p0 = problem.pushes[0] if problem.pushes else None
         yaw, _ = yaw_and_omega(data)
-        if ini.from_rest:
+        if p0 is None:
+            # Thrown: the slide starts with the initial velocity and omega
+            # (the carriage stays at rest; the first step releases).
+            lin, w = tuple(ini.velocity), ini.omega
+        elif ini.from_rest:
             lin, w = (0.0, 0.0), 0.0
         else:
             w = ini.omega
@@ -188,7 +206,7 @@ class MujocoPush(Engine):
         mat = data.xmat[OBJECT]
         data.qvel[0:3] = [lin[0], lin[1], 0.0]
         data.qvel[3:6] = [mat[6] * w, mat[7] * w, mat[8] * w]
-        cvx, cvy = p0.world_velocity(yaw)
+        cvx, cvy = p0.world_velocity(yaw) if p0 is not None else (0.0, 0.0)
         data.qvel[CARRIAGE_DOF:CARRIAGE_DOF + 3] = [cvx, cvy, 0.0]
         self.theta = ini.theta + math.remainder(yaw - ini.theta, 2 * math.pi)
         self.t = 0.0
@@ -198,8 +216,15 @@ class MujocoPush(Engine):
         mujoco, model, data = self.mj, self.model, self.data
         model.opt.timestep = h
         yaw, wz = yaw_and_omega(data)
-        # The carriage follows the pusher's direction at the step's middle.
-        cvx, cvy = push.world_velocity(yaw + 0.5 * h * wz)
+        if push is None:
+            if not self.released:
+                # The pusher lets go: its connect off, the carriage still.
+                data.eq_active[0] = 0
+                self.released = True
+            cvx, cvy = 0.0, 0.0
+        else:
+            # The carriage follows the pusher's direction at the step's middle.
+            cvx, cvy = push.world_velocity(yaw + 0.5 * h * wz)
         data.qvel[CARRIAGE_DOF] = cvx
         data.qvel[CARRIAGE_DOF + 1] = cvy
         mujoco.mj_step(model, data)

@@ -26,6 +26,18 @@ speed * R(theta) (cos phi, sin phi), joined to the plate's contact point by a
 point-to-point constraint. Bullet steps semi-implicitly (velocities, then
 positions): first order in dt.
 
+Released (protocol 3's release; the step receives no push), the pusher's
+constraint is removed and the plate slides freely. In forces mode each
+step's support impulses are implicit Coulomb friction (coulomb_slide.py:
+each within its disc |P_i| <= mu_i N_i h, jointly the ones that leave the
+supports' slip zero where the discs allow), given to the plate as its
+velocity before Bullet's step moves the pose: a plate one step can stop comes
+to rest instead of its slip reversing every step. In contact mode Bullet's
+own contact friction slides it: velocity-level friction rows whose impulses
+are clamped by mu lambda, so a slip one step can remove is removed and the
+plate sticks. A plate thrown without pushes starts with its initial velocity
+and omega.
+
 In contact mode the constraint must not hold the plate up: a point-to-point
 joint fixes all three coordinates, and a pusher at a fixed height carries
 part of the weight (the plate then hangs from the pusher and rests on its far
@@ -50,6 +62,9 @@ except ImportError:  # run from the source tree without the wheel installed
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
     from pushval.adapter import AdapterError, Engine, State, main
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from coulomb_slide import coulomb_impulses  # noqa: E402
+
 THICK = 0.005
 FOOT = 0.0025
 SLIDER_MASS = 1e-3
@@ -62,6 +77,7 @@ class PyBulletPush(Engine):
     name = "pybullet_push.py"
     step_rule = "round"
     switching_rules = ("impulsive",)
+    can_release = True
 
     @classmethod
     def add_arguments(cls, parser):
@@ -198,9 +214,15 @@ class PyBulletPush(Engine):
             cid = p.createConstraint(body, -1, pusher, -1, p.JOINT_POINT2POINT, [0, 0, 0], [rc[0], rc[1], 0], [0, 0, 0], physicsClientId=client)
         p.changeConstraint(cid, maxForce=1e6, erp=0.8, physicsClientId=client)
         self.pusher = pusher
+        self.constraint = cid
+        self.mass, self.i_cm = m, i_cm
 
         w0 = 0.0 if ini.from_rest else ini.omega
-        if not ini.from_rest:
+        if not problem.pushes:
+            # Thrown: the slide starts with the initial velocity and omega.
+            vx, vy = ini.velocity
+            p.resetBaseVelocity(body, [vx, vy, 0], [0, 0, ini.omega], physicsClientId=client)
+        elif not ini.from_rest:
             # The plate moving with the first push at omega = w0.
             c, s = math.cos(th0), math.sin(th0)
             px, py = c * rc[0] - s * rc[1], s * rc[0] + c * rc[1]
@@ -235,6 +257,16 @@ class PyBulletPush(Engine):
         rc = self.rc
         return [pos[0] + c * rc[0] - s * rc[1], pos[1] + s * rc[0] + c * rc[1], pos[2]]
 
+    def slide(self, yaw, h):
+        """Forces mode, released: the step's implicit Coulomb support
+        impulses, given to the plate as its velocity before the step."""
+        p, client, body = self.p, self.client, self.body
+        v, w = p.getBaseVelocity(body, physicsClientId=client)
+        c, s = math.cos(yaw), math.sin(yaw)
+        sup = [((c * sx - s * sy, s * sx + c * sy), max(mu * nf, 0.0) * h) for sx, sy, mu, nf in self.sup]
+        _, (vx, vy), wz = coulomb_impulses(self.mass, self.i_cm, (v[0], v[1]), w[2], sup)
+        p.resetBaseVelocity(body, [vx, vy, v[2]], [w[0], w[1], wz], physicsClientId=client)
+
     def step(self, push, h):
         p, client, body = self.p, self.client, self.body
         if h != self.h:
@@ -242,6 +274,13 @@ class PyBulletPush(Engine):
             self.h = h
         pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
         yaw = p.getEulerFromQuaternion(orn)[2]
+        if push is None:
+            if self.constraint is not None:
+                p.removeConstraint(self.constraint, physicsClientId=client)
+                self.constraint = None
+            if self.args.mode == "forces":
+                self.slide(yaw, h)
+            return self.finish_step()
         if self.args.mode == "forces":
             v, w = p.getBaseVelocity(body, physicsClientId=client)
             c, s = math.cos(yaw), math.sin(yaw)
@@ -260,6 +299,11 @@ class PyBulletPush(Engine):
         p.resetBasePositionAndOrientation(self.pusher, target, [0, 0, 0, 1], physicsClientId=client)
         if self.slider:
             p.applyExternalForce(self.pusher, 0, [0, 0, SLIDER_MASS * self.g], [0, 0, 0], p.LINK_FRAME, physicsClientId=client)
+        return self.finish_step()
+
+    def finish_step(self):
+        """Steps Bullet and reads the plate."""
+        p, client, body = self.p, self.client, self.body
         p.stepSimulation(physicsClientId=client)
         pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
         v, w = p.getBaseVelocity(body, physicsClientId=client)

@@ -20,6 +20,18 @@
 //! nanosecond grid ([`clock`]) that lands every step sequence exactly on the
 //! switch times; the recorded times are the ones the engine integrated.
 //!
+//! **The release** despawns the pusher's joint (avian2d's revolute joint,
+//! avian3d's pin) and stops the pusher; the plate slides until at rest
+//! (pushval's rule: `|v_cm| + |ω| L` below 1e-5 m/s for 10 steps). In
+//! avian2d the supports' friction, applied by hand in the substep loop,
+//! becomes the free slide's implicit Coulomb impulses
+//! (`pushval_engine::slide::coulomb_impulses`, each within its disc
+//! `μᵢNᵢ h_s` and capped at what stops its slip within the substep): a
+//! fixed force would reverse a slip smaller than one substep's friction
+//! removes, every substep, and never rest. avian3d slides on Avian's own
+//! contact friction, which is already implicit (each contact's impulse
+//! clamped to its disc, see [`predict`]), so the plate sticks at the stop.
+//!
 //! Avian is behind the cargo feature `avian`: Avian and bevy add about six
 //! minutes to a clean release build on a 2-core machine. Without it the crate still builds: [`AVAILABLE`] is false,
 //! the models are listed but report themselves unavailable, and the

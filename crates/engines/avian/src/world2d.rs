@@ -12,7 +12,7 @@ use avian2d::prelude::*;
 use bevy::app::{App, TaskPoolPlugin};
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::DVec2;
-use bevy::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Time, World};
+use bevy::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Resource, Time, World};
 
 use pushval_engine::stepping::{
     Plate, PlateWorld, StepLayout, StepLoop, StepPlan, Stepped, Stepping, SupportForces,
@@ -35,10 +35,19 @@ struct Step;
 #[derive(Component)]
 struct Supports(Vec<(DVec2, f64)>);
 
+/// Whether the pusher has let go: the supports' friction is then the
+/// implicit Coulomb impulses of the free slide
+/// ([`pushval_engine::slide::coulomb_impulses`]).
+#[derive(Resource, Default)]
+struct Released(bool);
+
 /// Adds, at the start of every substep, the impulse of each support's
 /// Coulomb force over the substep, from the body's velocity and angle at
 /// that substep (Avian's solver state: the pose so far this step is the
-/// step-start pose turned by `delta_rotation`).
+/// step-start pose turned by `delta_rotation`). After the release, the
+/// impulses of the free slide: each within `F_i h`, jointly the ones that
+/// leave the supports' slip zero where the caps allow (so the plate stops
+/// instead of reversing its slip every substep).
 fn support_friction(
     mut bodies: Query<(
         &mut SolverBody,
@@ -48,10 +57,38 @@ fn support_friction(
         &Supports,
     )>,
     time: Res<Time>,
+    released: Res<Released>,
 ) {
     let h = time.delta_secs_f64();
     for (mut body, rotation, mass, inertia, supports) in &mut bodies {
         let rot = body.delta_rotation * *rotation;
+        if released.0 {
+            let rs: Vec<([f64; 2], f64)> = supports
+                .0
+                .iter()
+                .map(|&(p, friction)| {
+                    let r = rot * p;
+                    ([r.x, r.y], friction.max(0.0) * h)
+                })
+                .collect();
+            let v = body.linear_velocity;
+            let acc = pushval_engine::slide::coulomb_impulses(
+                1.0 / mass.inverse(),
+                1.0 / inertia.inverse(),
+                [v.x, v.y],
+                body.angular_velocity,
+                &rs,
+            );
+            let (mut impulse, mut moment) = (DVec2::ZERO, 0.0);
+            for ((r, _), a) in rs.iter().zip(&acc) {
+                let p = DVec2::new(a[0], a[1]);
+                impulse += p;
+                moment += DVec2::new(r[0], r[1]).perp_dot(p);
+            }
+            body.linear_velocity += impulse * mass.inverse();
+            body.angular_velocity += moment * inertia.inverse();
+            continue;
+        }
         let (mut force, mut torque) = (DVec2::ZERO, 0.0);
         for &(p, friction) in &supports.0 {
             let r = rot * p;
@@ -78,6 +115,7 @@ fn headless_app(substeps: u32) -> App {
         .insert_resource(Gravity::ZERO)
         // Deliberately not Avian's default of 6: see `DEFAULT_SUBSTEPS`.
         .insert_resource(SubstepCount(substeps))
+        .insert_resource(Released(false))
         .add_systems(
             SubstepSchedule,
             support_friction
@@ -90,10 +128,13 @@ fn headless_app(substeps: u32) -> App {
     app
 }
 
-/// The two bodies.
+/// The two bodies and the joint.
 struct Scene {
     object: Entity,
     pusher: Entity,
+    /// The revolute joint (the pusher's constraint), despawned at the
+    /// release.
+    joint: Entity,
     /// Contact point in the object frame (m).
     contact: DVec2,
 }
@@ -153,14 +194,17 @@ fn spawn(world: &mut World, problem: &Problem) -> Scene {
             SleepingDisabled,
         ))
         .id();
-    world.spawn(
-        RevoluteJoint::new(pusher, object)
-            .with_local_anchor1(DVec2::ZERO)
-            .with_local_anchor2(pc),
-    );
+    let joint = world
+        .spawn(
+            RevoluteJoint::new(pusher, object)
+                .with_local_anchor1(DVec2::ZERO)
+                .with_local_anchor2(pc),
+        )
+        .id();
     Scene {
         object,
         pusher,
+        joint,
         contact: pc,
     }
 }
@@ -218,6 +262,9 @@ pub(crate) struct World2d {
     /// Largest distance between the pusher and the object's contact point
     /// after a step (m).
     pub(crate) max_drift: f64,
+    /// Whether the pusher has let go (its steps are then laid out one by
+    /// one, and its drift is no longer measured).
+    released: bool,
 }
 
 impl PlateWorld for World2d {
@@ -270,8 +317,14 @@ impl PlateWorld for World2d {
         0.0
     }
 
-    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
-        let (k0, k1) = self.spans[self.index];
+    fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+        let (k0, k1) = if self.released {
+            // The slide's steps, on the clock from its end back.
+            let c = self.clock;
+            (c.ticks(t1 - h), c.ticks(t1).max(c.ticks(t1 - h) + 1))
+        } else {
+            self.spans[self.index]
+        };
         let world = self.app.world_mut();
         world
             .resource_mut::<Time>()
@@ -283,7 +336,10 @@ impl PlateWorld for World2d {
 
     fn state(&mut self, prev: &State) -> State {
         let mut st = read(self.app.world(), self.scene.object, prev.theta);
-        st.step_omega = (st.theta - prev.theta) / self.h;
+        // No step since the release (h = 0): the engine's ω as it is.
+        if self.h > 0.0 {
+            st.step_omega = (st.theta - prev.theta) / self.h;
+        }
         st
     }
 
@@ -292,6 +348,9 @@ impl PlateWorld for World2d {
     }
 
     fn after_step(&mut self, st: &State) {
+        if self.released {
+            return;
+        }
         let anchor = self
             .app
             .world()
@@ -308,6 +367,34 @@ impl PlateWorld for World2d {
 
     fn cm_velocity(&self, st: &State) -> Option<[f64; 2]> {
         Some([st.velocity.x, st.velocity.y])
+    }
+
+    /// Despawns the revolute joint and stops the pusher; a throw sets the
+    /// object's velocity and ω. From here the supports' friction is the
+    /// free slide's implicit Coulomb impulses, substep by substep (see
+    /// [`support_friction`]).
+    fn release(&mut self, _st: &State, throw: Option<([f64; 2], f64)>) -> Result<(), ModelError> {
+        let world = self.app.world_mut();
+        world.despawn(self.scene.joint);
+        if let Some(mut v) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
+            v.0 = DVec2::ZERO;
+        }
+        if let Some((v, omega)) = throw {
+            let mut e = world.entity_mut(self.scene.object);
+            if let Some(mut lv) = e.get_mut::<LinearVelocity>() {
+                lv.0 = DVec2::new(v[0], v[1]);
+            }
+            if let Some(mut w) = e.get_mut::<AngularVelocity>() {
+                w.0 = omega;
+            }
+        }
+        world.resource_mut::<Released>().0 = true;
+        self.released = true;
+        self.h = 0.0;
+        Ok(())
     }
 }
 
@@ -336,6 +423,7 @@ pub(crate) fn start(
         index: 0,
         h: s.dt,
         max_drift: 0.0,
+        released: false,
     };
     Ok(Stepping::new(
         world,

@@ -155,6 +155,8 @@ fn headless_app(s: &Avian3dSettings) -> App {
 struct Scene {
     object: Entity,
     pusher: Entity,
+    /// The pusher's pin ([`PlanarPin`]), despawned at the release.
+    pin: Entity,
     /// One collider per support, in support order.
     feet: Vec<Entity>,
     /// The pinned point in the object frame (m): the contact point at the
@@ -227,14 +229,17 @@ fn spawn(world: &mut World, problem: &Problem, s: &Avian3dSettings) -> Scene {
             SleepingDisabled,
         ))
         .id();
-    world.spawn(PlanarPin {
-        body1: pusher,
-        body2: object,
-        anchor2: anchor,
-    });
+    let pin = world
+        .spawn(PlanarPin {
+            body1: pusher,
+            body2: object,
+            anchor2: anchor,
+        })
+        .id();
     Scene {
         object,
         pusher,
+        pin,
         feet,
         anchor,
     }
@@ -372,6 +377,9 @@ pub(crate) struct World3d {
     max_drift: f64,
     rest_loads: Vec<f64>,
     mu: Vec<f64>,
+    /// Whether the pusher has let go (the slide's steps are laid out one
+    /// by one and kept out of the pushes' records).
+    released: bool,
 }
 
 impl PlateWorld for World3d {
@@ -433,8 +441,14 @@ impl PlateWorld for World3d {
         0.0
     }
 
-    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
-        let (k0, k1) = self.spans[self.index];
+    fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
+        let (k0, k1) = if self.released {
+            // The slide's steps, on the clock from its end back.
+            let c = self.clock;
+            (c.ticks(t1 - h), c.ticks(t1).max(c.ticks(t1 - h) + 1))
+        } else {
+            self.spans[self.index]
+        };
         let world = self.app.world_mut();
         world
             .resource_mut::<Time>()
@@ -446,7 +460,10 @@ impl PlateWorld for World3d {
 
     fn state(&mut self, prev: &State) -> State {
         let mut st = read(self.app.world(), self.scene.object, prev.theta);
-        st.step_omega = (st.theta - prev.theta) / self.h;
+        // No step since the release (h = 0): the engine's ω as it is.
+        if self.h > 0.0 {
+            st.step_omega = (st.theta - prev.theta) / self.h;
+        }
         st
     }
 
@@ -456,6 +473,9 @@ impl PlateWorld for World3d {
 
     fn after_step(&mut self, st: &State) {
         self.max_tilt = self.max_tilt.max(st.tilt);
+        if self.released {
+            return;
+        }
         let world = self.app.world();
         let anchor = world
             .entity(self.scene.pusher)
@@ -498,6 +518,33 @@ impl PlateWorld for World3d {
 
     fn cm_velocity(&self, st: &State) -> Option<[f64; 2]> {
         Some([st.velocity.x, st.velocity.y])
+    }
+
+    /// Despawns the pusher's pin and stops the pusher; a throw sets the
+    /// object's horizontal velocity and its spin about the vertical. The
+    /// slide is the engine's own: the feet's contact friction on the floor
+    /// (see the crate docs).
+    fn release(&mut self, st: &State, throw: Option<([f64; 2], f64)>) -> Result<(), ModelError> {
+        let world = self.app.world_mut();
+        world.despawn(self.scene.pin);
+        if let Some(mut v) = world
+            .entity_mut(self.scene.pusher)
+            .get_mut::<LinearVelocity>()
+        {
+            v.0 = DVec3::ZERO;
+        }
+        if let Some((v, omega)) = throw {
+            let mut e = world.entity_mut(self.scene.object);
+            if let Some(mut lv) = e.get_mut::<LinearVelocity>() {
+                lv.0 = DVec3::new(v[0], v[1], st.velocity.z);
+            }
+            if let Some(mut w) = e.get_mut::<AngularVelocity>() {
+                w.0.z = omega;
+            }
+        }
+        self.released = true;
+        self.h = 0.0;
+        Ok(())
     }
 }
 
@@ -581,6 +628,7 @@ pub(crate) fn start(
         max_drift: 0.0,
         rest_loads,
         mu,
+        released: false,
     };
     let cfg = StepLoop {
         tail: TailSteps::ByTime,

@@ -29,6 +29,17 @@
 //! crate): Jolt decides how the weight is shared between the contacts.
 //! [`predict`] holds Jolt's friction law in closed form.
 //!
+//! **The release** removes the six-DOF constraint and stops the pusher;
+//! the plate slides to rest under the same contact friction (pushval's
+//! rule: `|v_cm| + |ω| L` below 1e-5 m/s for 10 steps). Jolt's friction
+//! rows are velocity constraints solved by sequential impulses and clamped
+//! to the disc `μ Σλ`: a slip that an impulse within the disc can remove is
+//! removed, so the plate sticks at the stop instead of chattering. In pure
+//! translation of a plate square to the world axes (or the box) that is
+//! Coulomb's stop, `v²/(2μg)` after `v/(μg)`; the feet of a turned plate
+//! have rows of unequal effective masses, so their friction is not against
+//! the slip ([`predict`]) and the plate slides farther.
+//!
 //! Each run builds its own physics system with a single-threaded job
 //! system; joltc's global set-up is serialised by a lock.
 //!

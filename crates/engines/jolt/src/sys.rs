@@ -397,6 +397,28 @@ impl World {
         }
     }
 
+    /// Removes and destroys the pusher's six-DOF constraint (the object is
+    /// then free of the pusher) and stops the pusher; nothing if it is gone
+    /// already.
+    pub fn release_pusher(&mut self) {
+        // SAFETY: the constraint, when non-null, was added to this live
+        // system in `build` and is removed and destroyed once here (the
+        // pointer is nulled, so `drop` skips it); the pusher is a body of
+        // this system and the input is a live local.
+        unsafe {
+            if !self.constraint.is_null() {
+                JPH_PhysicsSystem_RemoveConstraint(
+                    self.system,
+                    self.constraint as *mut JPH_Constraint,
+                );
+                JPH_Constraint_Destroy(self.constraint as *mut JPH_Constraint);
+                self.constraint = std::ptr::null_mut();
+            }
+            let bi = JPH_PhysicsSystem_GetBodyInterface(self.system);
+            JPH_BodyInterface_SetLinearVelocity(bi, self.pusher, &v3([0.0; 3]));
+        }
+    }
+
     /// The contact cache as `JPH_PhysicsSystem_SaveState` writes it (state
     /// `Contacts` only): the bytes [`crate::world`] parses.
     pub fn contact_state(&self) -> Vec<u8> {

@@ -574,6 +574,27 @@ impl PlateWorld for Stepper {
         self.out.load_range.push(tail.load_range);
         Ok(())
     }
+
+    /// Removes the pusher's six-DOF constraint and stops the pusher (it
+    /// collides with nothing); a throw sets the object's horizontal
+    /// velocity and its spin about the vertical. The slide is the engine's
+    /// own: the contacts' friction on the floor (see the crate docs).
+    fn release(
+        &mut self,
+        (st, _): &(BodyState, f64),
+        throw: Option<([f64; 2], f64)>,
+    ) -> Result<(), ModelError> {
+        self.world.release_pusher();
+        if let Some((v, omega)) = throw {
+            let object = self.world.object;
+            self.world.set_velocity(
+                object,
+                [v[0], v[1], st.linear[2]],
+                [st.angular[0], st.angular[1], omega],
+            );
+        }
+        Ok(())
+    }
 }
 
 /// The loads of `targets` (feet, or the box's corners) in the problem's

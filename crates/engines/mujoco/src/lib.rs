@@ -31,6 +31,21 @@
 //! driven, so the object's momentum — the mass term of the model — is the
 //! engine's own.
 //!
+//! **The release** turns the `connect` off (`eq_active`) and stops the
+//! carriage; the plate slides on its feet under MuJoCo's own contact
+//! friction until at rest (pushval's rule: `|v_cm| + |ω| L` below 1e-5 m/s
+//! for 10 steps). Sliding, a foot's friction is its cone's bound: `μN`
+//! against the slip (elliptic), or within the diamond `|f₁| + |f₂| ≤ μN` of
+//! the contact frame (pyramidal: `μN` along the world axes, down to
+//! `μN/√2` on the diagonals). It stops without chattering because friction
+//! is a soft constraint: once the force that would stop the slip fits in
+//! the cone, the slip follows MuJoCo's reference acceleration `u̇ = −u/τ`,
+//! `τ = d_max·timeconst/(2d)` (10–10.6 ms at the default `solref` and
+//! `solimp`), and decays geometrically without reversing. The price is a
+//! tail: from the crossover speed `μgτ` the rest rule holds about 70 ms
+//! after Coulomb's stop, and the plate slides up to `μgτ²` (0.55 mm)
+//! farther.
+//!
 //! Without the `mujoco` feature the crate builds with no MuJoCo at all
 //! ([`AVAILABLE`] is false) and [`MujocoSimulator`] returns an error.
 //!

@@ -210,6 +210,7 @@ pub(crate) fn start(
         foot_speeds: Vec::new(),
         rest_loads,
         mu,
+        released: false,
     };
     let cfg = StepLoop {
         forces_every_step: false,
@@ -312,6 +313,9 @@ pub(crate) struct Stepper {
     rest_loads: Vec<f64>,
     /// The calibrated friction coefficient of each foot.
     mu: Vec<f64>,
+    /// Whether the pusher has let go (its connect is off; the tip's gap to
+    /// the contact point no longer measures the pusher).
+    released: bool,
 }
 
 impl Stepper {
@@ -360,9 +364,13 @@ impl PlateWorld for Stepper {
         0.0
     }
 
-    fn step(&mut self, h: f64, _t1: f64) -> Result<(), ModelError> {
+    fn step(&mut self, h: f64, t1: f64) -> Result<(), ModelError> {
         self.data.model_opt_mut().timestep = h;
         self.data.step();
+        if self.released {
+            // The slide has no segment ends: its steps are checked here.
+            check_warnings(&self.data, t1)?;
+        }
         Ok(())
     }
 
@@ -385,7 +393,9 @@ impl PlateWorld for Stepper {
             + (sx[0][1] - sx[1][1]).powi(2)
             + (sx[0][2] - sx[1][2]).powi(2))
         .sqrt();
-        self.max_gap = self.max_gap.max(gap);
+        if !self.released {
+            self.max_gap = self.max_gap.max(gap);
+        }
         self.max_pen = self.max_pen.max(max_penetration(&self.data));
         let speed = self.foot_speed(&st.s);
         self.foot_speeds.push(speed);
@@ -409,6 +419,29 @@ impl PlateWorld for Stepper {
 
     fn end_segment(&mut self, _count: f64, t: f64) -> Result<(), ModelError> {
         check_warnings(&self.data, t)
+    }
+
+    /// Turns the pusher's `connect` off (MuJoCo's `eq_active`) and stops
+    /// the carriage; a throw sets the object's horizontal velocity and its
+    /// spin about the vertical (the free joint's angular velocity is in the
+    /// body frame: `Rᵀ (0, 0, ω)`). The slide is the engine's own: the
+    /// feet's soft contact friction on the floor, nothing applied besides.
+    fn release(&mut self, st: &MjState, throw: Option<([f64; 2], f64)>) -> Result<(), ModelError> {
+        self.data.eq_active_mut()[0] = false;
+        self.released = true;
+        let qv = self.data.qvel_mut();
+        qv[CARRIAGE_DOF] = 0.0;
+        qv[CARRIAGE_DOF + 1] = 0.0;
+        if let Some((v, omega)) = throw {
+            let mat = st.s.mat;
+            let w = [st.s.w[0], st.s.w[1], omega];
+            qv[0] = v[0];
+            qv[1] = v[1];
+            qv[3] = mat[0] * w[0] + mat[3] * w[1] + mat[6] * w[2];
+            qv[4] = mat[1] * w[0] + mat[4] * w[1] + mat[7] * w[2];
+            qv[5] = mat[2] * w[0] + mat[5] * w[1] + mat[8] * w[2];
+        }
+        Ok(())
     }
 }
 

@@ -53,6 +53,19 @@
 //! `from_rest` the joint delivers the start impulse. `Problem::switching` is
 //! ignored (the engine shows which reading a rigid body obeys).
 //!
+//! **The release** releases the D6 joint; the plate slides on its feet
+//! under the same friction rows until at rest (pushval's rule: `|v_cm| +
+//! |ω| L` below 1e-5 m/s for 10 steps). A friction row is a velocity
+//! constraint whose impulse is capped by `μ λ`: a slip that one step's
+//! capped impulse can remove is removed, so the plate sticks instead of
+//! chattering. In pure translation `eTWO_DIRECTIONAL` and `ePATCH` put the
+//! whole `μ m g` against the motion (Coulomb's stop); `eONE_DIRECTIONAL`
+//! only the `t0` feet's share, so it slides farther. With PhysX's single
+//! velocity iteration `ePATCH` keeps a solver residual of about 1e-5 m/s at
+//! the stop: it is seen a few steps late, or (after a turned push, or at
+//! dt 5e-4) never below the rest rule, the pose still: reported as not
+//! stopped.
+//!
 //! PhysX keeps one foundation per process, so runs are serialised by a lock.
 //! PhysX computes in f32.
 //!

@@ -572,4 +572,19 @@ impl PlateWorld for Stepper {
         self.acc_f = [0.0; 2];
         Ok(())
     }
+
+    /// Releases the pusher's D6 joint (the kinematic pusher, which has no
+    /// shapes, stays where it is); a throw sets the object's horizontal
+    /// velocity and its spin about the vertical. The slide is the engine's
+    /// own: the feet's contact friction on the ground (see the crate docs).
+    fn release(&mut self, _st: &State, throw: Option<([f64; 2], f64)>) -> Result<(), ModelError> {
+        drop(self.world.joint.take());
+        if let Some((v, omega)) = throw {
+            let o = actor(self.world.scene(), OBJECT);
+            let (vz, w) = (o.get_linear_velocity().z(), o.get_angular_velocity());
+            o.set_linear_velocity(&PxVec3::new(v[0] as f32, v[1] as f32, vz), true);
+            o.set_angular_velocity(&PxVec3::new(w.x(), w.y(), omega as f32), true);
+        }
+        Ok(())
+    }
 }
