@@ -35,6 +35,11 @@ use crate::common::root;
 const ALLOWED: &[(&str, &str, &str)] = &[
     // README.md and docs/
     (
+        "docs/closed-loop.md",
+        "floored at 0.2 mm, 2 mrad and\n  0.05 rad/s (`estimate::FLOOR`)",
+        "the estimator's weight floors, constants of crates/control/src/estimate.rs",
+    ),
+    (
         "docs/benchmarks.md",
         "paper trajectory (10 s, five segments)",
         "the paper scene's duration: five 2 s segments of scenarios/paper-square-v1.0.toml",
