@@ -127,7 +127,12 @@ fn every_shipped_scenario_gives_a_valid_document() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             let name = path.file_name().unwrap().to_str().unwrap().to_string();
-            let (_, doc) = doc_of(&name, 1e-3);
+            let (sc, doc) = doc_of(&name, 1e-3);
+            // A protocol 1 engine is refused a problem with a release (a
+            // thrown plate has no push): its document is never written.
+            if sc.release.is_some() {
+                continue;
+            }
             assert_eq!(errors(&doc), Vec::<String>::new(), "{name}");
         }
     }
