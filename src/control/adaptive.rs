@@ -416,6 +416,9 @@ pub fn cli(
         );
     }
     let names = engines(only)?;
+    if names.is_empty() {
+        bail!("no engine to study (every engine of this build is unavailable)");
+    }
     let list = tasks(&names, speeds, goals.len());
     let keys: Vec<String> = list.iter().map(Task::key).collect();
     let parts = Parts {
