@@ -27,7 +27,10 @@ use pushval_control::{At, Goal, ModelKind, Reach};
 use pushval_engine::Engine;
 use pushval_model::{Body, Problem, Support};
 
-use super::study::{cannot_release, engines, goals, law_line, scene, PERIOD, SEGMENTS, SPEEDS};
+use super::study::{
+    cannot_release, engines, goals, law_line, rows_with_progress, scene, write_part, PERIOD,
+    SEGMENTS, SPEEDS,
+};
 use crate::outdir::{num, Csv, Writer as OutDir};
 use crate::shard::{grid_hash, grid_name, Parts, Shard};
 
@@ -480,26 +483,12 @@ pub fn cli(
                 }
             }
         }
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let quiet_bar = !std::io::IsTerminal::is_terminal(&std::io::stderr());
-        let computed = crate::parallel::par_rows(&mine, true, "runs", |t| {
-            let row = run_task(&problem, built[&t.engine].as_ref(), &goals, &plans, t);
-            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if quiet_bar && (k * 10 / mine.len() != (k - 1) * 10 / mine.len() || k == mine.len()) {
-                eprintln!(
-                    "control-study --adaptive: {k}/{} runs done ({:.0} s)",
-                    mine.len(),
-                    clock.elapsed().as_secs_f64()
-                );
-            }
-            row
-        });
+        let computed =
+            rows_with_progress("control-study --adaptive", &mine, clock, Task::key, |t| {
+                run_task(&problem, built[&t.engine].as_ref(), &goals, &plans, t)
+            });
         if let Some(s) = shard {
-            std::fs::create_dir_all(out.join("parts"))?;
-            crate::atomic::write_atomic(
-                &out.join(parts.file_name(s)),
-                parts.text(list.len(), &indices, &computed, s).as_bytes(),
-            )?;
+            write_part(out, &parts, list.len(), &indices, &computed, s, clock)?;
             return Ok(ExitCode::SUCCESS);
         }
         computed

@@ -469,37 +469,11 @@ pub fn cli(
         let mine: Vec<&Task> = indices.iter().map(|&i| &list[i]).collect();
         let built = build_engines(&names, &mine)?;
         let plans = plans(&problem, speeds, &goals);
-        // Progress on stderr (a bar on a terminal; a line per tenth
-        // elsewhere, e.g. in CI logs).
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let quiet_bar = !std::io::IsTerminal::is_terminal(&std::io::stderr());
-        let computed = crate::parallel::par_rows(&mine, true, "runs", |t| {
-            let row = run_task(&problem, built[&t.engine].as_ref(), &goals, &plans, t);
-            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if quiet_bar && (k * 10 / mine.len() != (k - 1) * 10 / mine.len() || k == mine.len()) {
-                eprintln!(
-                    "control-study: {k}/{} runs done ({:.0} s; last {})",
-                    mine.len(),
-                    clock.elapsed().as_secs_f64(),
-                    t.key()
-                );
-            }
-            row
+        let computed = rows_with_progress("control-study", &mine, clock, Task::key, |t| {
+            run_task(&problem, built[&t.engine].as_ref(), &goals, &plans, t)
         });
         if let Some(s) = shard {
-            std::fs::create_dir_all(out.join("parts"))?;
-            crate::atomic::write_atomic(
-                &out.join(parts.file_name(s)),
-                parts.text(list.len(), &indices, &computed, s).as_bytes(),
-            )?;
-            eprintln!(
-                "control-study: part {}/{} ({} runs) in {:.1} s: {}",
-                s.k,
-                s.n,
-                computed.len(),
-                clock.elapsed().as_secs_f64(),
-                out.join(parts.file_name(s)).display()
-            );
+            write_part(out, &parts, list.len(), &indices, &computed, s, clock)?;
             return Ok(ExitCode::SUCCESS);
         }
         computed
@@ -520,6 +494,60 @@ pub fn cli(
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Each of `items` through `eval` on every core, with progress on standard
+/// error (a bar on a terminal; a line per tenth elsewhere, e.g. in CI logs,
+/// tagged `tag` and naming the last run by `key`).
+pub(crate) fn rows_with_progress<T: Sync>(
+    tag: &str,
+    items: &[&T],
+    clock: Instant,
+    key: impl Fn(&T) -> String + Sync,
+    eval: impl Fn(&T) -> Vec<f64> + Sync,
+) -> Vec<Vec<f64>> {
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let quiet_bar = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    crate::parallel::par_rows(items, true, "runs", |t| {
+        let row = eval(t);
+        let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        let n = items.len();
+        if quiet_bar && (k * 10 / n != (k - 1) * 10 / n || k == n) {
+            eprintln!(
+                "{tag}: {k}/{n} runs done ({:.0} s; last {})",
+                clock.elapsed().as_secs_f64(),
+                key(t)
+            );
+        }
+        row
+    })
+}
+
+/// Writes a shard's rows into `out`'s parts folder and says so.
+pub(crate) fn write_part(
+    out: &Path,
+    parts: &Parts,
+    total: usize,
+    indices: &[usize],
+    rows: &[Vec<f64>],
+    s: Shard,
+    clock: Instant,
+) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out.join("parts"))?;
+    crate::atomic::write_atomic(
+        &out.join(parts.file_name(s)),
+        parts.text(total, indices, rows, s).as_bytes(),
+    )?;
+    eprintln!(
+        "{}: part {}/{} ({} runs) in {:.1} s: {}",
+        parts.tag,
+        s.k,
+        s.n,
+        rows.len(),
+        clock.elapsed().as_secs_f64(),
+        out.join(parts.file_name(s)).display()
+    );
+    Ok(())
 }
 
 /// One success.csv row's key.
