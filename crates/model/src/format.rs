@@ -30,6 +30,15 @@
 //! in Rust's shortest round-trip form, so reading a written file gives back
 //! the same `f64`s.
 //!
+//! Why the reader is written here rather than on the `csv` crate (which
+//! the tables pushval writes use): an outside engine's output arrives as a
+//! framed stream, where a line starting with `#` ends one run and belongs
+//! to the protocol, not to the table; the `csv` crate reads such a line as
+//! a comment to skip or as a record, never as the end of the input. The
+//! reader must also stop at a row cap before buffering a runaway engine's
+//! output, and name the line of the whole stream in every error. With no
+//! quoting in the format, what remains of a CSV parser is the split on `,`.
+//!
 //! Why one file of a little over 800 lines: 630 of them are the reader, the
 //! writer and the ω derivation, which share the column rules and the error
 //! type; the rest are their tests.
