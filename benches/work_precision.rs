@@ -8,7 +8,8 @@
 //! for 1e-9 m at the final pose), then the medians of the model-predictive
 //! controller's unit of work
 //! (`model_short_horizon`: 6 segments from rest, two samples, assumption
-//! checks off; `short_horizon/mod.rs`).
+//! checks off; `short_horizon/mod.rs`), the last also with its pushes'
+//! analysis cached from an earlier call.
 //!
 //! `cargo bench --bench work_precision` (add `-- --quick` for fewer repeats).
 //!
@@ -29,8 +30,8 @@ use ode_solvers::{Dop853, Dopri5, OutputType, System, Vector4};
 use pushval::harness::{analyse_segments, rel_err, tail_omega, SegmentInfo};
 use pushval::outdir::csv_line;
 use pushval_model::{
-    DynamicModel, Integrator, Problem, Rotor, SegmentDynamics, Simulator, Switching, Trajectory,
-    Vec2,
+    DynamicModel, Integrator, Problem, PushCache, Rotor, SegmentDynamics, Simulator, Switching,
+    Trajectory, Vec2,
 };
 use pushval_scenario::Scenario;
 
@@ -591,7 +592,9 @@ fn target_comparison(
 /// short horizon (`short_horizon/mod.rs`), as comment lines of
 /// `work_precision_target.csv`: the sampled run (two samples) at the
 /// bench's tolerance, then the final state alone at that tolerance and at
-/// the predictor's ([`short_horizon::PREDICTOR_TOL`]), timed alternately.
+/// the predictor's ([`short_horizon::PREDICTOR_TOL`]), and that with the
+/// pushes' analysis cached from an earlier call ([`PushCache`]), timed
+/// alternately.
 fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
     let problem = short_horizon::problem(root);
     let model = short_horizon::model();
@@ -603,17 +606,35 @@ fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
     let tr = model.simulate(&problem).unwrap();
     let end = model.final_state(&problem).unwrap();
     let end9 = predictor.final_state(&problem).unwrap();
-    let (mut ts, mut tf, mut tp) = (Vec::new(), Vec::new(), Vec::new());
+    // The predictor's call again with its pushes seen before (the cache
+    // warm): what a repeated push spares, the same state to the bit.
+    let mut cache = PushCache::new();
+    assert_eq!(
+        predictor.final_state_cached(&problem, &mut cache).unwrap(),
+        end9
+    );
+    let (mut ts, mut tf, mut tp, mut tc) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for _ in 0..runs {
         ts.push(time(1, || model.simulate(&problem).unwrap()).0);
         tf.push(time(1, || model.final_state(&problem).unwrap()).0);
         tp.push(time(1, || predictor.final_state(&problem).unwrap()).0);
+        tc.push(
+            time(1, || {
+                predictor.final_state_cached(&problem, &mut cache).unwrap()
+            })
+            .0,
+        );
     }
     let median = |v: &mut Vec<Duration>| {
         v.sort();
         v[v.len() / 2].as_secs_f64()
     };
-    let (ms, mf, mp) = (median(&mut ts), median(&mut tf), median(&mut tp));
+    let (ms, mf, mp, mc) = (
+        median(&mut ts),
+        median(&mut tf),
+        median(&mut tp),
+        median(&mut tc),
+    );
     let mut out = format!(
         "# model_short_horizon ({} segments from rest, {:.2} s, {} samples, checks off, DOP853 tol {tol:e}): median {ms:.6e} s, {} RHS evaluations\n",
         short_horizon::SEGMENTS,
@@ -629,6 +650,9 @@ fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
         "# model_short_horizon final state only at the predictor's tolerance (DOP853 tol {:e}): median {mp:.6e} s, {} RHS evaluations\n",
         short_horizon::PREDICTOR_TOL,
         end9.stats.rhs_evals
+    ));
+    out.push_str(&format!(
+        "# model_short_horizon final state only at the predictor's tolerance, every push seen before (PushCache warm; the same state to the bit): median {mc:.6e} s\n",
     ));
     out
 }

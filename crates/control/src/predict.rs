@@ -7,8 +7,8 @@
 //! models of `pushval_model` are predictors through [`ModelPredictor`].
 
 use pushval_model::{
-    cross, Body, DynamicModel, Initial, Integrator, ModelError, Problem, Push, Simulator,
-    Switching, Trajectory, Vec2,
+    cross, Body, DynamicModel, Initial, Integrator, ModelError, Problem, Push, PushCache,
+    Simulator, Switching, Trajectory, Vec2,
 };
 
 use crate::At;
@@ -128,14 +128,17 @@ impl Clone for Box<dyn Predictor> {
 }
 
 /// One of pushval's models as a predictor: the model, a working copy of the
-/// problem (only its schedule and start change between calls), and the
-/// count of model runs.
+/// problem (only its schedule and start change between calls), the count
+/// of model runs, and the dynamic model's analysis of the pushes it has
+/// seen (a plan's calls share most pushes: a finite-difference Jacobian
+/// changes one direction at a time, a re-plan starts from the last plan's).
 #[derive(Clone)]
 pub struct ModelPredictor {
     problem: Problem,
     model: DynamicModel,
     kind: ModelKind,
     runs: usize,
+    cache: PushCache,
 }
 
 impl ModelPredictor {
@@ -154,6 +157,7 @@ impl ModelPredictor {
             },
             kind,
             runs: 0,
+            cache: PushCache::new(),
         }
     }
 
@@ -182,11 +186,20 @@ impl ModelPredictor {
     }
 
     fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
-        match self.kind {
-            ModelKind::Dynamic => self.model.simulate(problem),
-            ModelKind::Kinematic => pushval_model::KinematicModel.simulate(problem),
-            ModelKind::LimitSurface => pushval_model::LimitSurfaceModel.simulate(problem),
-        }
+        simulate(self.kind, &self.model, problem)
+    }
+}
+
+/// `problem` run by the model of `kind` (`model` for the dynamic one).
+fn simulate(
+    kind: ModelKind,
+    model: &DynamicModel,
+    problem: &Problem,
+) -> Result<Trajectory, ModelError> {
+    match kind {
+        ModelKind::Dynamic => model.simulate(problem),
+        ModelKind::Kinematic => pushval_model::KinematicModel.simulate(problem),
+        ModelKind::LimitSurface => pushval_model::LimitSurfaceModel.simulate(problem),
     }
 }
 
@@ -204,21 +217,23 @@ impl Predictor for ModelPredictor {
     }
 
     fn final_pose(&mut self, start: &Start, pushes: &[Push]) -> Result<[f64; 3], ModelError> {
-        let mut p = std::mem::replace(&mut self.problem, placeholder());
-        set_start(&mut p, start, pushes, None);
+        set_start(&mut self.problem, start, pushes, None);
+        let p = &self.problem;
         // The dynamic model's end state alone (no samples; through the
-        // slide when judged at rest); the quasi-static ones sample their
-        // closed-form arcs at the end.
+        // slide when judged at rest; the pushes' analysis kept); the
+        // quasi-static ones sample their closed-form arcs at the end.
         let out = match self.kind {
-            ModelKind::Dynamic => self.model.final_state(&p).map(|f| [f.t, f.x, f.y, f.theta]),
-            _ => self.simulate(&p).and_then(|tr| {
+            ModelKind::Dynamic => self
+                .model
+                .final_state_cached(p, &mut self.cache)
+                .map(|f| [f.t, f.x, f.y, f.theta]),
+            _ => simulate(self.kind, &self.model, p).and_then(|tr| {
                 tr.samples
                     .last()
                     .map(|s| [s.t, s.x, s.y, s.theta])
                     .ok_or(ModelError::EmptySchedule)
             }),
         };
-        self.problem = p;
         self.runs += 1;
         let [t, x, y, theta] = out?;
         if !(x.is_finite() && y.is_finite() && theta.is_finite()) {
@@ -290,26 +305,4 @@ fn set_start(p: &mut Problem, start: &Start, pushes: &[Push], sample_dt: Option<
             }
         }
     };
-}
-
-/// An empty stand-in while the working problem is lent out.
-fn placeholder() -> Problem {
-    Problem {
-        body: pushval_model::Body::new(
-            1.0,
-            1.0,
-            Vec2::zeros(),
-            &[pushval_model::Support {
-                position: Vec2::new(1.0, 0.0),
-                friction: 1.0,
-            }],
-        )
-        .expect("a valid body"),
-        limits: Default::default(),
-        pushes: Vec::new(),
-        initial: Initial::default(),
-        switching: Switching::default(),
-        sample_dt: 1.0,
-        release: None,
-    }
 }

@@ -9,7 +9,10 @@
 //! `cargo run --release -p pushval-model --example per_call -- paper|short [runs [sample_dt]]`;
 //! `NO_SKIP=1` integrates every segment (no series tail), `TOL=…` sets the
 //! tolerance, `SEGMENTS=1` prints the solver work and each segment's report,
-//! `FINAL=1` asks for the final state alone ([`DynamicModel::final_state`]).
+//! `FINAL=1` asks for the final state alone ([`DynamicModel::final_state`]),
+//! `CACHE=1` the same with the pushes' analysis kept between calls
+//! ([`DynamicModel::final_state_cached`]; every call after the first finds
+//! all its pushes).
 use pushval_model::*;
 
 fn plate() -> Body {
@@ -84,8 +87,14 @@ fn main() {
     let mut last = 0.0;
     let t0 = std::time::Instant::now();
     let final_only = std::env::var_os("FINAL").is_some();
+    let mut cache = std::env::var_os("CACHE").map(|_| PushCache::new());
     for _ in 0..runs {
-        if final_only {
+        if let Some(cache) = cache.as_mut() {
+            let end = m
+                .final_state_cached(std::hint::black_box(&pb), cache)
+                .unwrap();
+            (evals, last) = (end.stats.rhs_evals, end.x);
+        } else if final_only {
             let end = m.final_state(std::hint::black_box(&pb)).unwrap();
             (evals, last) = (end.stats.rhs_evals, end.x);
         } else {

@@ -58,8 +58,8 @@ pub use slide::{
     slide_to_rest, PivotEnd, PivotPhase, Slide, SlideOptions, SlideReport, SlideState,
 };
 pub use trajectory::{
-    Assumptions, DynamicModel, FinalState, Integrator, KinematicModel, LimitSurfaceModel, Sample,
-    SegmentReport, SolverStats, Trajectory, Violation,
+    Assumptions, DynamicModel, FinalState, Integrator, KinematicModel, LimitSurfaceModel,
+    PushCache, Sample, SegmentReport, SolverStats, Trajectory, Violation,
 };
 
 /// A 2-D vector in metres (or m/s, N, as the context says).

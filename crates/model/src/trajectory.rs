@@ -12,12 +12,14 @@ mod adaptive;
 mod checker;
 mod dynamic_model;
 mod final_state;
+mod push_cache;
 mod rk4;
 mod sampling;
 mod segment;
 
 pub use dynamic_model::{DynamicModel, Integrator};
 pub use final_state::FinalState;
+pub use push_cache::PushCache;
 
 use crate::tail::Tail;
 use crate::{kinematic, limit_surface, rotate, Body, ModelError, Problem, Push, Simulator};

@@ -1,11 +1,12 @@
 //! The dynamic model asked for less: [`DynamicModel::final_state`] (the end
 //! state alone) and [`DynamicModel::sample_at`] (the caller's times) against
 //! the full sampled run they must agree with, and the final state against a
-//! much tighter run (its error stays within the tolerance's bound).
+//! much tighter run (its error stays within the tolerance's bound); the
+//! final state with the pushes' analysis cached against the one without.
 
 use pushval_model::{
-    DynamicModel, FinalState, Initial, Integrator, ModelError, Problem, Push, Simulator, Switching,
-    Trajectory,
+    DynamicModel, FinalState, Initial, Integrator, ModelError, Problem, Push, PushCache, Simulator,
+    Switching, Trajectory,
 };
 use rstest::rstest;
 
@@ -232,4 +233,59 @@ fn sample_at_refuses_bad_times() {
             other => panic!("{times:?}: {other:?}"),
         }
     }
+}
+
+/// A cache of the pushes' analysis spares work, never changes an answer:
+/// over schedules that share pushes the way a planner's calls do (one
+/// direction changed at a time, every duration scaled, another start, the
+/// slide to rest after the last push), for several tolerances and a held
+/// contact and a pivot, the cached final state equals the uncached one to
+/// the bit, and the repeated pushes are found in the cache. A new body
+/// empties it (the answer is the new body's).
+#[test]
+fn cached_final_state_is_the_uncached_one_to_the_bit() {
+    let mut cache = PushCache::new();
+    let mut calls = 0;
+    for base in [short_horizon(), paper_problem(), pivot_and_hold()] {
+        for tol in [1e-9, 1e-10, 3.162e-8] {
+            let m = model(Integrator::Dop853 { tol }, true);
+            let mut variants = vec![base.clone()];
+            for k in 0..base.pushes.len() {
+                let mut p = base.clone();
+                p.pushes[k].phi += 1e-6;
+                variants.push(p);
+            }
+            let mut longer = base.clone();
+            longer.pushes.iter_mut().for_each(|q| q.duration *= 1.07);
+            variants.push(longer);
+            let mut moving = base.clone();
+            moving.initial = Initial {
+                omega: -0.4,
+                ..Default::default()
+            };
+            variants.push(moving);
+            let mut to_rest = base.clone();
+            to_rest.release = Some(Default::default());
+            variants.push(to_rest);
+            for p in &variants {
+                let cold = m.final_state(p).unwrap();
+                let warm = m.final_state_cached(p, &mut cache).unwrap();
+                assert_eq!(warm, cold, "tol {tol}");
+                calls += 1;
+            }
+        }
+    }
+    let (hits, misses) = cache.hits_misses();
+    assert!(
+        hits > 4 * misses,
+        "{hits} hits, {misses} misses in {calls} calls"
+    );
+    // Another body: the cache forgets the old one's roots and series.
+    let mut p = short_horizon();
+    p.body = square(0.3, 1.5, 0.4, 9.81);
+    let m = model(Integrator::Dop853 { tol: 1e-9 }, true);
+    assert_eq!(
+        m.final_state_cached(&p, &mut cache).unwrap(),
+        m.final_state(&p).unwrap()
+    );
 }

@@ -138,26 +138,14 @@ impl SegmentDynamics {
             if (gl > 0.0) != (gh > 0.0) && gl != 0.0 && gh != 0.0 {
                 return Some(self.classify(self.refine((omega - h, gl), (omega + h, gh))));
             }
+        } else if self.k < 0.0 {
+            // G decreases strictly: its one root is the attractor from
+            // every start. It is found from ω = 0, not from `omega`, so the
+            // same push gives the same root to the last bit whatever the
+            // start (what lets a caller keep it per push: `PushCache`).
+            return self.monotone_root();
         } else {
-            // G is monotone: its one root lies ahead. Steps from ω growing
-            // by doubling from a tenth of v/r_min bracket it; past 2⁶⁰ times
-            // that scale there is none (the full scan's bound stops sooner).
-            let mut h = 0.1 * self.speed / self.r_min().max(1e-300);
-            let dir = if up { 1.0 } else { -1.0 };
-            let (mut prev, mut gprev) = (omega, g0);
-            for _ in 0..64 {
-                let w = omega + dir * h;
-                let gw = self.moment(w);
-                if gw == 0.0 {
-                    return Some(self.classify(w));
-                }
-                if (gw > 0.0) != up {
-                    return Some(self.classify(self.refine((prev, gprev), (w, gw))));
-                }
-                (prev, gprev) = (w, gw);
-                h *= 2.0;
-            }
-            return None;
+            return self.root_ahead(omega, g0);
         }
         let bound = self.root_bound();
         // The clustered points ahead, nearest first.
@@ -202,6 +190,40 @@ impl SegmentDynamics {
             }
             (prev, gprev) = (w, gw);
         }
+    }
+
+    /// The one root of a strictly decreasing `G` (`k < 0`), bracketed from
+    /// ω = 0: a function of the push alone.
+    pub(crate) fn monotone_root(&self) -> Option<SteadyState> {
+        let g0 = self.moment(0.0);
+        if g0 == 0.0 {
+            return Some(self.classify(0.0));
+        }
+        self.root_ahead(0.0, g0)
+    }
+
+    /// The first root of a non-increasing `G` from `omega` (where `G` is
+    /// `g0 ≠ 0`) in the direction it drives ω: steps from ω growing by
+    /// doubling from a tenth of v/r_min bracket it; past 2⁶⁰ times that
+    /// scale there is none (the full scan's bound stops sooner).
+    fn root_ahead(&self, omega: f64, g0: f64) -> Option<SteadyState> {
+        let up = g0 > 0.0;
+        let mut h = 0.1 * self.speed / self.r_min().max(1e-300);
+        let dir = if up { 1.0 } else { -1.0 };
+        let (mut prev, mut gprev) = (omega, g0);
+        for _ in 0..64 {
+            let w = omega + dir * h;
+            let gw = self.moment(w);
+            if gw == 0.0 {
+                return Some(self.classify(w));
+            }
+            if (gw > 0.0) != up {
+                return Some(self.classify(self.refine((prev, gprev), (w, gw))));
+            }
+            (prev, gprev) = (w, gw);
+            h *= 2.0;
+        }
+        None
     }
 
     fn classify(&self, w: f64) -> SteadyState {

@@ -387,3 +387,37 @@ fn taylor_coefficients_reproduce_omega_dot() {
         }
     }
 }
+
+/// With `k < 0` (`G` strictly decreasing: one root, the attractor of every
+/// start) the root found does not depend on where ω starts, to the bit:
+/// what lets a run keep it per push (`PushCache`). It is a root: `G`
+/// changes sign within a few ulps of it.
+#[test]
+fn monotone_root_is_the_same_from_every_start() {
+    let b = body(&[(0.1, 0.08), (0.12, -0.07), (-0.05, 0.02), (0.0, 0.1)]);
+    for phi in [0.2, 0.4, 0.9] {
+        let push = Push {
+            duration: 1.0,
+            speed: 0.7,
+            phi,
+        };
+        let seg = SegmentDynamics::new(&b, &push);
+        assert!(
+            seg.inertial_slope() < 0.0,
+            "phi {phi}: k = {}",
+            seg.inertial_slope()
+        );
+        let root = seg.attractor_from(0.0).expect("a steady state");
+        for w in [-30.0, -2.0, -0.3, 1e-9, 0.3, 2.0, 30.0] {
+            let r = seg.attractor_from(w).expect("a steady state");
+            assert_eq!(
+                r.omega.to_bits(),
+                root.omega.to_bits(),
+                "phi {phi} from {w}"
+            );
+            assert_eq!(r.kind, root.kind);
+        }
+        let ulps = 8.0 * f64::EPSILON * (1.0 + root.omega.abs());
+        assert!(seg.moment(root.omega - ulps) >= 0.0 && seg.moment(root.omega + ulps) <= 0.0);
+    }
+}

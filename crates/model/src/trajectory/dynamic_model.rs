@@ -4,6 +4,7 @@
 //! `rk4`) where there is not.
 
 use super::checker::Checker;
+use super::push_cache::PushCache;
 use super::segment::{pose_of, Recorder, SegmentRun};
 use super::{adaptive, rk4, SegmentReport, Trajectory};
 use crate::dynamic::{SegmentDynamics, SteadyState};
@@ -92,10 +93,12 @@ impl DynamicModel {
     /// `r_min`: the shortest nonzero distance from the contact to a support (m).
     /// `spare`: the previous segment's dynamics on the same `body` and
     /// inertial term, of which only the push's part is redone;
-    /// `dir`: the push direction `n_φ`.
+    /// `dir`: the push direction `n_φ`; `cache`: what is kept per push
+    /// between runs (the same analysis, spared).
     #[allow(clippy::too_many_arguments)]
     fn segment(
         &self,
+        cache: Option<&mut PushCache>,
         spare: Option<SegmentDynamics>,
         body: &Body,
         push: &Push,
@@ -115,10 +118,11 @@ impl DynamicModel {
             }
             None => SegmentDynamics::with_inertial_term(body, push, self.inertial_term),
         };
-        let target = if push.speed > 0.0 {
-            dynamics.attractor_from(omega)
-        } else {
-            None
+        let mut cached = cache.map(|c| (c.entry(push), c));
+        let target = match &mut cached {
+            _ if push.speed <= 0.0 => None,
+            Some((i, c)) => c.attractor(*i, &dynamics, omega),
+            None => dynamics.attractor_from(omega),
         };
         // For a constant input ω is a scalar autonomous ODE: it moves
         // monotonically from ω_start to the root it tends to and never
@@ -142,9 +146,12 @@ impl DynamicModel {
                 kind: RootKind::Stable,
                 tau: Some(tau),
                 omega: ws,
-            }) if self.skip_settled && tau > 0.0 => {
-                SettleRule::new(&dynamics, ws, tol, omega, t1 - t0)
-            }
+            }) if self.skip_settled && tau > 0.0 => match cached {
+                Some((i, c)) => {
+                    SettleRule::new_with(&dynamics, ws, tol, omega, t1 - t0, c.memo(i, ws))
+                }
+                None => SettleRule::new(&dynamics, ws, tol, omega, t1 - t0),
+            },
             _ => None,
         };
         // A stable pivot is reached in finite time (ω̇ jumps there); past
@@ -262,13 +269,18 @@ impl DynamicModel {
     /// Walks `problem`'s segments (switch, analysis of ω̇, closed form or
     /// integrator), recording into `rec` the samples its sampler hands out
     /// and, with `reports`, one [`SegmentReport`] per segment. `problem`
-    /// and the integrator have been checked.
+    /// and the integrator have been checked. `cache`: kept per push between
+    /// runs (bound to the problem's body here).
     pub(super) fn run(
         &self,
         problem: &Problem,
         rec: &mut Recorder,
         reports: bool,
+        mut cache: Option<&mut PushCache>,
     ) -> Result<RunEnd, ModelError> {
+        if let Some(c) = cache.as_deref_mut() {
+            c.bind(&problem.body, self.inertial_term);
+        }
         let body = &problem.body;
         let pc = body.contact();
         let init = problem.initial;
@@ -309,6 +321,7 @@ impl DynamicModel {
             prev = Some(*push);
             prev_vel = Some(vel);
             let seg = self.segment(
+                cache.as_deref_mut(),
                 spare.take(),
                 body,
                 push,
@@ -366,7 +379,7 @@ impl Simulator for DynamicModel {
         problem.check()?;
         self.check_integrator()?;
         let mut rec = Recorder::new(problem, self.name(), self.check_assumptions);
-        let end = self.run(problem, &mut rec, true)?;
+        let end = self.run(problem, &mut rec, true, None)?;
         rec.out.assumptions = rec.checker.finish();
         if let Some(release) = &problem.release {
             let vel = (!problem.pushes.is_empty()).then_some(end.vel);

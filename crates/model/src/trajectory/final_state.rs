@@ -5,6 +5,7 @@
 //! closed forms), so their states are the full run's at those times.
 
 use super::dynamic_model::DynamicModel;
+use super::push_cache::PushCache;
 use super::sampling::Sampler;
 use super::segment::Recorder;
 use super::{SolverStats, Trajectory};
@@ -48,10 +49,31 @@ impl DynamicModel {
     /// With a `[release]`, the state is the slide's end: at rest, or at
     /// `max_duration` when the plate has not stopped.
     pub fn final_state(&self, problem: &Problem) -> Result<FinalState, ModelError> {
+        self.final_state_in(problem, None)
+    }
+
+    /// [`DynamicModel::final_state`] with the analysis of each push kept in
+    /// `cache` between calls (the root its segments tend to and the series
+    /// tail's coefficients, see [`PushCache`]): the same state to the bit,
+    /// at less cost when pushes repeat, as in a planner's finite-difference
+    /// Jacobian or a warm-started re-plan.
+    pub fn final_state_cached(
+        &self,
+        problem: &Problem,
+        cache: &mut PushCache,
+    ) -> Result<FinalState, ModelError> {
+        self.final_state_in(problem, Some(cache))
+    }
+
+    fn final_state_in(
+        &self,
+        problem: &Problem,
+        cache: Option<&mut PushCache>,
+    ) -> Result<FinalState, ModelError> {
         problem.check()?;
         self.check_integrator()?;
         let mut rec = Recorder::with_sampler(problem, String::new(), false, Sampler::none());
-        let end = self.run(problem, &mut rec, false)?;
+        let end = self.run(problem, &mut rec, false, cache)?;
         if let Some(release) = &problem.release {
             // Through the free slide to rest, with no sample taken.
             let vel = (!problem.pushes.is_empty()).then_some(end.vel);
@@ -123,7 +145,7 @@ impl DynamicModel {
         // Within a relative 1e-12 of the run a time counts as a switch's.
         let sampler = Sampler::at(times.to_vec(), 1e-12 * end);
         let mut rec = Recorder::with_sampler(problem, self.name(), self.check_assumptions, sampler);
-        self.run(problem, &mut rec, true)?;
+        self.run(problem, &mut rec, true, None)?;
         rec.out.assumptions = rec.checker.finish();
         Ok(rec.out)
     }

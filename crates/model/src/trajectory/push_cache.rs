@@ -1,0 +1,126 @@
+//! What the dynamic model's analysis of a push keeps between runs
+//! ([`PushCache`]): a planner predicts schedules that share most of their
+//! pushes (a finite-difference Jacobian changes one direction at a time; a
+//! warm-started re-plan starts from the last plan's directions), and per
+//! segment most of a run's work depends on the push alone.
+
+use crate::dynamic::{SegmentDynamics, SteadyState};
+use crate::tail::MapMemo;
+use crate::{Body, InertialTerm, Push};
+
+/// Pushes remembered at most; the oldest is replaced beyond that.
+const CAPACITY: usize = 32;
+
+/// Per push (speed and direction, to the bit) on one body: the steady state
+/// a segment tends to, when that does not depend on where ω starts (the
+/// inertial slope `k < 0`: `G` decreases and has one root), and the series
+/// tail's coefficients about it. [`DynamicModel::final_state_cached`] with
+/// a cache returns what [`DynamicModel::final_state`] returns, bit for bit;
+/// the cache only spares the work. It forgets everything when the body or
+/// the reading of the inertial term changes.
+///
+/// [`DynamicModel::final_state_cached`]: crate::DynamicModel::final_state_cached
+/// [`DynamicModel::final_state`]: crate::DynamicModel::final_state
+#[derive(Debug, Clone, Default)]
+pub struct PushCache {
+    /// The body and inertial term the entries belong to.
+    owner: Option<(Body, InertialTerm)>,
+    entries: Vec<Entry>,
+    /// The entry replaced next once full.
+    next: usize,
+    hits: usize,
+    misses: usize,
+}
+
+#[derive(Debug, Clone)]
+struct Entry {
+    /// `speed` and `phi` of the push, as bits.
+    key: (u64, u64),
+    /// The root its segments tend to (k < 0 only; None until found).
+    root: Option<Option<SteadyState>>,
+    /// ω* (bits) the memo is about.
+    memo_root: u64,
+    memo: Option<MapMemo>,
+}
+
+impl PushCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Pushes looked up and found, and not found, so far.
+    pub fn hits_misses(&self) -> (usize, usize) {
+        (self.hits, self.misses)
+    }
+
+    /// Empties the cache unless it belongs to `body` and `term`.
+    pub(super) fn bind(&mut self, body: &Body, term: InertialTerm) {
+        let same = self
+            .owner
+            .as_ref()
+            .is_some_and(|(b, t)| *t == term && b == body);
+        if !same {
+            self.owner = Some((body.clone(), term));
+            self.entries.clear();
+            self.next = 0;
+        }
+    }
+
+    /// The entry of `push`, made if new.
+    pub(super) fn entry(&mut self, push: &Push) -> usize {
+        let key = (push.speed.to_bits(), push.phi.to_bits());
+        if let Some(i) = self.entries.iter().position(|e| e.key == key) {
+            self.hits += 1;
+            return i;
+        }
+        self.misses += 1;
+        let e = Entry {
+            key,
+            root: None,
+            memo_root: 0,
+            memo: None,
+        };
+        if self.entries.len() < CAPACITY {
+            self.entries.push(e);
+            self.entries.len() - 1
+        } else {
+            let i = self.next;
+            self.entries[i] = e;
+            self.next = (i + 1) % CAPACITY;
+            i
+        }
+    }
+
+    /// [`SegmentDynamics::attractor_from`] for entry `i`'s push.
+    pub(super) fn attractor(
+        &mut self,
+        i: usize,
+        dynamics: &SegmentDynamics,
+        omega: f64,
+    ) -> Option<SteadyState> {
+        // The cases in which `attractor_from` returns the root of the push
+        // alone; every other goes to it.
+        if dynamics.inertial_slope() < 0.0
+            && dynamics.speed() > 0.0
+            && dynamics.moment(omega) != 0.0
+        {
+            *self.entries[i]
+                .root
+                .get_or_insert_with(|| dynamics.monotone_root())
+        } else {
+            dynamics.attractor_from(omega)
+        }
+    }
+
+    /// The memo slot of entry `i` for the root `omega` (emptied if it was
+    /// about another root).
+    pub(super) fn memo(&mut self, i: usize, omega: f64) -> &mut Option<MapMemo> {
+        let e = &mut self.entries[i];
+        if e.memo_root != omega.to_bits() {
+            e.memo_root = omega.to_bits();
+            e.memo = None;
+        }
+        &mut e.memo
+    }
+}
