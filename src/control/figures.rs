@@ -9,9 +9,16 @@ use pushval_control::predict::Start;
 use pushval_control::{Goal, ModelKind, Reach};
 use pushval_model::Problem;
 
-/// One success.csv row's key: engine, speed (bits), plan predictor, mode,
-/// plant.
-pub(crate) type Group = (String, u64, &'static str, &'static str, &'static str);
+/// One success.csv row's key: engine, speed (bits), rule (`release` or
+/// `rest`), plan predictor, mode, plant.
+pub(crate) type Group = (
+    String,
+    u64,
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static str,
+);
 
 use crate::plot::{self, Axis, Figure, Legend, MapCell, Panel, Scale, Series, Stroke};
 
@@ -51,13 +58,16 @@ pub(crate) fn success_figure(
     ];
     let scale = Scale::Classes(colors);
     let mut panels = Vec::new();
-    for &v in speeds {
+    for (v, at) in speeds
+        .iter()
+        .flat_map(|&v| super::study::RULES.map(|at| (v, at.as_str())))
+    {
         let mut cells = Vec::new();
         let n = names.len();
         for (row, name) in names.iter().enumerate() {
             let y = (n - 1 - row) as f64;
             for (col, c) in COLUMNS.iter().enumerate() {
-                let k: Group = (name.clone(), v.to_bits(), c.0, c.1, c.2);
+                let k: Group = (name.clone(), v.to_bits(), at, c.0, c.1, c.2);
                 let (value, mark) = match summary.get(&k) {
                     Some(&(ok, total, _, _)) if total > 0 => {
                         let share = ok as f64 / total as f64;
@@ -110,7 +120,7 @@ pub(crate) fn success_figure(
             c.push(plotters::style::RGBColor(255, 255, 255));
         }
         let panel = plot::heat_map(
-            format!("goals reached at {v} m/s"),
+            format!("goals reached at {v} m/s, judged at {at}"),
             Axis::lin("plan predictor · open loop or MPC · plant")
                 .range(0.0, 11.0)
                 .without_ticks(),
@@ -125,8 +135,10 @@ pub(crate) fn success_figure(
     }
     let labels = ["< 25 %", "25–50 %", "50–75 %", "75–95 %", "≥ 95 %"];
     let notes = vec![
-        "goals reached (20 mm, 5°, at rest".to_string(),
-        "unless runs.csv says release)".to_string(),
+        "goals reached (20 mm, 5°) judged".to_string(),
+        "at the release or at rest (an".to_string(),
+        "engine that cannot release: at".to_string(),
+        "the release, runs.csv judged_at)".to_string(),
         "dyn/kin: plan made on the".to_string(),
         "dynamic / kinematic model;".to_string(),
         "pert: plant μ × 0.8, I_cm × 1.2".to_string(),
@@ -134,7 +146,10 @@ pub(crate) fn success_figure(
     let key = scale.key("success", &labels, &notes);
     let rows = names.len().max(4) as u32;
     Figure {
-        size: (1500, 120 + 34 * (rows + 1) * speeds.len() as u32),
+        size: (
+            1500,
+            120 + 34 * (rows + 1) * (speeds.len() * super::study::RULES.len()) as u32,
+        ),
         cols: 1,
         panels,
         key: Some(key),
