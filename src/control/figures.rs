@@ -22,7 +22,9 @@ pub(crate) type Group = (
 
 use crate::plot::{self, Axis, Figure, Legend, MapCell, Panel, Scale, Series, Stroke};
 
-const COLUMNS: [(&str, &str, &str); 8] = [
+/// The columns of the tables and of `success.svg`: plan predictor, mode,
+/// plant.
+pub(crate) const COLUMNS: [(&str, &str, &str); 8] = [
     ("dynamic", "open", "nominal"),
     ("dynamic", "mpc", "nominal"),
     ("dynamic", "open", "perturbed"),
@@ -33,7 +35,8 @@ const COLUMNS: [(&str, &str, &str); 8] = [
     ("kinematic", "mpc", "perturbed"),
 ];
 
-fn short(c: &(&str, &str, &str)) -> String {
+/// A column's short label, e.g. `dyn·open·nom`.
+pub(crate) fn short(c: &(&str, &str, &str)) -> String {
     format!(
         "{}·{}·{}",
         if c.0 == "dynamic" { "dyn" } else { "kin" },
@@ -156,9 +159,10 @@ pub(crate) fn success_figure(
     }
 }
 
-/// The first goal's paths (dynamic plan, open loop, nominal plant, at the
-/// grid's fastest speed) in every engine, drawn over the goal and the
-/// dynamic model's prediction.
+/// The first goal's paths (the dynamic plan aimed at rest, open loop,
+/// nominal plant, at the grid's fastest speed) in every engine through the
+/// slide to rest, drawn over the goal and the dynamic model's prediction;
+/// an engine that cannot release is drawn to the release and says so.
 pub(crate) fn paths_figure(
     problem: &Problem,
     segments: usize,
@@ -173,7 +177,7 @@ pub(crate) fn paths_figure(
         segments,
         speed: v,
         predictor: ModelKind::Dynamic,
-        at: pushval_control::At::Release,
+        at: pushval_control::At::Rest,
     };
     let mut planner = Planner::new(
         problem,
@@ -185,7 +189,10 @@ pub(crate) fn paths_figure(
     let plan = planner.plan(&start).context("the first goal's plan")?;
     let mut p = problem.clone();
     p.pushes = plan.pushes.clone();
+    p.release = Some(p.release.unwrap_or_default());
     p.sample_dt = p.duration() / 200.0;
+    let mut held = p.clone();
+    held.release = None;
     let model = pushval_model::DynamicModel::default();
     let traj = pushval_model::Simulator::simulate(&model, &p)?;
     // The plate's outline: the hull of its support points in the body frame
@@ -221,7 +228,7 @@ pub(crate) fn paths_figure(
         let labels: Vec<&str> = members.iter().map(|s| s.as_str()).collect();
         let styles = plot::family_styles(&labels);
         let mut panel = Panel::new(
-            format!("{fam}: goal 0 at {v} m/s, the dynamic plan open loop"),
+            format!("{fam}: goal 0 at {v} m/s, the dynamic plan open loop, to rest"),
             Axis::lin("x (m)"),
             Axis::lin("y (m)"),
         )
@@ -241,11 +248,18 @@ pub(crate) fn paths_figure(
             let e = crate::registry::entry(name)
                 .expect("listed")
                 .default_engine();
-            match e.run(&p, e.default_dt()) {
+            let (run, label) = match e.run(&p, e.default_dt()) {
+                Err(pushval_model::ModelError::NoRelease { .. }) => (
+                    e.run(&held, e.default_dt()),
+                    format!("{name} (to the release: it cannot release)"),
+                ),
+                r => (r, (*name).clone()),
+            };
+            match run {
                 Ok(run) => {
                     let pts: Vec<(f64, f64)> =
                         run.trajectory.samples.iter().map(|s| (s.x, s.y)).collect();
-                    panel = panel.series(Series::new((*name).clone(), color, stroke).points(pts));
+                    panel = panel.series(Series::new(label, color, stroke).points(pts));
                     if let Some(l) = run.trajectory.samples.last() {
                         panel = panel.series(
                             Series::new(format!("{name}: final pose"), color, Stroke::Dotted)
