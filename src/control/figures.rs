@@ -123,7 +123,14 @@ pub(crate) fn success_figure(
             c.push(plotters::style::RGBColor(255, 255, 255));
         }
         let panel = plot::heat_map(
-            format!("goals reached at {v} m/s, judged at {at}"),
+            format!(
+                "goals reached at {v} m/s, judged {}",
+                if at == "rest" {
+                    "at rest"
+                } else {
+                    "at the release"
+                }
+            ),
             Axis::lin("plan predictor · open loop or MPC · plant")
                 .range(0.0, 11.0)
                 .without_ticks(),
