@@ -1026,6 +1026,32 @@ fn readme(problem: &Problem, c: &Counts) -> String {
         }
     }
     s.push('\n');
+    // The perturbed plant's slide: μ × 0.8 makes it 1/0.8 times as long as
+    // the predictor's, which no feedback corrects once the pusher has let go.
+    let mu_scale = PlantScale::PERTURBED.mu_scale;
+    let extra = |v: f64| v * v / (2.0 * decel) * (1.0 / mu_scale - 1.0);
+    let mut pert = Vec::new();
+    for n in &able {
+        let (rel, tot, _, _) = get(n, vmax, "release", "dynamic", "mpc", "perturbed");
+        let (rest, _, _, _) = get(n, vmax, "rest", "dynamic", "mpc", "perturbed");
+        if rel >= rest + 2 {
+            pert.push(format!("{n} {rel}/{tot} → {rest}/{tot}"));
+        }
+    }
+    if !pert.is_empty() {
+        s.push_str(&format!(
+            "On the perturbed plant (μ × {mu_scale}) a plate released at the pusher's speed slides 1/{mu_scale} times as far as the predictor expects: about {:.1} mm further at {vmax} m/s{}, and no feedback acts once the pusher has let go. MPC on the perturbed plant loses two or more goals at rest against the release rule at {vmax} m/s in {} of {} engines that release ({}).\n\n",
+            extra(vmax) * 1e3,
+            speeds
+                .iter()
+                .filter(|&&v| v < vmax)
+                .map(|&v| format!(" ({:.1} mm at {v} m/s)", extra(v) * 1e3))
+                .collect::<String>(),
+            pert.len(),
+            able.len(),
+            pert.join(", ")
+        ));
+    }
     // Where the goals lost at rest (dynamic plan, open loop, nominal plant,
     // at least two at some speed) come from, from what each engine declares.
     let (mut slide, mut integ, mut push, mut nolaw) =
@@ -1139,6 +1165,11 @@ fn readme(problem: &Problem, c: &Counts) -> String {
         } else {
             let cause = if coulomb {
                 "its declared law is Coulomb's, the model's, so the misses come from how it integrates the scene, not from its friction law".to_string()
+            } else if e.law().is_some_and(|l| l.coulomb_on_run_loads()) {
+                format!(
+                    "{}; its friction is Coulomb's on the loads it carries, so the misses come from those loads or from how it integrates the scene, not from the shape of its law",
+                    law.clone().unwrap_or_default()
+                )
             } else {
                 format!(
                     "{}; a controller whose predictor has the model's law cannot steer a plate that turns otherwise",
