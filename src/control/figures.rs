@@ -9,13 +9,22 @@ use pushval_control::predict::Start;
 use pushval_control::{Goal, ModelKind, Reach};
 use pushval_model::Problem;
 
-/// One success.csv row's key: engine, speed (bits), plan predictor, mode,
-/// plant.
-pub(crate) type Group = (String, u64, &'static str, &'static str, &'static str);
+/// One success.csv row's key: engine, speed (bits), rule (`release` or
+/// `rest`), plan predictor, mode, plant.
+pub(crate) type Group = (
+    String,
+    u64,
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static str,
+);
 
 use crate::plot::{self, Axis, Figure, Legend, MapCell, Panel, Scale, Series, Stroke};
 
-const COLUMNS: [(&str, &str, &str); 8] = [
+/// The columns of the tables and of `success.svg`: plan predictor, mode,
+/// plant.
+pub(crate) const COLUMNS: [(&str, &str, &str); 8] = [
     ("dynamic", "open", "nominal"),
     ("dynamic", "mpc", "nominal"),
     ("dynamic", "open", "perturbed"),
@@ -26,7 +35,8 @@ const COLUMNS: [(&str, &str, &str); 8] = [
     ("kinematic", "mpc", "perturbed"),
 ];
 
-fn short(c: &(&str, &str, &str)) -> String {
+/// A column's short label, e.g. `dyn·open·nom`.
+pub(crate) fn short(c: &(&str, &str, &str)) -> String {
     format!(
         "{}·{}·{}",
         if c.0 == "dynamic" { "dyn" } else { "kin" },
@@ -51,13 +61,16 @@ pub(crate) fn success_figure(
     ];
     let scale = Scale::Classes(colors);
     let mut panels = Vec::new();
-    for &v in speeds {
+    for (v, at) in speeds
+        .iter()
+        .flat_map(|&v| super::study::RULES.map(|at| (v, at.as_str())))
+    {
         let mut cells = Vec::new();
         let n = names.len();
         for (row, name) in names.iter().enumerate() {
             let y = (n - 1 - row) as f64;
             for (col, c) in COLUMNS.iter().enumerate() {
-                let k: Group = (name.clone(), v.to_bits(), c.0, c.1, c.2);
+                let k: Group = (name.clone(), v.to_bits(), at, c.0, c.1, c.2);
                 let (value, mark) = match summary.get(&k) {
                     Some(&(ok, total, _, _)) if total > 0 => {
                         let share = ok as f64 / total as f64;
@@ -110,7 +123,14 @@ pub(crate) fn success_figure(
             c.push(plotters::style::RGBColor(255, 255, 255));
         }
         let panel = plot::heat_map(
-            format!("goals reached at {v} m/s"),
+            format!(
+                "goals reached at {v} m/s, judged {}",
+                if at == "rest" {
+                    "at rest"
+                } else {
+                    "at the release"
+                }
+            ),
             Axis::lin("plan predictor · open loop or MPC · plant")
                 .range(0.0, 11.0)
                 .without_ticks(),
@@ -125,8 +145,10 @@ pub(crate) fn success_figure(
     }
     let labels = ["< 25 %", "25–50 %", "50–75 %", "75–95 %", "≥ 95 %"];
     let notes = vec![
-        "goals reached (20 mm, 5°, at rest".to_string(),
-        "unless runs.csv says release)".to_string(),
+        "goals reached (20 mm, 5°) judged".to_string(),
+        "at the release or at rest (an".to_string(),
+        "engine that cannot release: at".to_string(),
+        "the release, runs.csv judged_at)".to_string(),
         "dyn/kin: plan made on the".to_string(),
         "dynamic / kinematic model;".to_string(),
         "pert: plant μ × 0.8, I_cm × 1.2".to_string(),
@@ -134,16 +156,20 @@ pub(crate) fn success_figure(
     let key = scale.key("success", &labels, &notes);
     let rows = names.len().max(4) as u32;
     Figure {
-        size: (1500, 120 + 34 * (rows + 1) * speeds.len() as u32),
+        size: (
+            1500,
+            120 + 34 * (rows + 1) * (speeds.len() * super::study::RULES.len()) as u32,
+        ),
         cols: 1,
         panels,
         key: Some(key),
     }
 }
 
-/// The first goal's paths (dynamic plan, open loop, nominal plant, at the
-/// grid's fastest speed) in every engine, drawn over the goal and the
-/// dynamic model's prediction.
+/// The first goal's paths (the dynamic plan aimed at rest, open loop,
+/// nominal plant, at the grid's fastest speed) in every engine through the
+/// slide to rest, drawn over the goal and the dynamic model's prediction;
+/// an engine that cannot release is drawn to the release and says so.
 pub(crate) fn paths_figure(
     problem: &Problem,
     segments: usize,
@@ -158,7 +184,7 @@ pub(crate) fn paths_figure(
         segments,
         speed: v,
         predictor: ModelKind::Dynamic,
-        at: pushval_control::At::Release,
+        at: pushval_control::At::Rest,
     };
     let mut planner = Planner::new(
         problem,
@@ -170,7 +196,10 @@ pub(crate) fn paths_figure(
     let plan = planner.plan(&start).context("the first goal's plan")?;
     let mut p = problem.clone();
     p.pushes = plan.pushes.clone();
+    p.release = Some(p.release.unwrap_or_default());
     p.sample_dt = p.duration() / 200.0;
+    let mut held = p.clone();
+    held.release = None;
     let model = pushval_model::DynamicModel::default();
     let traj = pushval_model::Simulator::simulate(&model, &p)?;
     // The plate's outline: the hull of its support points in the body frame
@@ -206,7 +235,7 @@ pub(crate) fn paths_figure(
         let labels: Vec<&str> = members.iter().map(|s| s.as_str()).collect();
         let styles = plot::family_styles(&labels);
         let mut panel = Panel::new(
-            format!("{fam}: goal 0 at {v} m/s, the dynamic plan open loop"),
+            format!("{fam}: goal 0 at {v} m/s, the dynamic plan open loop, to rest"),
             Axis::lin("x (m)"),
             Axis::lin("y (m)"),
         )
@@ -226,11 +255,18 @@ pub(crate) fn paths_figure(
             let e = crate::registry::entry(name)
                 .expect("listed")
                 .default_engine();
-            match e.run(&p, e.default_dt()) {
+            let (run, label) = match e.run(&p, e.default_dt()) {
+                Err(pushval_model::ModelError::NoRelease { .. }) => (
+                    e.run(&held, e.default_dt()),
+                    format!("{name} (to the release: it cannot release)"),
+                ),
+                r => (r, (*name).clone()),
+            };
+            match run {
                 Ok(run) => {
                     let pts: Vec<(f64, f64)> =
                         run.trajectory.samples.iter().map(|s| (s.x, s.y)).collect();
-                    panel = panel.series(Series::new((*name).clone(), color, stroke).points(pts));
+                    panel = panel.series(Series::new(label, color, stroke).points(pts));
                     if let Some(l) = run.trajectory.samples.last() {
                         panel = panel.series(
                             Series::new(format!("{name}: final pose"), color, Stroke::Dotted)

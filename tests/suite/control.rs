@@ -809,3 +809,80 @@ fn a_loop_judged_at_rest_releases_the_plant_and_judges_its_rest() {
         .unwrap()
         .contains("[release]"));
 }
+
+/// The control study judges every run by both rules: the quick grid in
+/// rapier2d (Coulomb friction at every support, the model's law) has each
+/// (predictor, mode, plant) at the release and at rest, runs.csv's `at` is
+/// the rule asked and `judged_at` what judged it (rapier2d releases, so the
+/// same). From the physics: at 1 m/s the plate slides v²/(2μg) ≈ 0.1 m
+/// after the release (μ = 0.5), five tolerances, yet the dynamic plans aimed
+/// at rest reach, open loop on the nominal plant, the goals the plans aimed
+/// at the release reach (within one), and their median miss at rest is
+/// inside the 20 mm tolerance: the model's slide is the engine's.
+#[test]
+fn the_control_study_judges_both_rules_and_a_coulomb_engine_keeps_its_goals_at_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("study");
+    let st = pushval()
+        .current_dir(root())
+        .args(["control-study", "--quick", "--only", "rapier2d", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let table = |name: &str| -> (Vec<String>, Vec<Vec<String>>) {
+        let text = std::fs::read_to_string(out.join(name)).unwrap();
+        let mut lines = text.lines();
+        let head = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect();
+        (head, rows)
+    };
+    let col = |head: &[String], name: &str| head.iter().position(|h| h == name).unwrap();
+    let (head, rows) = table("runs.csv");
+    let (at, judged) = (col(&head, "at"), col(&head, "judged_at"));
+    // 3 goals × 2 predictors × 2 modes × 2 plants, per rule, at 1 m/s.
+    for rule in ["release", "rest"] {
+        let n = rows.iter().filter(|r| r[at] == rule).count();
+        assert_eq!(n, 24, "{rule}: {n} runs");
+    }
+    assert_eq!(rows.len(), 48);
+    for r in &rows {
+        assert_eq!(r[at], r[judged], "{r:?}");
+    }
+    let (head, rows) = table("success.csv");
+    let (at, pr, mode, plant, ok, goals, pe, judged) = (
+        col(&head, "at"),
+        col(&head, "predictor"),
+        col(&head, "mode"),
+        col(&head, "plant"),
+        col(&head, "successes"),
+        col(&head, "goals"),
+        col(&head, "median_position_error_m"),
+        col(&head, "judged_at"),
+    );
+    assert_eq!(rows.len(), 16, "8 groups per rule");
+    let cell = |rule: &str| {
+        rows.iter()
+            .find(|r| {
+                r[at] == rule && r[pr] == "dynamic" && r[mode] == "open" && r[plant] == "nominal"
+            })
+            .unwrap_or_else(|| panic!("no {rule} row"))
+            .clone()
+    };
+    let (release, rest) = (cell("release"), cell("rest"));
+    assert_eq!(rest[judged], "rest");
+    assert_eq!(release[judged], "release");
+    assert_eq!(rest[goals], "3");
+    let n = |r: &Vec<String>, i: usize| r[i].parse::<f64>().unwrap();
+    assert!(
+        n(&rest, ok) >= n(&release, ok) - 1.0,
+        "at rest {rest:?}, at the release {release:?}"
+    );
+    assert!(n(&rest, pe) < 0.02, "{rest:?}");
+}
