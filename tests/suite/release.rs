@@ -255,7 +255,9 @@ fn the_rest_state_is_at_rest_and_a_short_slide_is_not_rest() {
 }
 
 /// An engine that cannot release refuses a release problem, naming itself
-/// and the release; it never runs the pushes and stops there.
+/// and the release; it never runs the pushes and stops there. Every
+/// compiled-in engine releases, so the engine here is an outside one
+/// declared without a session: a whole-run document has no slide.
 #[test]
 fn an_engine_that_cannot_release_refuses_naming_it() {
     let p = problem(
@@ -266,11 +268,19 @@ fn an_engine_that_cannot_release_refuses_naming_it() {
         }],
         Initial::default(),
     );
-    let e = engine("rapier2d_impulse_disk");
+    let adapter = crate::common::root().join("adapters/python/pure_python.py");
+    let file = crate::common::root().join("pushval.toml");
+    let text = format!(
+        "[engine.whole_run]\ncommand = [\"python3\", {:?}]\n",
+        adapter.display().to_string()
+    );
+    let config = pushval_outside::Config::from_toml(&text, &file).unwrap();
+    let spec = std::sync::Arc::new(config.engines[0].clone());
+    let e = pushval_outside::OutsideEngine::new(spec, &Default::default());
     match e.run(&p, 1e-3) {
         Err(err @ ModelError::NoRelease { .. }) => {
             let text = err.to_string();
-            assert!(text.contains("rapier2d_impulse_disk"), "{text}");
+            assert!(text.contains("whole_run"), "{text}");
             assert!(text.contains("release"), "{text}");
         }
         other => panic!("not refused: {other:?}"),

@@ -161,8 +161,8 @@ fn rapier2d_slide_is_gated_at_first_order() {
     assert!((0.8..=1.2).contains(&p), "observed order {p}");
 }
 
-/// The slide study (quick grid): every engine that refuses the release is
-/// reported as refused, never as measured; rapier2d's rows agree with the
+/// The slide study (quick grid): every compiled-in engine, the friction
+/// idioms included, releases and is measured; rapier2d's rows agree with the
 /// model within the first-order bounds of the module's header at its step
 /// and at half of it, and the gap halves with the step; `throws.csv` holds
 /// one parsed row per engine, step and throw.
@@ -181,15 +181,17 @@ fn slide_study_rows_agree_with_the_model_within_the_step() {
         let e = study.engines.iter().find(|e| e.name == name).unwrap();
         assert_eq!(e.status, Status::Released, "{name}");
     }
-    assert!(matches!(
-        study
-            .engines
-            .iter()
-            .find(|e| e.name == "rapier2d_impulse_disk")
-            .unwrap()
-            .status,
-        Status::Refused(_)
-    ));
+    // The friction idioms let go too, each sliding under its own law.
+    for name in [
+        "rapier2d_impulse_disk",
+        "rapier2d_impulse_box",
+        "rapier2d_regularised_linear",
+        "rapier2d_regularised_tanh",
+        "box2d_motor_joint",
+    ] {
+        let e = study.engines.iter().find(|e| e.name == name).unwrap();
+        assert_eq!(e.status, Status::Released, "{name}");
+    }
     let h = study
         .engines
         .iter()
@@ -241,30 +243,54 @@ fn slide_study_rows_agree_with_the_model_within_the_step() {
 
 /// A gated engine that cannot let go is not applicable to a thrown plate:
 /// its row is neither a pass nor a failure, names the release, and the
-/// scenario's other gate still decides.
+/// scenario's other gate still decides. Every compiled-in engine lets go,
+/// so the one that cannot is an outside engine declared without a session
+/// (a whole-run document has no slide), through the binary.
 #[test]
 fn a_gated_engine_that_cannot_let_go_is_not_applicable() {
-    let mut sc = load(&root().join("scenarios/thrown-square.toml"));
-    sc.gate = vec!["rapier2d".into(), "rapier2d_impulse_disk".into()];
-    if !sc.models.iter().any(|m| m == "rapier2d_impulse_disk") {
-        sc.models.push("rapier2d_impulse_disk".into());
-    }
-    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
-    let c = report
-        .comparisons
-        .iter()
-        .find(|c| c.model == "rapier2d_impulse_disk")
+    let dir = tempfile::tempdir().unwrap();
+    let adapter = root().join("adapters/python/pure_python.py");
+    let engines = dir.path().join("engines.toml");
+    std::fs::write(
+        &engines,
+        format!(
+            "[engine.whole_run]\ncommand = [\"python3\", {:?}]\norder = 1\ndt = 0.001\n",
+            adapter.display().to_string()
+        ),
+    )
+    .unwrap();
+    let models =
+        "models = [\"dynamic\", \"rapier2d\", \"box2d\", \"rapier3d\", \"rapier2d_impulse_disk\"]";
+    let text = std::fs::read_to_string(root().join("scenarios/thrown-square.toml")).unwrap();
+    assert!(text.contains(models), "{text}");
+    let text = text.replace(
+        models,
+        "models = [\"dynamic\", \"rapier2d\", \"whole_run\"]\ngate = [\"rapier2d\", \"whole_run\"]",
+    );
+    let sc = dir.path().join("thrown.toml");
+    std::fs::write(&sc, text).unwrap();
+    let junit = dir.path().join("junit.xml");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .arg("run")
+        .arg(&sc)
+        .arg("--engines")
+        .arg(&engines)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .arg("--junit")
+        .arg(&junit)
+        .output()
         .unwrap();
-    assert_eq!(c.pass, None, "{c:?}");
-    let e = c.error.as_deref().unwrap();
-    assert!(
-        e.starts_with("not applicable") && e.contains("release"),
-        "{e}"
+    let said = format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
     );
-    assert!(report.pass());
-    let junit = pushval::output::junit(std::slice::from_ref(&report));
-    assert!(
-        junit.contains("<skipped message=\"not applicable"),
-        "{junit}"
-    );
+    assert_eq!(o.status.code(), Some(0), "{said}");
+    let junit = std::fs::read_to_string(&junit).unwrap();
+    let skipped = junit
+        .lines()
+        .find(|l| l.contains("<skipped message=\"not applicable"))
+        .unwrap_or_else(|| panic!("{junit}"));
+    assert!(skipped.contains("release"), "{skipped}");
 }

@@ -25,6 +25,13 @@
 //!   body to the object with zero target velocities whose force and torque
 //!   are capped ([`predict`] has its steady state in closed form).
 //!
+//! Both let go ([`pushval_engine::EngineSession::release`]): the pusher's
+//! joint is destroyed; Coulomb slides on the implicit impulses of
+//! `pushval_engine::slide`, and the motor joint, which is the idiom's
+//! friction, stays and stops the translation at its force cap's
+//! deceleration μg and the spin at its torque cap's, each on its own and
+//! within a step once the cap can hold it (README, "The release").
+//!
 //! Box2D stores velocities, rotations, forces, masses and joint data in f32
 //! whatever the build; `double-precision` makes only the world positions
 //! f64. The adapter works in f64 and rounds where it hands values over.

@@ -414,18 +414,14 @@ impl PlateWorld for Stepper {
     }
 
     /// Destroys the pin joint and stops the pusher; a throw sets the
-    /// object's velocity. Only the Coulomb model slides (the motor-joint
-    /// idiom has no slide here).
+    /// object's velocity. Both laws slide: Coulomb through
+    /// [`slide_step`](PlateWorld::slide_step), the motor-joint idiom under
+    /// its motor joint, which stays (it is the friction, not the pusher).
     fn release(
         &mut self,
         _state: &State,
         throw: Option<([f64; 2], f64)>,
     ) -> Result<(), ModelError> {
-        if self.scene.friction != Friction::Coulomb {
-            return Err(pushval_engine::no_release(
-                "the motor-joint friction idiom has no free slide in this adapter (only the Coulomb model slides)",
-            ));
-        }
         let err = engine_error(self.t0);
         let w = &mut self.scene.world;
         w.joint(self.scene.joint)
@@ -450,7 +446,15 @@ impl PlateWorld for Stepper {
     /// The supports' implicit Coulomb impulses of
     /// [`pushval_engine::slide`] (no chatter at the stop), applied as a
     /// constant force at the centre of mass and a torque over the step.
+    /// Under the motor-joint idiom nothing: the motor joint, solved by
+    /// Box2D, holds the plate's velocity at zero within its force and
+    /// torque caps, so it decelerates the translation at `F_max/m` and the
+    /// spin at `T_max/I` each on its own and stops each within a step once
+    /// the cap suffices (crate docs).
     fn slide_step(&mut self, state: &State, h: f64) {
+        if self.scene.friction == Friction::MotorJoint {
+            return;
+        }
         let sup: Vec<([f64; 2], f64)> = self
             .scene
             .supports

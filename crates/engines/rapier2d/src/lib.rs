@@ -23,6 +23,12 @@
 //! chosen at run time by [`EngineSettings::precision`]; one source file
 //! (`world.rs`) is compiled once for each precision.
 //!
+//! After a release the pin joint goes and the plate slides to rest under
+//! its support friction: Coulomb's as implicit impulses, the impulse idioms'
+//! joints solved together by sequential impulses (they stop the plate in a
+//! step once their caps can), the regularised laws as forces (a geometric
+//! creep below their slip speed): see [`slide`] and the README.
+//!
 //! Units are SI throughout (m, s, rad, kg, N).
 #![warn(missing_docs)]
 
@@ -38,6 +44,8 @@ mod f64_engine;
 /// The 2-D friction idioms and their closed forms (they live in
 /// `pushval-laws`).
 pub use pushval_laws::idioms;
+/// The friction idioms over a step of the free slide.
+pub mod slide;
 
 pub use engine::{laws, models, Rapier2dModel, ENGINE_CRATE};
 pub use idioms::FrictionModel;

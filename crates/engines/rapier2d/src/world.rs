@@ -458,19 +458,13 @@ impl PlateWorld for World2d {
     }
 
     /// Removes the pin joint and stops the pusher; a throw sets the
-    /// object's velocity. Only the Coulomb model slides (the idioms'
-    /// impulse caps and regularisations have no slide here).
+    /// object's velocity. Every friction model slides (see
+    /// [`slide_step`](PlateWorld::slide_step)).
     fn release(
         &mut self,
         _state: &State,
         throw: Option<([f64; 2], f64)>,
     ) -> Result<(), ModelError> {
-        if self.friction_model != FrictionModel::Coulomb {
-            return Err(pushval_engine::no_release(format!(
-                "the {} friction idiom has no free slide in this adapter (only the Coulomb model slides)",
-                self.friction_model.as_str()
-            )));
-        }
         self.world.remove_impulse_joint(self.joint);
         {
             let p = &mut self.world.bodies[self.pusher];
@@ -486,28 +480,56 @@ impl PlateWorld for World2d {
         Ok(())
     }
 
-    /// The supports' Coulomb friction over a step of the slide, without
-    /// chattering at the stop: the implicit Coulomb impulses of
-    /// [`pushval_engine::slide`] (each support's impulse capped at what
-    /// leaves its slip zero at the step's end), applied as the constant
-    /// forces `Pᵢ / h` at the supports.
+    /// The supports' friction over a step of the slide, applied as the
+    /// constant forces `Pᵢ / h` at the supports (the impulses `Pᵢ` of the
+    /// step). Coulomb: the implicit impulses of [`pushval_engine::slide`]
+    /// (each support's impulse capped at what leaves its slip zero at the
+    /// step's end: no chatter at the stop). The impulse idioms: their
+    /// joints solved together by sequential impulses
+    /// ([`crate::slide::idiom_impulses`]), which stop the plate within a
+    /// step once their caps allow it. The regularised laws: each support's
+    /// force on the step's start velocity, as in the pushing steps (module
+    /// docs of [`crate::slide`]).
     fn slide_step(&mut self, state: &State, h: f64) {
         let rs: Vec<([f64; 2], f64)> = self
             .supports
             .iter()
-            .map(|s| (state.rot.apply(s.0), s.1.max(0.0) * h))
+            .map(|s| (state.rot.apply(s.0), s.1.max(0.0)))
             .collect();
-        let acc = pushval_engine::slide::coulomb_impulses(
-            self.mass,
-            self.inertia_cm,
-            state.v,
-            state.omega,
-            &rs,
-        );
+        let law = LawContext {
+            mass: self.mass,
+            inertia_cm: self.inertia_cm,
+            dt: h,
+        };
+        let impulses = match self.friction_model {
+            FrictionModel::Coulomb => {
+                let caps: Vec<([f64; 2], f64)> = rs.iter().map(|&(r, f)| (r, f * h)).collect();
+                pushval_engine::slide::coulomb_impulses(
+                    self.mass,
+                    self.inertia_cm,
+                    state.v,
+                    state.omega,
+                    &caps,
+                )
+            }
+            model => crate::slide::idiom_impulses(model, &law, state.v, state.omega, &rs)
+                .unwrap_or_else(|| {
+                    rs.iter()
+                        .map(|&(r, f)| {
+                            let u = [
+                                state.v[0] - state.omega * r[1],
+                                state.v[1] + state.omega * r[0],
+                            ];
+                            let force = support_force(model, u, r, f, &law);
+                            [force[0] * h, force[1] * h]
+                        })
+                        .collect()
+                }),
+        };
         let rb = &mut self.world.bodies[self.object];
         rb.reset_forces(false);
         rb.reset_torques(false);
-        for ((r, _), a) in rs.iter().zip(&acc) {
+        for ((r, _), a) in rs.iter().zip(&impulses) {
             if *a != [0.0, 0.0] {
                 let point = v(state.x + r[0], state.y + r[1]);
                 rb.add_force_at_point(v(a[0] / h, a[1] / h), point, true);
