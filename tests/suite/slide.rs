@@ -161,6 +161,34 @@ fn rapier2d_slide_is_gated_at_first_order() {
     assert!((0.8..=1.2).contains(&p), "observed order {p}");
 }
 
+/// pure_python_heun declares order 2, for its pushes and its slide alike
+/// (Heun's step while every support slides, the implicit step only at the
+/// stop): the gate's ladder observes second order on the thrown square and
+/// the gate passes on its auto tolerances. A slide integrated at first
+/// order (as `pure_python`'s is) shows 1 here and fails the declaration.
+#[test]
+fn pure_python_heun_slides_at_the_second_order_it_declares() {
+    use_repo_engines();
+    let mut sc = load(&root().join("scenarios/thrown-square.toml"));
+    sc.models.retain(|m| m == "dynamic");
+    sc.models.push("pure_python_heun".into());
+    sc.gate = vec!["pure_python_heun".into()];
+    let engine =
+        pushval::registry::engine("pure_python_heun", &pushval::registry::engine_options(&sc));
+    assert_eq!(engine.order_for(&sc.problem()), 2.0);
+    let report = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let c = report
+        .comparisons
+        .iter()
+        .find(|c| c.model == "pure_python_heun")
+        .unwrap();
+    let order = c.tolerance.as_ref().unwrap().order.clone().unwrap();
+    assert_eq!(order.declared, 2.0);
+    let p = order.observed.expect("the slide's order is observed");
+    assert!((1.7..=2.3).contains(&p), "observed order {p}");
+    assert_eq!(c.pass, Some(true), "{:?}", c.failed);
+}
+
 /// The slide study (quick grid): every compiled-in engine, the friction
 /// idioms included, releases and is measured; rapier2d's rows agree with the
 /// model within the first-order bounds of the module's header at its step
