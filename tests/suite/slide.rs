@@ -299,12 +299,10 @@ fn a_gated_engine_that_cannot_let_go_is_not_applicable() {
     std::fs::write(&sc, text).unwrap();
     let junit = dir.path().join("junit.xml");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_pushval"))
-        .arg("run")
+        .arg("validate")
         .arg(&sc)
         .arg("--engines")
         .arg(&engines)
-        .arg("--out")
-        .arg(dir.path().join("out"))
         .arg("--junit")
         .arg(&junit)
         .output()
