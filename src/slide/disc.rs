@@ -23,8 +23,18 @@ use anyhow::Context;
 use pushval_engine::Engine;
 use pushval_model::{slide_to_rest, Problem, SlideOptions, SlideState};
 
-use super::measure::Status;
 use crate::outdir::{num, Csv};
+
+/// What became of one engine in the study.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Status {
+    /// It released on every throw.
+    Released,
+    /// It refused the release (it cannot let go): not applicable.
+    Refused(String),
+    /// It failed to run (its error).
+    Failed(String),
+}
 
 /// The shipped scenario of the thrown disc.
 pub const DISC_SCENE: &str = "thrown-disc.toml";

@@ -5,6 +5,7 @@ use pushval_engine::Engine;
 use pushval_model::{DynamicModel, Integrator, ModelError, Problem, Simulator, Vec2};
 use rayon::prelude::*;
 
+use super::disc::Status;
 use crate::harness::{rest_of, Rest};
 use crate::outdir::{num, Csv};
 
@@ -166,17 +167,6 @@ fn rest_or_end(
         theta: b.theta,
     };
     (None, Some((end, speed)))
-}
-
-/// What became of one engine in the study.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Status {
-    /// It released on every throw.
-    Released,
-    /// It refused the release (it cannot let go): not applicable.
-    Refused(String),
-    /// It failed to run (its error).
-    Failed(String),
 }
 
 /// One engine of the study.

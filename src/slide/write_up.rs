@@ -3,7 +3,8 @@
 
 use crate::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
-use super::measure::{EngineRow, Row, Status, Study, SCENE};
+use super::disc::Status;
+use super::measure::{EngineRow, Row, Study, SCENE};
 
 /// Values below this are drawn at it on the figure's log axes.
 const FLOOR: f64 = 1e-12;
