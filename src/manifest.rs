@@ -125,6 +125,7 @@ pub const RULES: &[Rule] = &[
         files: &[
             "results/slide/throws.csv",
             "results/slide/engines.csv",
+            "results/slide/disc.csv",
             "results/slide/rest.svg",
             "results/slide/README.md",
         ],

@@ -5,6 +5,7 @@ use pushval_engine::Engine;
 use pushval_model::{DynamicModel, Integrator, ModelError, Problem, Simulator, Vec2};
 use rayon::prelude::*;
 
+use super::disc::Status;
 use crate::harness::{rest_of, Rest};
 use crate::outdir::{num, Csv};
 
@@ -99,6 +100,11 @@ pub struct Row {
     pub model: Option<Rest>,
     /// The engine's rest (None: not stopped).
     pub engine_rest: Option<Rest>,
+    /// Where the engine's plate was when the slide was cut at
+    /// `max_duration` without a stop (its `t` that time), and the rest
+    /// rule's speed `|v| + |ω| L` (m/s) over its last sample interval;
+    /// None when it stopped.
+    pub engine_end: Option<(Rest, f64)>,
 }
 
 impl Row {
@@ -123,17 +129,44 @@ impl Row {
             _ => f64::NAN,
         }
     }
+    /// Distance (m) from the model's rest to where an engine that did not
+    /// stop was at `max_duration`; NaN otherwise.
+    pub fn d_end(&self) -> f64 {
+        match (self.model, self.engine_end) {
+            (Some(m), Some((e, _))) => (e.x - m.x).hypot(e.y - m.y),
+            _ => f64::NAN,
+        }
+    }
 }
 
-/// What became of one engine in the study.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Status {
-    /// It released on every throw.
-    Released,
-    /// It refused the release (it cannot let go): not applicable.
-    Refused(String),
-    /// It failed to run (its error).
-    Failed(String),
+/// What one run through the slide gives the study: its rest, or where it
+/// was at `max_duration` and its speed there (see [`Row::engine_end`]).
+fn rest_or_end(
+    problem: &Problem,
+    tr: &pushval_model::Trajectory,
+) -> (Option<Rest>, Option<(Rest, f64)>) {
+    if let Some(r) = rest_of(tr) {
+        return (Some(r), None);
+    }
+    let n = tr.samples.len();
+    if n < 2 {
+        return (None, None);
+    }
+    let (a, b) = (tr.samples[n - 2], tr.samples[n - 1]);
+    let dt = b.t - a.t;
+    let v = if dt > 0.0 {
+        [(b.x - a.x) / dt, (b.y - a.y) / dt]
+    } else {
+        [f64::NAN; 2]
+    };
+    let speed = pushval_engine::rest_speed(problem, v, b.omega);
+    let end = Rest {
+        t: b.t,
+        x: b.x,
+        y: b.y,
+        theta: b.theta,
+    };
+    (None, Some((end, speed)))
 }
 
 /// One engine of the study.
@@ -158,6 +191,8 @@ pub struct Study {
     pub quick: bool,
     pub engines: Vec<EngineRow>,
     pub rows: Vec<Row>,
+    /// The thrown disc's ratio `v/(Rω)` near the stop, per engine.
+    pub disc: super::disc::DiscStudy,
 }
 
 /// The scene's problem: the shipped `thrown-square` scenario's.
@@ -194,8 +229,9 @@ pub fn run_engine(
     model: &[Option<Rest>],
 ) -> (Status, Vec<Row>) {
     let h = engine.default_dt();
-    let one = |t: &Throw, dt: f64| -> Result<Option<Rest>, ModelError> {
-        Ok(rest_of(&engine.run(&t.problem(scene), dt)?.trajectory))
+    let one = |t: &Throw, dt: f64| -> Result<(Option<Rest>, Option<(Rest, f64)>), ModelError> {
+        let p = t.problem(scene);
+        Ok(rest_or_end(&p, &engine.run(&p, dt)?.trajectory))
     };
     if let Some(first) = throws.first() {
         match one(first, h) {
@@ -210,12 +246,14 @@ pub fn run_engine(
     let results: Vec<Result<Row, ModelError>> = jobs
         .par_iter()
         .map(|&(i, dt)| {
+            let (engine_rest, engine_end) = one(&throws[i], dt)?;
             Ok(Row {
                 engine: engine.name().to_string(),
                 dt,
                 throw: throws[i],
                 model: model[i],
-                engine_rest: one(&throws[i], dt)?,
+                engine_rest,
+                engine_end,
             })
         })
         .collect();
@@ -241,17 +279,21 @@ pub fn measure(quick: bool) -> anyhow::Result<Study> {
         .map(|t| model_rest(&t.problem(&scene)))
         .collect::<Result<_, _>>()
         .context("the dynamic model's slide")?;
+    let available: Vec<(String, Box<dyn Engine>)> = crate::registry::entries()
+        .into_iter()
+        .map(|entry| (entry.name.clone(), entry.default_engine()))
+        .filter(|(_, e)| e.availability().is_ok())
+        .collect();
+    // The disc first: one run per engine, cheap.
+    let engines_only: Vec<&dyn Engine> = available.iter().map(|(_, e)| e.as_ref()).collect();
+    let disc = super::disc::measure_disc(&engines_only)?;
     let mut engines = Vec::new();
     let mut rows = Vec::new();
-    for entry in crate::registry::entries() {
-        let engine = entry.default_engine();
-        if engine.availability().is_err() {
-            continue;
-        }
+    for (name, engine) in &available {
         let (status, mut r) = run_engine(engine.as_ref(), &throws, &scene, &model);
         engines.push(EngineRow {
-            name: entry.name.clone(),
-            law: declared_law(&entry.name),
+            name: name.clone(),
+            law: declared_law(name),
             dt: engine.default_dt(),
             declared_order: engine.order_for(&scene),
             status,
@@ -263,6 +305,7 @@ pub fn measure(quick: bool) -> anyhow::Result<Study> {
         quick,
         engines,
         rows,
+        disc,
     })
 }
 
@@ -285,6 +328,11 @@ pub fn throws_csv(study: &Study) -> Csv {
         "d_position",
         "d_theta",
         "d_t_stop",
+        "end_t",
+        "end_x",
+        "end_y",
+        "end_theta",
+        "end_speed",
     ]);
     let f = |r: Option<Rest>, k: fn(&Rest) -> f64| r.as_ref().map_or(String::new(), |r| num(k(r)));
     for r in &study.rows {
@@ -305,6 +353,11 @@ pub fn throws_csv(study: &Study) -> Csv {
             num(r.d_position()),
             num(r.d_theta()),
             num(r.d_t_stop()),
+            f(r.engine_end.map(|e| e.0), |r| r.t),
+            f(r.engine_end.map(|e| e.0), |r| r.x),
+            f(r.engine_end.map(|e| e.0), |r| r.y),
+            f(r.engine_end.map(|e| e.0), |r| r.theta),
+            r.engine_end.map_or(String::new(), |e| num(e.1)),
         ]);
     }
     csv

@@ -3,7 +3,9 @@
 //! rest pose and stop time against the dynamic model's; writes
 //! `results/slide/` (or `--out DIR`): `throws.csv` (one row per engine, step
 //! and throw), `engines.csv` (one row per engine: its declared law, whether
-//! it released), `rest.svg` and a generated `README.md`.
+//! it released), `disc.csv` (the thrown disc's ratio v/(Rω) near the stop,
+//! one row per engine: see the `disc` module), `rest.svg` and a generated
+//! `README.md`.
 //!
 //! The scene is the shipped `thrown-square` scenario's plate (the seed's
 //! 0.25 m square, 1 kg, μ 0.5 on its four corners); each throw replaces its
@@ -17,9 +19,11 @@ use std::process::ExitCode;
 
 use crate::outdir::Writer;
 
+mod disc;
 mod measure;
 mod write_up;
 
+pub use disc::*;
 pub use measure::*;
 
 /// `pushval slide-study`: measures and writes the folder whole (into a
@@ -31,6 +35,7 @@ pub fn cli(out: &Path, quick: bool) -> anyhow::Result<ExitCode> {
     let throws = throws_csv(&study);
     w.file("throws.csv", throws.as_bytes())?;
     w.file("engines.csv", engines_csv(&study).as_bytes())?;
+    w.file("disc.csv", disc_csv(&study.disc).as_bytes())?;
     w.figure("rest.svg", &write_up::figure(&study))?;
     w.file("README.md", write_up::readme(&study).as_bytes())?;
     let names: Vec<PathBuf> = w

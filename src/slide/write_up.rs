@@ -3,7 +3,8 @@
 
 use crate::plot::{self, Axis, Figure, Legend, Panel, Series, Stroke};
 
-use super::measure::{EngineRow, Row, Status, Study, SCENE};
+use super::disc::Status;
+use super::measure::{EngineRow, Row, Study, SCENE};
 
 /// Values below this are drawn at it on the figure's log axes.
 const FLOOR: f64 = 1e-12;
@@ -178,6 +179,32 @@ fn sci(v: f64) -> String {
     }
 }
 
+/// How a plate comes to rest under the law `name` (a catalogue name), as
+/// its form says: what decelerates it while it slides and what ends the
+/// slide. Empty for a law this study has no sentence for.
+pub fn law_stop(name: &str) -> &'static str {
+    match name {
+        "coulomb" => "Coulomb friction does not depend on the speed: the plate decelerates at a rate bounded below (μg for a translation) and stops in finite time, translation and spin at the same instant (Goyal, Ruina & Papadopoulos 1991); an engine that integrates it with capped or implicit impulses ends the slide within a step, one that regularises it near zero slip creeps there instead.",
+        "impulse_disk" => "A friction joint per support: while it slides each joint's impulse is at its cap μNΔt along −K⁻¹u, bent from −u towards the direction of the larger effective mass (on the square thrown along an edge only 0.857 of μg acts against the motion, so it slides 17 % farther than Coulomb's v²/(2μg); along a diagonal it is Coulomb's); once the caps can hold the plate the joints, solved together, stop it within a step: no creep.",
+        "impulse_box" => "The stopping impulse capped per world axis: a translation along an axis decelerates at μg, one along a diagonal at √2 μg (both rows at their caps), so the law depends on the direction of the throw and on the plate's angle; once the rows' caps can hold the plate they stop it within a step: no creep.",
+        "impulse_rows_disk" => "Bullet's two rows per contact scaled onto the disc: Coulomb's magnitude while sliding, its direction bent towards the row with the larger effective mass (exactly Coulomb's where every support has r_x² = r_y²); the solver's rows stop the plate within a step once the disc can hold it.",
+        "regularised_linear" => "Coulomb above the slip speed v_s, viscous below it: the last v_s of slip decays exponentially (rate μg/v_s) instead of stopping, which adds about v_s²/(2μg) to the distance and the time to decay from v_s to the rest rule's 1e-5 m/s (a few ln(v_s/1e-5) v_s/(μg)) to the stop.",
+        "regularised_tanh" => "Coulomb smoothed everywhere by tanh(|u|/v_s): Coulomb's for slips well above v_s, viscous below, so the slide ends in an exponential creep (rate μg/v_s) that adds π²v_s²/(12μg) to the distance and ln-many time constants to the stop.",
+        "rapier3d_contact_disk" => "Each foot's friction along −K⁻¹u capped at μN, as the friction joint's, with the feet's loads from the tilting balance (springs ∝ effective mass): the direction bends as the joint's does and the loads shift with the deceleration, so it stops where a Coulomb plate with those loads would, within a step once the caps hold.",
+        "rapier3d_simplified_twist" => "One friction disc μΣN at the feet's mean and a separate twist limit μΣN|p−c|: translation and spin are capped each on its own, as a motor joint caps them, so they need not stop at the same instant, and the rest differs from Coulomb's wherever the throw spins.",
+        "mujoco_elliptic" => "A soft elliptic cone: Coulomb's bound μN against the slip while the feet slide; near the stop the friction is a soft constraint whose slip decays with its time constant τ (about 10 ms at the default solref), a tail that adds up to μgτ² to the distance and τ ln(μgτ/1e-5 m/s) to the time to rest.",
+        "physx_patch" => "Box-clamped rows (t0 and t1 each clamped on its own, not as a disc) at two anchors of the welded patch, each capped at half μΣN: against a slip along a diagonal of the rows the box allows up to √2 times Coulomb's friction, along a row Coulomb's; whether the rows, re-anchored on the patch's contacts every step, hold the plate still at the end is the engine's solver's, not the law's (the numbers below say).",
+        "physx_two_directional" => "At every foot one row along the centre of mass's velocity and one across it, each clamped at μN: along the motion Coulomb's magnitude, across it a second cap (a box in the velocity's frame), so a spinning throw meets more friction than Coulomb's; the rows stop the plate within a step once they hold.",
+        "physx_one_directional" => "One clamped row per foot, along and across the centre of mass's velocity by turns on a welded patch: the friction acts along one direction a step, so a sliding, spinning plate is decelerated in alternation and comes to rest elsewhere than Coulomb's.",
+        "box2d_motor_joint" => "A motor joint to the ground holding the velocity at zero with its force capped at ΣμN and its torque at ΣμN|p_i|, each on its own: the translation stops after v/(μg) at v²/(2μg), the spin after Iω/T_max, each within a step (a velocity constraint, no creep), but not at the same instant as Coulomb's do, and the path is straight.",
+        "avian3d_tilt" => "Coulomb along −u at every foot with its soft contacts' loads, moved by the couple of the raised centre of mass: Coulomb's stop with loads shifted forward while it decelerates, ended by the solver's velocity constraints.",
+        "jolt_box" => "One friction disc μΣN at the corners' mean with world-axis rows and a twist row clamped at μΣdᵢNᵢ: translation and spin capped each on its own (as the motor joint's), so they need not stop together.",
+        "jolt_feet" => "A disc μN per foot along the effective-mass direction of world-axis rows (yaw-dependent, no twist row): the friction joint's bend, in the world axes, stopped within a step once the discs hold.",
+        "drake_sap" | "drake_similar" => "Coulomb at every foot with the loads of a convex relaxation that lifts a sliding foot; regularised near zero slip (Drake's stiction tolerance), so the slide ends in a short creep, and the hops of the lift move the loads.",
+        _ => "",
+    }
+}
+
 /// What one engine's numbers say about its stop, from its declared law.
 fn engine_paragraph(study: &Study, e: &EngineRow) -> String {
     let (law_name, law_about) = e
@@ -185,9 +212,11 @@ fn engine_paragraph(study: &Study, e: &EngineRow) -> String {
         .clone()
         .unwrap_or_else(|| ("none".into(), "it declares no law in closed form.".into()));
     let (a, b) = engine_gaps(study, &e.name, e.dt);
+    let stop = law_stop(&law_name);
     let mut s = format!(
-        "**{}** declares `{law_name}`: {law_about}\nOver {} throws at dt = {} s its rest lies a median {} m (at most {} m) and at most {} rad from the model's, and it stops at most {} s from the model's stop time, on average {} s {}.",
+        "**{}** declares `{law_name}`: {law_about}{}{stop}\nOver {} throws at dt = {} s its rest lies a median {} m (at most {} m) and at most {} rad from the model's, and it stops at most {} s from the model's stop time, on average {} s {}.",
         e.name,
+        if stop.is_empty() { "" } else { " How it stops: " },
         a.n,
         e.dt,
         sci(a.position_median),
@@ -198,10 +227,34 @@ fn engine_paragraph(study: &Study, e: &EngineRow) -> String {
         if a.t_stop_mean >= 0.0 { "later" } else { "earlier" },
     );
     if a.unstopped > 0 {
+        let ends: Vec<&Row> = study
+            .rows
+            .iter()
+            .filter(|r| r.engine == e.name && r.dt == e.dt && r.engine_end.is_some())
+            .collect();
+        let speeds: Vec<f64> = ends
+            .iter()
+            .filter_map(|r| r.engine_end.map(|x| x.1))
+            .collect();
+        let far = ends.iter().map(|r| r.d_end()).fold(0.0, f64::max);
         s.push_str(&format!(
-            " On {} throws it did not stop within the release's max_duration, or the model did not.",
-            a.unstopped
+            " On {} of the throws it did not stop within the release's max_duration ({} s) by the rest rule",
+            a.unstopped,
+            ends.first().and_then(|r| r.engine_end).map_or("-".into(), |x| format!("{}", x.0.t)),
         ));
+        if !speeds.is_empty() {
+            s.push_str(&format!(
+                ": at the end it still moved at a median {} m/s (at most {} m/s), {} m at most from the model's rest",
+                sci(median(speeds.clone())),
+                sci(speeds.iter().cloned().fold(0.0, f64::max)),
+                sci(far),
+            ));
+        }
+        s.push_str(". It is reported, not tuned away.");
+    }
+    if a.n == 0 || b.n == 0 {
+        s.push_str(" With no rest at one of its two steps, how its gap moves with the step is not measured.");
+        return s;
     }
     let ratio = a.position_max / b.position_max;
     let order = ratio.log2();
@@ -301,6 +354,108 @@ fn coulomb_paragraph(study: &Study) -> Option<String> {
     ))
 }
 
+/// The disc's section: the ratio v/(Rω) near the stop, per engine.
+fn disc_section(study: &Study) -> String {
+    let d = &study.disc;
+    let mut s = format!(
+        "## The thrown disc: v/(Rω) at the stop\n\nA uniform disc sliding and spinning stops translating and turning together, and its ratio v/(Rω) tends to 0.653 at the stop whatever the throw (Farkas, Bartels, Unger & Wolf 2003). Each engine runs the shipped `{}` scenario (R = {} m, {} supports on its 20 mm grid, thrown at 0.3 m/s and 3 rad/s) at its step h, a row every step; `disc.csv` has the ratio at 40, 20 and 10 steps before its stop (v from the last step's displacement) and their Aitken extrapolation, beside the dynamic model's at the same times before the model's stop ({} s). On this grid the model's own limit is {:.4} (its jagged rim moves it off the continuous disc's 0.653; the model's test holds finer grids to 0.653).\n\n| engine | h (s) | stop (s) | ratio 40h, 20h, 10h before | extrapolated | model at the same times | model extrapolated |\n|---|---|---|---|---|---|---|\n",
+        super::disc::DISC_SCENE.trim_end_matches(".toml"),
+        d.radius,
+        d.supports,
+        format_args!("{:.4}", d.model_t_stop),
+        d.model_limit,
+    );
+    let f3 = |v: &[f64; 3]| {
+        v.iter()
+            .map(|x| {
+                if x.is_finite() {
+                    format!("{x:.3}")
+                } else {
+                    "-".into()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let f = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.3}")
+        } else {
+            "-".into()
+        }
+    };
+    for r in &d.rows {
+        let stop = match (&r.status, r.t_stop) {
+            (Status::Released, Some(t)) => format!("{t:.4}"),
+            (Status::Released, None) => "not stopped".into(),
+            (Status::Refused(_), _) => "refused".into(),
+            (Status::Failed(_), _) => "failed".into(),
+        };
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} |\n",
+            r.engine,
+            r.dt,
+            stop,
+            f3(&r.ratios),
+            f(r.extrapolated()),
+            f3(&r.model_ratios),
+            f(r.model_extrapolated()),
+        ));
+    }
+    let read: Vec<&super::disc::DiscRow> = d
+        .rows
+        .iter()
+        .filter(|r| r.ratios.iter().all(|x| x.is_finite()))
+        .collect();
+    if !read.is_empty() {
+        let gaps: Vec<f64> = read
+            .iter()
+            .map(|r| (r.ratios[2] - r.model_ratios[2]).abs())
+            .collect();
+        let close = read
+            .iter()
+            .zip(&gaps)
+            .filter(|(_, g)| **g <= 0.05)
+            .map(|(r, _)| r.engine.as_str())
+            .collect::<Vec<_>>();
+        let apart = read
+            .iter()
+            .zip(&gaps)
+            .filter(|(_, g)| **g > 0.05)
+            .map(|(r, g)| format!("{} ({:.3})", r.engine, g))
+            .collect::<Vec<_>>();
+        s.push_str(&format!(
+            "\nTen steps before the stop, {} of the {} engines read follow the model's ratio within 0.05{}{}.",
+            close.len(),
+            read.len(),
+            if close.is_empty() { String::new() } else { format!(" ({})", close.join(", ")) },
+            if apart.is_empty() {
+                String::new()
+            } else {
+                format!("; the others differ from it by {} (the engines' paragraphs above say how each law stops)", apart.join(", "))
+            },
+        ));
+    }
+    let unread: Vec<String> = d
+        .rows
+        .iter()
+        .filter(|r| !r.ratios.iter().all(|x| x.is_finite()))
+        .map(|r| match &r.status {
+            Status::Refused(why) | Status::Failed(why) => format!("{} ({why})", r.engine),
+            Status::Released if r.t_stop.is_none() => format!("{} (did not stop)", r.engine),
+            Status::Released => format!(
+                "{} (stopped within 40 steps of the throw, or its rows missed the read times)",
+                r.engine
+            ),
+        })
+        .collect();
+    if !unread.is_empty() {
+        s.push_str(&format!(" Not read: {}.", unread.join("; ")));
+    }
+    s.push_str("\n\n");
+    s
+}
+
 /// The generated README.md.
 pub fn readme(study: &Study) -> String {
     let g = &study.grid;
@@ -334,6 +489,7 @@ pub fn readme(study: &Study) -> String {
         s.push_str(&p);
         s.push_str("\n\n");
     }
+    s.push_str(&disc_section(study));
     let refused: Vec<_> = study
         .engines
         .iter()
