@@ -63,7 +63,7 @@ pub(crate) fn success_figure(
     let mut panels = Vec::new();
     for (v, at) in speeds
         .iter()
-        .flat_map(|&v| super::study::RULES.map(|at| (v, at.as_str())))
+        .flat_map(|&v| pushval_control::At::ALL.map(|at| (v, at.as_str())))
     {
         let mut cells = Vec::new();
         let n = names.len();
@@ -158,7 +158,7 @@ pub(crate) fn success_figure(
     Figure {
         size: (
             1500,
-            120 + 34 * (rows + 1) * (speeds.len() * super::study::RULES.len()) as u32,
+            120 + 34 * (rows + 1) * (speeds.len() * pushval_control::At::ALL.len()) as u32,
         ),
         cols: 1,
         panels,

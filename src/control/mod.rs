@@ -7,7 +7,9 @@
 pub mod adaptive;
 pub mod cli;
 pub mod figures;
+pub mod grid;
 pub mod study;
+pub mod write_up;
 
 use anyhow::{bail, Context};
 use pushval_control::mpc::PlantScale;

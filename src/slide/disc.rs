@@ -144,7 +144,6 @@ fn model_states(
             tol: 1e-13,
             max_duration,
             sample_times: &ts,
-            ..Default::default()
         },
     )?;
     Ok((sl.samples, stop))

@@ -219,6 +219,10 @@ fn declared_law(name: &str) -> Option<(String, String)> {
         .map(|(entry, _)| (entry.name.to_string(), entry.about.to_string()))
 }
 
+/// A run's rest, or where it ended and its speed there when it did not
+/// stop ([`rest_or_end`]).
+type RestOrEnd = (Option<Rest>, Option<(Rest, f64)>);
+
 /// Runs one engine on every throw at `h` and `h/2` (the model's rests
 /// given, in throw order). An engine that refuses the release, or fails,
 /// on the first throw is not run further.
@@ -229,7 +233,7 @@ pub fn run_engine(
     model: &[Option<Rest>],
 ) -> (Status, Vec<Row>) {
     let h = engine.default_dt();
-    let one = |t: &Throw, dt: f64| -> Result<(Option<Rest>, Option<(Rest, f64)>), ModelError> {
+    let one = |t: &Throw, dt: f64| -> Result<RestOrEnd, ModelError> {
         let p = t.problem(scene);
         Ok(rest_or_end(&p, &engine.run(&p, dt)?.trajectory))
     };

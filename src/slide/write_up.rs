@@ -425,7 +425,7 @@ fn disc_section(study: &Study) -> String {
             .map(|(r, g)| format!("{} ({:.3})", r.engine, g))
             .collect::<Vec<_>>();
         s.push_str(&format!(
-            "\nTen steps before the stop, {} of the {} engines read follow the model's ratio within 0.05{}{}.",
+            "\nTen steps before the stop, {} of the {} engines whose ratio could be read follow the model's ratio within 0.05{}{}.",
             close.len(),
             read.len(),
             if close.is_empty() { String::new() } else { format!(" ({})", close.join(", ")) },

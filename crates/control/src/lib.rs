@@ -41,6 +41,9 @@ pub enum At {
 }
 
 impl At {
+    /// Both rules, the release's first (the order a study reports them in).
+    pub const ALL: [At; 2] = [At::Release, At::Rest];
+
     /// `rest` or `release`.
     pub fn as_str(&self) -> &'static str {
         match self {
