@@ -101,7 +101,9 @@ enum Command {
         /// results/friction_models/MODEL (for all: results/friction_models).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Reduced grids (for tests).
+        /// Reduced grids (for tests): a 5-by-5 map of the base setup only
+        /// (no variant's map), the study file's quick ladder, one fit
+        /// schedule.
         #[arg(long)]
         quick: bool,
         /// Compute only part K of N of the tasks (K/N contiguous, hash:K/N by

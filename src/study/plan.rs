@@ -171,7 +171,10 @@ impl Plan {
                 supports_half: v.supports_half,
                 phi: v.phi.unwrap_or(PHI_TABLE),
                 dt: v.dt.unwrap_or(dt),
-                map: v.map,
+                // A variant's map is the full grid's: under --quick (the
+                // tests' grid) only the base setup is mapped, its table
+                // row (`variants.csv`) is kept.
+                map: v.map && !quick,
             });
         }
         let t_run = spec.t_run.unwrap_or(6.0);
