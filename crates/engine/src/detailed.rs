@@ -230,3 +230,35 @@ impl<S: DetailedSession> DetailedSession for FirstPush<S> {
         self.session.ok_or(ModelError::EmptySchedule)?.finish()
     }
 }
+
+/// The session of an engine this build cannot run (a cargo feature left
+/// out): it cannot be made, so its simulator's `start` only returns the
+/// error that says why; its record type is the engine's.
+pub enum Unavailable<R> {
+    #[doc(hidden)]
+    Never(std::convert::Infallible, std::marker::PhantomData<R>),
+}
+
+impl<R: DetailedRun> DetailedSession for Unavailable<R> {
+    type Run = R;
+    fn state(&self) -> EngineState {
+        match *self {
+            Self::Never(never, _) => match never {},
+        }
+    }
+    fn advance(&mut self, _: &Push) -> Result<(), ModelError> {
+        match *self {
+            Self::Never(never, _) => match never {},
+        }
+    }
+    fn steps_taken(&self) -> usize {
+        match *self {
+            Self::Never(never, _) => match never {},
+        }
+    }
+    fn finish(self) -> Result<R, ModelError> {
+        match self {
+            Self::Never(never, _) => match never {},
+        }
+    }
+}

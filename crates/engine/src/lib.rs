@@ -32,6 +32,7 @@ pub mod stepping;
 pub use contact::{ContactRecord, LoadRecorder, LOST_SHARE_OF_WEIGHT};
 pub use detailed::{
     drive, on_first_push, Detailed, DetailedEngine, DetailedRun, DetailedSession, FirstPush, RunOf,
+    Unavailable,
 };
 pub use options::{EngineOptions, OptionError, SceneFrame};
 /// The friction laws in closed form live in `pushval-laws`; re-exported so
