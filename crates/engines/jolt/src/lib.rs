@@ -44,7 +44,7 @@
 //! system; joltc's global set-up is serialised by a lock.
 //!
 //! Without the `jolt` feature the crate builds with no Jolt ([`AVAILABLE`]
-//! is false) and [`JoltSimulator::run`] returns an error.
+//! is false) and `JoltSimulator`'s `start` (and so `run`) returns an error.
 //!
 //! Units are SI throughout (m, s, rad, kg, N).
 #![warn(missing_docs)]

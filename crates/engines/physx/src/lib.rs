@@ -70,7 +70,7 @@
 //! PhysX computes in f32.
 //!
 //! Without the `physx` feature the crate builds with no PhysX at all
-//! ([`AVAILABLE`] is false) and [`PhysxSimulator::run`] returns an error.
+//! ([`AVAILABLE`] is false) and `PhysxSimulator`'s `start` (and so `run`) returns an error.
 //!
 //! Units are SI throughout (m, s, rad, kg, N).
 #![warn(missing_docs)]

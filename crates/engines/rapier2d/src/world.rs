@@ -131,7 +131,7 @@ pub struct World2d {
 
 /// Builds the world of `problem` in this precision's rapier build and hands
 /// it to the shared loop; `outline` is the object's outline for its collider
-/// (see `RapierSimulator::run_with_outline`). An object not starting at rest
+/// (see `RapierSimulator::start_with_outline`). An object not starting at rest
 /// starts with the first push of `problem`'s schedule (the first push
 /// applied: see `pushval_engine::on_first_push`).
 pub(crate) fn start(
