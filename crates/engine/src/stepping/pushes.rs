@@ -312,9 +312,11 @@ impl<W: PlateWorld> Stepping<W> {
                 }
             }
         }
+        // No step in the run's last fifth (a plate thrown without pushes):
+        // no mean, NaN (null in the diagnostics).
         out.loads = run_n
             .iter()
-            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+            .map(|a| if run_t > 0.0 { a / run_t } else { f64::NAN })
             .collect();
         out.contact = recorder.finish();
         (self.world, out, problem)

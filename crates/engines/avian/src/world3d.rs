@@ -662,9 +662,10 @@ pub(crate) fn finish(
         rest_loads: world.rest_loads,
         mu: world.mu,
         segment_tail_loads: world.tail_loads,
+        // No step in the run's last fifth (thrown without pushes): NaN.
         loads: run_acc
             .iter()
-            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+            .map(|a| if run_t > 0.0 { a / run_t } else { f64::NAN })
             .collect(),
         contact: run.contact,
         max_tilt: world.max_tilt,
