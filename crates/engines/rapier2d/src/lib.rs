@@ -337,7 +337,7 @@ impl RapierSimulator {
         on_first_push(problem, move |problem| {
             let start = Instant::now();
             Ok(match sim.settings.precision {
-                Precision::F64 => session::Worlds::F64(PlateSession::new(
+                Precision::F64 => session::Worlds::F64(Box::new(PlateSession::new(
                     f64_engine::world::start(problem, &sim.settings, &outline)?,
                     Box::new(move |world, stepped, problem| {
                         Ok(sim.rapier_run(
@@ -346,8 +346,8 @@ impl RapierSimulator {
                             start,
                         ))
                     }),
-                )),
-                Precision::F32 => session::Worlds::F32(PlateSession::new(
+                ))),
+                Precision::F32 => session::Worlds::F32(Box::new(PlateSession::new(
                     f32_engine::world::start(problem, &sim.settings, &outline)?,
                     Box::new(move |world, stepped, problem| {
                         Ok(sim.rapier_run(
@@ -356,7 +356,7 @@ impl RapierSimulator {
                             start,
                         ))
                     }),
-                )),
+                ))),
             })
         })
     }
@@ -439,8 +439,8 @@ mod session {
 
     /// The session's world in either precision.
     pub enum Worlds {
-        F64(PlateSession<f64_engine::world::World2d, RapierRun>),
-        F32(PlateSession<f32_engine::world::World2d, RapierRun>),
+        F64(Box<PlateSession<f64_engine::world::World2d, RapierRun>>),
+        F32(Box<PlateSession<f32_engine::world::World2d, RapierRun>>),
     }
 
     /// Both precisions' sessions answer alike.
@@ -471,7 +471,7 @@ mod session {
             each!(self, s => s.slide())
         }
         fn finish(self) -> Result<RapierRun, ModelError> {
-            each!(self, s => s.finish())
+            each!(self, s => (*s).finish())
         }
     }
 }
