@@ -9,6 +9,12 @@
 //! `report`, `stress`, the studies and the benches use engines only through
 //! this trait, so none of them names an engine.
 //!
+//! An engine crate has one face: its simulator's typed session
+//! ([`DetailedEngine`], [`DetailedSession`]), which finishes into the
+//! crate's own record of the run ([`DetailedRun`]); its [`Engine`] session
+//! is that same session behind [`Detailed`], and the [`EngineRun`] is the
+//! record converted once.
+//!
 //! It also holds the one resampler every adapter shares ([`resample`]):
 //! engine steps in, samples at the problem's sample times out; and the one
 //! stepping loop of the plate engines ([`stepping`]).
