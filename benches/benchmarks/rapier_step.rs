@@ -10,7 +10,9 @@
 
 use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use pushval_model::{Initial, Problem, Push, Switching};
-use pushval_rapier2d::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
+use pushval_rapier2d::{
+    DetailedEngine, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
+};
 use std::hint::black_box;
 
 fn rapier_step(c: &mut Criterion) {

@@ -16,7 +16,7 @@ use pushval_model::{
     perp, rotate, Body, ContactLimits, DynamicModel, Initial, Integrator, Problem, Push,
     SegmentDynamics, Simulator, Support, Switching, Trajectory, Vec2,
 };
-use pushval_rapier2d::{EngineSettings, RapierSimulator};
+use pushval_rapier2d::{DetailedEngine, EngineSettings, RapierSimulator};
 use pushval_scenario::polygon_mass_properties;
 
 const G: f64 = 9.81;

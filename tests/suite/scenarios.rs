@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use approx::assert_relative_eq;
 use pushval::{output, run_scenario, RunOptions};
 use pushval_model::{DynamicModel, Simulator};
-use pushval_rapier2d::{EngineSettings, RapierSimulator};
+use pushval_rapier2d::{drive, DetailedEngine, EngineSettings, RapierSimulator};
 use rstest::rstest;
 
 use crate::common::*;
@@ -349,7 +349,8 @@ fn scenario_engine_colliders_change_nothing(#[files("scenarios/*.toml")] path: P
         colliders: true,
         ..settings
     })
-    .run_with_outline(&problem, &outline)
+    .start_with_outline(&problem, &outline)
+    .and_then(|s| drive(s, &problem))
     .unwrap();
     assert_eq!(a.trajectory.samples, b.trajectory.samples);
 }

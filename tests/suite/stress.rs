@@ -13,7 +13,7 @@ use pushval_model::{
     arc_advance, rotate, Body, DynamicModel, Initial, Integrator, Problem, Push, RootKind,
     SegmentDynamics, Simulator, Support, Trajectory, Vec2,
 };
-use pushval_rapier2d::{tail_mean_omega, EngineSettings, RapierSimulator};
+use pushval_rapier2d::{tail_mean_omega, DetailedEngine, EngineSettings, RapierSimulator};
 
 use crate::common::*;
 

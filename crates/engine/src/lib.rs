@@ -9,6 +9,12 @@
 //! `report`, `stress`, the studies and the benches use engines only through
 //! this trait, so none of them names an engine.
 //!
+//! An engine crate has one face: its simulator's typed session
+//! ([`DetailedEngine`], [`DetailedSession`]), which finishes into the
+//! crate's own record of the run ([`DetailedRun`]); its [`Engine`] session
+//! is that same session behind [`Detailed`], and the [`EngineRun`] is the
+//! record converted once.
+//!
 //! It also holds the one resampler every adapter shares ([`resample`]):
 //! engine steps in, samples at the problem's sample times out; and the one
 //! stepping loop of the plate engines ([`stepping`]).
@@ -22,6 +28,7 @@ use std::time::Duration;
 use pushval_model::{ModelError, Problem, Trajectory};
 
 mod contact;
+mod detailed;
 mod options;
 mod resample;
 mod session;
@@ -29,6 +36,10 @@ pub mod slide;
 pub mod stepping;
 
 pub use contact::{ContactRecord, LoadRecorder, LOST_SHARE_OF_WEIGHT};
+pub use detailed::{
+    drive, on_first_push, Detailed, DetailedEngine, DetailedRun, DetailedSession, FirstPush, RunOf,
+    Unavailable,
+};
 pub use options::{EngineOptions, OptionError, SceneFrame};
 /// The friction laws in closed form live in `pushval-laws`; re-exported so
 /// that `pushval_engine::FrictionLaw` and its companions keep their paths.
@@ -40,9 +51,8 @@ pub use resample::{
     trajectory_from_steps, StepRecord,
 };
 pub use session::{
-    after_release, no_release, on_first_push, on_thread, rest_speed, rigid_cm_velocity,
-    run_via_session, with_pushes, EngineSession, EngineState, ReplaySession, Session, REST_SPEED,
-    REST_STEPS,
+    after_release, no_release, on_thread, rest_speed, rigid_cm_velocity, run_via_session,
+    with_pushes, EngineSession, EngineState, ReplaySession, Session, REST_SPEED, REST_STEPS,
 };
 
 /// What one engine run produced.

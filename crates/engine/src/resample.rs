@@ -87,6 +87,10 @@ fn omega_in(steps: &[StepRecord], t: f64) -> f64 {
 /// the initial state (see the module docs for the reading).
 pub fn sample(problem: &Problem, history: &[StepRecord]) -> Vec<Sample> {
     let times = problem.segment_times();
+    if times.is_empty() || history.is_empty() {
+        // No push (a plate thrown at once): no samples of pushes.
+        return Vec::new();
+    }
     let ranges = segment_ranges(times.len(), history);
     problem
         .sample_times()

@@ -12,7 +12,7 @@
 //! it was advanced by, never on a schedule announced at `start` (the engine
 //! is handed the start's problem without its schedule; an object that does
 //! not start at rest is set moving with the first push applied,
-//! [`on_first_push`]).
+//! [`on_first_push`](crate::on_first_push)).
 //!
 //! A session is owned and `Send`: it borrows nothing from its engine, so a
 //! loop, a thread or a binding can hold one. An engine whose world cannot
@@ -178,89 +178,6 @@ pub fn with_pushes(problem: &Problem, pushes: Vec<Push>) -> Problem {
     Problem {
         pushes,
         ..problem.clone()
-    }
-}
-
-/// Builds an engine's session for `problem` (whose schedule is empty) with
-/// `build`, where the start can be built without a push: at once for an
-/// object at rest; for an object that starts moving (with the contact
-/// velocity of its first push), at the first `advance`, with that push as
-/// the schedule of the problem `build` receives. Until then the session's
-/// state is [`EngineState::initial`].
-pub fn on_first_push<F>(problem: &Problem, build: F) -> Result<Session, ModelError>
-where
-    F: FnOnce(&Problem) -> Result<Session, ModelError> + Send + 'static,
-{
-    if problem.initial.from_rest {
-        return build(&with_pushes(problem, Vec::new()));
-    }
-    Ok(Box::new(Deferred {
-        problem: with_pushes(problem, Vec::new()),
-        build: Some(Box::new(build)),
-        session: None,
-    }))
-}
-
-/// The builder a [`Deferred`] session keeps until its first push.
-type Build = Box<dyn FnOnce(&Problem) -> Result<Session, ModelError> + Send>;
-
-/// A session built at its first push ([`on_first_push`]).
-struct Deferred {
-    problem: Problem,
-    build: Option<Build>,
-    session: Option<Session>,
-}
-
-impl EngineSession for Deferred {
-    fn state(&self) -> EngineState {
-        match &self.session {
-            Some(s) => s.state(),
-            None => EngineState::initial(&self.problem),
-        }
-    }
-
-    fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
-        if self.session.is_none() {
-            let build = self.build.take().ok_or_else(|| {
-                ModelError::Adapter("the session failed to start at its first push".into())
-            })?;
-            self.session = Some(build(&with_pushes(&self.problem, vec![*push]))?);
-        }
-        self.session.as_mut().expect("built above").advance(push)
-    }
-
-    fn finish(self: Box<Self>) -> Result<EngineRun, ModelError> {
-        self.session.ok_or(ModelError::EmptySchedule)?.finish()
-    }
-
-    fn replays(&self) -> bool {
-        self.session.as_ref().is_some_and(|s| s.replays())
-    }
-
-    fn steps_taken(&self) -> usize {
-        self.session.as_ref().map_or(0, |s| s.steps_taken())
-    }
-
-    /// A release before any push throws the plate: the world is built at
-    /// rest (no push gives it a velocity) and the release sets it moving
-    /// with `initial.velocity` and ω.
-    fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
-        if self.session.is_none() {
-            let build = self.build.take().ok_or_else(|| {
-                ModelError::Adapter("the session failed to start at its release".into())
-            })?;
-            let mut problem = self.problem.clone();
-            problem.initial.from_rest = true;
-            self.session = Some(build(&problem)?);
-        }
-        self.session
-            .as_mut()
-            .expect("built above")
-            .release(max_duration)
-    }
-
-    fn slide(&self) -> Option<SlideReport> {
-        self.session.as_ref().and_then(|s| s.slide())
     }
 }
 

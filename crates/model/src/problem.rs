@@ -115,6 +115,49 @@ pub struct Problem {
 }
 
 impl Problem {
+    /// Side of the seed plate (m).
+    pub const SEED_SIDE: f64 = 0.25;
+    /// Mass of the seed plate (kg).
+    pub const SEED_MASS: f64 = 1.0;
+    /// Friction coefficient at each of the seed plate's supports.
+    pub const SEED_MU: f64 = 0.5;
+
+    /// The seed plate, released after `pushes`: a uniform square plate of
+    /// side [`SEED_SIDE`](Self::SEED_SIDE) = 0.25 m and mass
+    /// [`SEED_MASS`](Self::SEED_MASS) = 1 kg (I_cm = m s²/6 = 1/96 kg m²),
+    /// its centre of mass at its centre, on four supports at its corners
+    /// (±0.125 m, ±0.125 m), each carrying a quarter of its weight at
+    /// μ = [`SEED_MU`](Self::SEED_MU) = 0.5 (friction force μ m `gravity` / 4
+    /// each, N; `gravity` in m/s²), pushed at the middle of its left side
+    /// (contact (−0.125, 0) m from the centre of mass). Impulsive switching,
+    /// a sample every 0.01 s, no contact limits, and a release with the
+    /// default `max_duration` after the last push (without pushes the plate
+    /// is thrown from `initial`). A `gravity` that is not finite and > 0 is
+    /// refused (it makes the supports' friction invalid).
+    pub fn seed_plate(
+        gravity: f64,
+        pushes: Vec<Push>,
+        initial: Initial,
+    ) -> Result<Self, ModelError> {
+        ModelError::require_positive("seed plate gravity", gravity)?;
+        let a = 0.5 * Self::SEED_SIDE;
+        let friction = Self::SEED_MU * Self::SEED_MASS * gravity / 4.0;
+        let supports = [(-a, -a), (a, -a), (a, a), (-a, a)].map(|(x, y)| crate::Support {
+            position: Vec2::new(x, y),
+            friction,
+        });
+        let inertia = Self::SEED_MASS * Self::SEED_SIDE * Self::SEED_SIDE / 6.0;
+        Ok(Self {
+            body: Body::new(Self::SEED_MASS, inertia, Vec2::new(-a, 0.0), &supports)?,
+            limits: ContactLimits::default(),
+            pushes,
+            initial,
+            switching: Switching::Impulsive,
+            sample_dt: 0.01,
+            release: Some(Release::default()),
+        })
+    }
+
     /// Checks the schedule, the release and the sampling interval. An empty
     /// schedule is a problem only without a release; an initial velocity
     /// only without pushes.

@@ -235,7 +235,7 @@ pub struct Stepped {
     /// (infinite where the engine gives none).
     pub segment_tail_min_slip: Vec<Vec<f64>>,
     /// Each support's time-weighted mean normal force over the run's last
-    /// fifth (N).
+    /// fifth (N); NaN without pushes.
     pub loads: Vec<f64>,
     /// The loads at every sample, the largest rise above `z_rest` and the
     /// share of steps with a support out of contact (None where the world

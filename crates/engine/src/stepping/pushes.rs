@@ -279,17 +279,6 @@ impl<W: PlateWorld> Stepping<W> {
         Ok(p)
     }
 
-    /// Advances by every push of `pushes` in order, then ends the loop
-    /// ([`Stepping::finish`]): the one push loop behind an engine crate's
-    /// detailed view of a run (its session's `advance` and `finish`, with
-    /// what the engine records besides the [`EngineRun`](crate::EngineRun)).
-    pub fn run(mut self, pushes: &[Push]) -> Result<(W, Stepped, Problem), ModelError> {
-        for push in pushes {
-            self.advance(push)?;
-        }
-        Ok(self.finish())
-    }
-
     /// Ends the loop: the world, what the loop gathered (the run's last fifth
     /// and the per-sample loads over the pushes applied), and the start's
     /// problem with the pushes applied as its schedule (the one to resample
@@ -323,9 +312,11 @@ impl<W: PlateWorld> Stepping<W> {
                 }
             }
         }
+        // No step in the run's last fifth (a plate thrown without pushes):
+        // no mean, NaN (null in the diagnostics).
         out.loads = run_n
             .iter()
-            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+            .map(|a| if run_t > 0.0 { a / run_t } else { f64::NAN })
             .collect();
         out.contact = recorder.finish();
         (self.world, out, problem)

@@ -10,9 +10,11 @@ fn run_pushes<W: PlateWorld>(
     cfg: &StepLoop,
     start: W::State,
 ) -> Result<Stepped, ModelError> {
-    Ok(Stepping::new(world, problem, *cfg, start)
-        .run(&problem.pushes)?
-        .1)
+    let mut stepping = Stepping::new(world, problem, *cfg, start);
+    for push in &problem.pushes {
+        stepping.advance(push)?;
+    }
+    Ok(stepping.finish().1)
 }
 
 /// An object carried rigidly by the pusher: it moves at the commanded

@@ -8,7 +8,9 @@
 use std::f64::consts::FRAC_PI_4;
 
 use pushval_avian::predict::PlateScene;
-use pushval_avian::{Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator};
+use pushval_avian::{
+    Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator, DetailedEngine,
+};
 use pushval_model::{Body, Initial, Problem, Push, SegmentDynamics, Support, Switching, Vec2};
 
 fn plate(speed: f64, duration: f64) -> Problem {

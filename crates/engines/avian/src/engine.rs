@@ -4,13 +4,13 @@
 //! are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, FrictionLaw, ModelEntry, OptionError,
-    OptionKeys, Session, COULOMB,
+    Detailed, DetailedEngine, Engine, EngineCrate, EngineInfo, EngineOptions, EngineSession,
+    FrictionLaw, ModelEntry, OptionError, OptionKeys, Session, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
 
 use crate::predict::Avian3dTilt;
-use crate::{Avian2dSettings, Avian3dSettings, AVAILABLE};
+use crate::{Avian2dSettings, Avian2dSimulator, Avian3dSettings, Avian3dSimulator, AVAILABLE};
 
 /// The 2-D engine crate and the version this adapter is built against (the
 /// `avian2d` entry of the workspace's Cargo.toml; a test checks it against
@@ -181,46 +181,17 @@ impl Engine for Avian2dModel {
     /// Without the `avian` feature: [`ModelError::Integration`] with
     /// [`crate::UNAVAILABLE`].
     fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
-        let settings = Avian2dSettings {
+        let sim = Avian2dSimulator::new(Avian2dSettings {
             dt,
             ..self.settings
-        };
-        settings.check()?;
-        #[cfg(feature = "avian")]
-        {
-            use pushval_engine::stepping::{PlateFinish, PlateSession};
-            use pushval_engine::EngineRun;
-            pushval_engine::on_first_push(problem, move |problem| {
-                let problem = problem.clone();
-                // Avian's world is a Bevy `App`, which is not `Send`: it
-                // stays on the session's own thread.
-                pushval_engine::on_thread(move || {
-                    let started = std::time::Instant::now();
-                    let stepping = crate::world2d::start(&problem, &settings)?;
-                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
-                        let r = crate::world2d::finish(&w, stepped, problem, &settings, started);
-                        Ok(EngineRun {
-                            dt,
-                            steps: r.steps,
-                            wall_time: r.wall_time,
-                            diagnostics: serde_json::json!({
-                                "steps": r.steps,
-                                "max_joint_drift": r.max_joint_drift,
-                            }),
-                            trajectory: r.trajectory,
-                            contact: None,
-                        })
-                    });
-                    Ok(Box::new(PlateSession::new(stepping, finish))
-                        as Box<dyn pushval_engine::EngineSession>)
-                })
-            })
-        }
-        #[cfg(not(feature = "avian"))]
-        {
-            let _ = problem;
-            Err(crate::unavailable())
-        }
+        });
+        sim.settings.check()?;
+        let problem = problem.clone();
+        // Avian's world is a Bevy `App`, which is not `Send`: it stays on
+        // the session's own thread.
+        pushval_engine::on_thread(move || {
+            Ok(Box::new(Detailed::new(sim.start(&problem)?)) as Box<dyn EngineSession>)
+        })
     }
 }
 
@@ -252,50 +223,17 @@ impl Engine for Avian3dModel {
     /// Without the `avian` feature: [`ModelError::Integration`] with
     /// [`crate::UNAVAILABLE`].
     fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
-        let settings = Avian3dSettings {
+        let sim = Avian3dSimulator::new(Avian3dSettings {
             dt,
             ..self.settings
-        };
-        settings.check()?;
-        #[cfg(feature = "avian")]
-        {
-            use pushval_engine::stepping::{PlateFinish, PlateSession};
-            use pushval_engine::EngineRun;
-            pushval_engine::on_first_push(problem, move |problem| {
-                let problem = problem.clone();
-                // Avian's world is a Bevy `App`, which is not `Send`: it
-                // stays on the session's own thread.
-                pushval_engine::on_thread(move || {
-                    let started = std::time::Instant::now();
-                    let stepping = crate::world3d::start(&problem, &settings)?;
-                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
-                        let r = crate::world3d::finish(w, stepped, problem, &settings, started);
-                        Ok(EngineRun {
-                            dt,
-                            steps: r.steps,
-                            wall_time: r.wall_time,
-                            diagnostics: serde_json::json!({
-                                "steps": r.steps,
-                                "max_joint_drift": r.max_joint_drift,
-                                "max_tilt": r.max_tilt,
-                                "rest_loads": r.rest_loads,
-                                "mu": r.mu,
-                                "loads": r.loads,
-                            }),
-                            trajectory: r.trajectory,
-                            contact: r.contact,
-                        })
-                    });
-                    Ok(Box::new(PlateSession::new(stepping, finish))
-                        as Box<dyn pushval_engine::EngineSession>)
-                })
-            })
-        }
-        #[cfg(not(feature = "avian"))]
-        {
-            let _ = problem;
-            Err(crate::unavailable())
-        }
+        });
+        sim.settings.check()?;
+        let problem = problem.clone();
+        // Avian's world is a Bevy `App`, which is not `Send`: it stays on
+        // the session's own thread.
+        pushval_engine::on_thread(move || {
+            Ok(Box::new(Detailed::new(sim.start(&problem)?)) as Box<dyn EngineSession>)
+        })
     }
 }
 

@@ -43,7 +43,9 @@
 
 use std::time::Duration;
 
-use pushval_engine::StepRecord;
+#[cfg(feature = "avian")]
+use pushval_engine::on_first_push;
+use pushval_engine::{DetailedRun, EngineRun, FirstPush, StepRecord};
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 pub mod clock;
@@ -56,6 +58,7 @@ mod world2d;
 mod world3d;
 
 pub use engine::{models, Avian2dModel, Avian3dModel, ENGINE_CRATE_2D, ENGINE_CRATE_3D};
+pub use pushval_engine::{DetailedEngine, DetailedSession};
 
 /// True when this build has Avian (feature `avian`).
 pub const AVAILABLE: bool = cfg!(feature = "avian");
@@ -181,18 +184,41 @@ impl Avian2dSimulator {
     pub fn new(settings: Avian2dSettings) -> Self {
         Self { settings }
     }
+}
 
-    /// Runs the problem. Without the `avian` feature:
-    /// [`ModelError::Integration`] with [`UNAVAILABLE`] as the reason.
-    pub fn run(&self, problem: &Problem) -> Result<Avian2dRun, ModelError> {
-        problem.check()?;
+/// An `avian2d` session: the world pushed one push at a time. Not
+/// `Send`: Avian's world is a Bevy `App` and stays on the thread that built
+/// it (the [`Engine`](pushval_engine::Engine) session builds it on a thread
+/// of its own). Built at the first push for an object that starts moving.
+pub type Avian2dSession = FirstPush<sessions::Avian2d>;
+
+/// The crate's one face: a session of the `avian2d` world, finished into
+/// an [`Avian2dRun`].
+impl DetailedEngine for Avian2dSimulator {
+    type Session = Avian2dSession;
+
+    /// The scene of `problem` through the shared stepping loop
+    /// ([`pushval_engine::stepping`]) on Avian's clock, on the calling
+    /// thread. Without the `avian` feature: [`ModelError::Integration`] with
+    /// [`UNAVAILABLE`] as the reason.
+    fn start(&self, problem: &Problem) -> Result<Avian2dSession, ModelError> {
         self.settings.check()?;
         #[cfg(feature = "avian")]
         {
-            world2d::run(problem, &self.settings)
+            let s = self.settings;
+            on_first_push(problem, move |problem| {
+                let started = std::time::Instant::now();
+                Ok(pushval_engine::stepping::PlateSession::new(
+                    world2d::start(problem, &s)?,
+                    Box::new(move |w, stepped, problem| {
+                        Ok(world2d::finish(&w, stepped, problem, &s, started))
+                    }),
+                ))
+            })
         }
         #[cfg(not(feature = "avian"))]
         {
+            let _ = problem;
             Err(unavailable())
         }
     }
@@ -357,18 +383,41 @@ impl Avian3dSimulator {
     pub fn new(settings: Avian3dSettings) -> Self {
         Self { settings }
     }
+}
 
-    /// Runs the problem. Without the `avian` feature:
-    /// [`ModelError::Integration`] with [`UNAVAILABLE`] as the reason.
-    pub fn run(&self, problem: &Problem) -> Result<Avian3dRun, ModelError> {
-        problem.check()?;
+/// An `avian3d` session: the world pushed one push at a time. Not
+/// `Send`: Avian's world is a Bevy `App` and stays on the thread that built
+/// it (the [`Engine`](pushval_engine::Engine) session builds it on a thread
+/// of its own). Built at the first push for an object that starts moving.
+pub type Avian3dSession = FirstPush<sessions::Avian3d>;
+
+/// The crate's one face: a session of the `avian3d` world, finished into
+/// an [`Avian3dRun`].
+impl DetailedEngine for Avian3dSimulator {
+    type Session = Avian3dSession;
+
+    /// The scene of `problem` through the shared stepping loop
+    /// ([`pushval_engine::stepping`]) on Avian's clock, on the calling
+    /// thread. Without the `avian` feature: [`ModelError::Integration`] with
+    /// [`UNAVAILABLE`] as the reason.
+    fn start(&self, problem: &Problem) -> Result<Avian3dSession, ModelError> {
         self.settings.check()?;
         #[cfg(feature = "avian")]
         {
-            world3d::run(problem, &self.settings)
+            let s = self.settings;
+            on_first_push(problem, move |problem| {
+                let started = std::time::Instant::now();
+                Ok(pushval_engine::stepping::PlateSession::new(
+                    world3d::start(problem, &s)?,
+                    Box::new(move |w, stepped, problem| {
+                        Ok(world3d::finish(w, stepped, problem, &s, started))
+                    }),
+                ))
+            })
         }
         #[cfg(not(feature = "avian"))]
         {
+            let _ = problem;
             Err(unavailable())
         }
     }
@@ -381,4 +430,67 @@ impl Simulator for Avian3dSimulator {
     fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
         self.run(problem).map(|r| r.trajectory)
     }
+}
+
+impl DetailedRun for Avian2dRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
+    }
+
+    /// The run with the step count and the joint drift as diagnostics.
+    fn engine_run(self) -> EngineRun {
+        EngineRun {
+            dt: self.settings.dt,
+            steps: self.steps,
+            wall_time: self.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": self.steps,
+                "max_joint_drift": self.max_joint_drift,
+            }),
+            trajectory: self.trajectory,
+            contact: None,
+        }
+    }
+}
+
+impl DetailedRun for Avian3dRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
+    }
+
+    /// The run with the step count, the joint drift, the tilt, the feet's
+    /// rest loads, calibrated μ and loads as diagnostics, and its contact
+    /// record.
+    fn engine_run(self) -> EngineRun {
+        EngineRun {
+            dt: self.settings.dt,
+            steps: self.steps,
+            wall_time: self.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": self.steps,
+                "max_joint_drift": self.max_joint_drift,
+                "max_tilt": self.max_tilt,
+                "rest_loads": self.rest_loads,
+                "mu": self.mu,
+                "loads": self.loads,
+            }),
+            trajectory: self.trajectory,
+            contact: self.contact,
+        }
+    }
+}
+
+/// The worlds of the sessions, or none in a build without the `avian`
+/// feature.
+mod sessions {
+    #[cfg(feature = "avian")]
+    pub type Avian2d =
+        pushval_engine::stepping::PlateSession<crate::world2d::World2d, crate::Avian2dRun>;
+    #[cfg(feature = "avian")]
+    pub type Avian3d =
+        pushval_engine::stepping::PlateSession<crate::world3d::World3d, crate::Avian3dRun>;
+    #[cfg(not(feature = "avian"))]
+    pub type Avian2d = pushval_engine::Unavailable<crate::Avian2dRun>;
+    #[cfg(not(feature = "avian"))]
+    pub type Avian3d = pushval_engine::Unavailable<crate::Avian3dRun>;
 }

@@ -211,7 +211,7 @@ fn spawn(world: &mut World, problem: &Problem) -> Scene {
 
 /// The object's state as the engine has it.
 #[derive(Clone, Copy)]
-pub(crate) struct State {
+pub struct State {
     position: DVec2,
     rotation: Rotation,
     /// Unwrapped angle (rad).
@@ -246,7 +246,7 @@ fn read(world: &World, object: Entity, prev_theta: f64) -> State {
 /// The scene as the shared stepping loop sees it: steps on Avian's clock
 /// (whole ticks, [`Clock`]), the pusher's velocity set at the mid-step angle
 /// the engine's θ and ω predict, the joint's drift measured after every step.
-pub(crate) struct World2d {
+pub struct World2d {
     app: App,
     scene: Scene,
     clock: Clock,
@@ -450,12 +450,4 @@ pub(crate) fn finish(
         max_joint_drift: world.max_drift,
         wall_time: started.elapsed(),
     }
-}
-
-/// Runs the problem (checked by the caller): [`start`], one push at a time,
-/// [`finish`].
-pub(crate) fn run(problem: &Problem, s: &Avian2dSettings) -> Result<Avian2dRun, ModelError> {
-    let started = Instant::now();
-    let (world, run, applied) = start(problem, s)?.run(&problem.pushes)?;
-    Ok(finish(&world, run, &applied, s, started))
 }

@@ -247,7 +247,7 @@ fn spawn(world: &mut World, problem: &Problem, s: &Avian3dSettings) -> Scene {
 
 /// The object's state as the engine has it.
 #[derive(Clone, Copy)]
-pub(crate) struct State {
+pub struct State {
     position: DVec3,
     rotation: DQuat,
     /// Unwrapped yaw (rad).
@@ -351,7 +351,7 @@ struct StepImpulses {
 /// (whole ticks, [`Clock`]), the pusher's velocity set at the mid-step yaw
 /// the engine's θ and ω predict, the pin's horizontal drift, the tilt and
 /// the feet's loads measured after every step.
-pub(crate) struct World3d {
+pub struct World3d {
     app: App,
     scene: Scene,
     clock: Clock,
@@ -662,9 +662,10 @@ pub(crate) fn finish(
         rest_loads: world.rest_loads,
         mu: world.mu,
         segment_tail_loads: world.tail_loads,
+        // No step in the run's last fifth (thrown without pushes): NaN.
         loads: run_acc
             .iter()
-            .map(|a| a / run_t.max(f64::MIN_POSITIVE))
+            .map(|a| if run_t > 0.0 { a / run_t } else { f64::NAN })
             .collect(),
         contact: run.contact,
         max_tilt: world.max_tilt,
@@ -672,12 +673,4 @@ pub(crate) fn finish(
         steps: run.steps,
         wall_time: started.elapsed(),
     }
-}
-
-/// Runs the problem (checked by the caller): [`start`], one push at a time,
-/// [`finish`].
-pub(crate) fn run(problem: &Problem, s: &Avian3dSettings) -> Result<Avian3dRun, ModelError> {
-    let started = Instant::now();
-    let (world, run, applied) = start(problem, s)?.run(&problem.pushes)?;
-    Ok(finish(world, run, &applied, s, started))
 }

@@ -8,7 +8,7 @@ mod common;
 
 use std::f64::consts::FRAC_PI_4;
 
-use pushval_avian::{Avian2dSettings, Avian2dSimulator};
+use pushval_avian::{Avian2dSettings, Avian2dSimulator, DetailedEngine};
 use pushval_engine::step_tail_omega;
 
 use common::*;

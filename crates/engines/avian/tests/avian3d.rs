@@ -7,7 +7,7 @@
 mod common;
 
 use pushval_avian::predict::PlateScene;
-use pushval_avian::{Avian3dSettings, Avian3dSimulator};
+use pushval_avian::{Avian3dSettings, Avian3dSimulator, DetailedEngine};
 use pushval_engine::step_tail_omega;
 
 use common::*;

@@ -7,7 +7,7 @@
 use std::f64::consts::FRAC_PI_4;
 
 use pushval_box2d::predict::{motor_joint_locks, motor_joint_quasi_static, motor_joint_steady};
-use pushval_box2d::{Box2dSettings, Box2dSimulator, Friction};
+use pushval_box2d::{Box2dSettings, Box2dSimulator, DetailedEngine, Friction};
 use pushval_model::{Body, Initial, Problem, Push, SegmentDynamics, Support, Vec2};
 
 fn plate(half: f64, support_half: f64, speed: f64, phi: f64) -> Problem {

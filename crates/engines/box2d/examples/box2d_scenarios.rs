@@ -7,7 +7,7 @@
 //! `cargo run --release -p pushval-box2d --example box2d_scenarios [FILES...]`
 //! (default: every file in scenarios/).
 
-use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator};
+use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator, DetailedEngine};
 use pushval_model::{DynamicModel, Simulator};
 use pushval_scenario::Scenario;
 

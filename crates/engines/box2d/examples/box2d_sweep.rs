@@ -7,7 +7,7 @@
 
 use std::f64::consts::FRAC_PI_4;
 
-use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator};
+use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator, DetailedEngine};
 use pushval_model::{Body, DynamicModel, Initial, Problem, Push, Simulator, Support, Vec2};
 
 fn plate(from_rest: bool) -> Problem {

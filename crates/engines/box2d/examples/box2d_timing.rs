@@ -7,7 +7,7 @@
 //!
 //! `cargo run --release -p pushval-box2d --example box2d_timing [FILE] [DT]`
 
-use pushval_box2d::{Box2dSettings, Box2dSimulator, Friction};
+use pushval_box2d::{Box2dSettings, Box2dSimulator, DetailedEngine, Friction};
 use pushval_scenario::Scenario;
 
 /// CPU time of this thread (s), if the kernel reports it.

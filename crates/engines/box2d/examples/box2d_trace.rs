@@ -1,5 +1,5 @@
 //! ω over time of one box2d run: `--example box2d_trace FILE DT [EVERY]`.
-use pushval_box2d::{Box2dSettings, Box2dSimulator};
+use pushval_box2d::{Box2dSettings, Box2dSimulator, DetailedEngine};
 use pushval_scenario::Scenario;
 
 fn main() {

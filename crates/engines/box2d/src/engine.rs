@@ -2,9 +2,8 @@
 //! Coulomb forces, gateable) and `box2d_motor_joint` (Box2D's top-down
 //! friction idiom, informational).
 
-use pushval_engine::stepping::{PlateFinish, PlateSession};
 use pushval_engine::{
-    on_first_push, on_thread, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun,
+    on_thread, Detailed, DetailedEngine, Engine, EngineCrate, EngineInfo, EngineOptions,
     EngineSession, FrictionLaw, ModelEntry, OptionError, OptionKeys, Session, COULOMB,
 };
 use pushval_model::{ModelError, Problem};
@@ -145,27 +144,9 @@ impl Engine for Box2dModel {
             ..self.settings
         });
         sim.settings.check()?;
-        on_first_push(problem, move |problem| {
-            let problem = problem.clone();
-            on_thread(move || {
-                let started = std::time::Instant::now();
-                let stepping = crate::world::start(&problem, &sim.settings)?;
-                let finish: PlateFinish<_> = Box::new(move |world, stepped, problem| {
-                    let r = sim.box2d_run(problem, crate::world::raw_run(world, &stepped), started);
-                    Ok(EngineRun {
-                        contact: None,
-                        dt,
-                        steps: r.steps,
-                        wall_time: r.wall_time,
-                        diagnostics: serde_json::json!({
-                            "max_joint_drift": r.max_joint_drift,
-                            "steps": r.steps,
-                        }),
-                        trajectory: r.trajectory,
-                    })
-                });
-                Ok(Box::new(PlateSession::new(stepping, finish)) as Box<dyn EngineSession>)
-            })
+        let problem = problem.clone();
+        on_thread(move || {
+            Ok(Box::new(Detailed::new(sim.start(&problem)?)) as Box<dyn EngineSession>)
         })
     }
 }

@@ -41,6 +41,8 @@
 
 use std::time::Duration;
 
+use pushval_engine::stepping::PlateSession;
+use pushval_engine::{on_first_push, DetailedRun, EngineRun, FirstPush};
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 pub mod engine;
@@ -49,7 +51,7 @@ pub use pushval_laws::box2d as predict;
 mod world;
 
 pub use engine::{models, Box2dModel, ENGINE_CRATE};
-pub use pushval_engine::{tail_mean_omega, StepRecord};
+pub use pushval_engine::{tail_mean_omega, DetailedEngine, DetailedSession, StepRecord};
 
 /// Box2D's sub-steps per step (`b2World_Step`'s `subStepCount`) by default:
 /// one.
@@ -206,15 +208,6 @@ impl Box2dSimulator {
         Self { settings }
     }
 
-    /// Runs the problem and returns the trajectory with the engine's diagnostics.
-    pub fn run(&self, problem: &Problem) -> Result<Box2dRun, ModelError> {
-        let start = std::time::Instant::now();
-        problem.check()?;
-        self.settings.check()?;
-        let (w, stepped, _) = world::start(problem, &self.settings)?.run(&problem.pushes)?;
-        Ok(self.box2d_run(problem, world::raw_run(w, &stepped), start))
-    }
-
     /// The run of `raw` on `problem` (the pushes applied), started at `start`.
     pub(crate) fn box2d_run(
         &self,
@@ -235,6 +228,56 @@ impl Box2dSimulator {
             step_time: raw.step_time,
             segment_tail_omega,
             history: raw.history,
+        }
+    }
+}
+
+/// A Box2D session: the world pushed one push at a time. Not `Send`: the
+/// Box2D world is a handle into a C library's memory and stays on the
+/// thread that built it (the [`Engine`](pushval_engine::Engine) session
+/// builds it on a thread of its own). Built at the first push for an object
+/// that starts moving.
+pub type Box2dSession = FirstPush<PlateSession<world::Stepper, Box2dRun>>;
+
+/// The crate's one face: a session of the Box2D world, finished into a
+/// [`Box2dRun`].
+impl DetailedEngine for Box2dSimulator {
+    type Session = Box2dSession;
+
+    /// The world of `problem` through the shared stepping loop
+    /// ([`pushval_engine::stepping`]), on the calling thread.
+    fn start(&self, problem: &Problem) -> Result<Box2dSession, ModelError> {
+        self.settings.check()?;
+        let sim = *self;
+        on_first_push(problem, move |problem| {
+            let started = std::time::Instant::now();
+            Ok(PlateSession::new(
+                world::start(problem, &sim.settings)?,
+                Box::new(move |w, stepped, problem| {
+                    Ok(sim.box2d_run(problem, world::raw_run(w, &stepped), started))
+                }),
+            ))
+        })
+    }
+}
+
+impl DetailedRun for Box2dRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
+    }
+
+    /// The run with the joint drift and the step count as diagnostics.
+    fn engine_run(self) -> EngineRun {
+        EngineRun {
+            contact: None,
+            dt: self.settings.dt,
+            steps: self.steps,
+            wall_time: self.wall_time,
+            diagnostics: serde_json::json!({
+                "max_joint_drift": self.max_joint_drift,
+                "steps": self.steps,
+            }),
+            trajectory: self.trajectory,
         }
     }
 }

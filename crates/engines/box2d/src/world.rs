@@ -45,7 +45,7 @@ fn rot(c: f64, s: f64, a: [f64; 2]) -> [f64; 2] {
 
 /// The object's state as Box2D holds it, in f64.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct State {
+pub struct State {
     /// Centre of mass (m, world).
     x: f64,
     y: f64,
@@ -285,7 +285,7 @@ impl Scene {
 
 /// The Box2D scene as the shared stepping loop sees it (a 2-D world: height
 /// and tilt zero).
-pub(crate) struct Stepper {
+pub struct Stepper {
     scene: Scene,
     /// Whether the pusher has let go.
     released: bool,

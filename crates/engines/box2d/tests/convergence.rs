@@ -5,7 +5,7 @@
 
 mod common;
 
-use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator};
+use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator, DetailedEngine};
 use pushval_model::{DynamicModel, Problem, Simulator, Trajectory};
 use pushval_scenario::Scenario;
 

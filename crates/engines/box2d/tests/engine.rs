@@ -3,7 +3,9 @@
 
 mod common;
 
-use pushval_box2d::{models, Box2dSettings, Box2dSimulator, Friction, ENGINE_CRATE};
+use pushval_box2d::{
+    models, Box2dSettings, Box2dSimulator, DetailedEngine, Friction, ENGINE_CRATE,
+};
 use pushval_engine::EngineOptions;
 use pushval_model::{Simulator, Trajectory};
 

@@ -7,7 +7,7 @@
 
 mod common;
 
-use pushval_box2d::{Box2dSettings, Box2dSimulator, Friction};
+use pushval_box2d::{Box2dSettings, Box2dSimulator, DetailedEngine, Friction};
 use pushval_model::{Body, Problem, Support, Trajectory, Vec2};
 
 fn run(problem: &Problem, friction: Friction) -> Trajectory {

@@ -9,7 +9,7 @@
 
 mod common;
 
-use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator};
+use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator, DetailedEngine};
 use pushval_model::{DynamicModel, Problem, SegmentDynamics, Simulator};
 
 /// The one stable steady ω (rad/s) of segment `j` of the dynamic model.

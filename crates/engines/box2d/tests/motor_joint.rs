@@ -9,7 +9,7 @@ use pushval_box2d::predict::{
     motor_joint_limits, motor_joint_locks, motor_joint_moment, motor_joint_quasi_static,
     motor_joint_steady,
 };
-use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator, Friction};
+use pushval_box2d::{tail_mean_omega, Box2dSettings, Box2dSimulator, DetailedEngine, Friction};
 use pushval_engine::rel_err;
 use pushval_model::{cross, Body, Problem, SegmentDynamics, Support};
 

@@ -16,7 +16,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use pushval_jolt::predict::{self, at_rest, Direction, Law};
-use pushval_jolt::{JoltRun, JoltSettings, JoltSimulator, Scene};
+use pushval_jolt::{DetailedEngine, JoltRun, JoltSettings, JoltSimulator, Scene};
 use pushval_model::{Body, Initial, Problem, Push, SegmentDynamics, Support, Switching, Vec2};
 
 const MU: f64 = 0.5;

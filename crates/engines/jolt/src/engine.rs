@@ -4,13 +4,13 @@
 //! listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys, Session,
+    Detailed, DetailedEngine, DetailedRun, Engine, EngineCrate, EngineInfo, EngineOptions,
+    EngineRun, EngineSession, FrictionLaw, ModelEntry, OptionError, OptionKeys, Session,
 };
-use pushval_model::{ModelError, Problem};
+use pushval_model::{ModelError, Problem, Trajectory};
 
 use crate::predict::{JoltBox, JoltFeet};
-use crate::{JoltRun, JoltSettings, Scene, AVAILABLE};
+use crate::{JoltRun, JoltSettings, JoltSimulator, Scene, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the
 /// `oxijolt-sys` entry of the workspace's Cargo.toml).
@@ -130,67 +130,51 @@ impl Engine for JoltModel {
     /// with the first push applied. Without the `jolt`
     /// feature: [`ModelError::Integration`] with [`crate::UNAVAILABLE`].
     fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
-        let settings = JoltSettings {
+        let sim = JoltSimulator::new(JoltSettings {
             dt,
             ..self.settings
-        };
-        settings.check()?;
-        #[cfg(feature = "jolt")]
-        {
-            use pushval_engine::stepping::{PlateFinish, PlateSession};
-            pushval_engine::on_first_push(problem, move |problem| {
-                let problem = problem.clone();
-                // Jolt's world is raw pointers into the C API (joltc): it
-                // stays on the session's own thread.
-                pushval_engine::on_thread(move || {
-                    let started = std::time::Instant::now();
-                    let stepping = crate::world::start(&problem, &settings)?;
-                    let name = settings.scene.model_name().to_string();
-                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
-                        let mut r = crate::world::finish(w, stepped, problem, &settings);
-                        r.trajectory.model = name;
-                        r.wall_time = started.elapsed();
-                        Ok(engine_run(r, dt))
-                    });
-                    Ok(Box::new(PlateSession::new(stepping, finish))
-                        as Box<dyn pushval_engine::EngineSession>)
-                })
-            })
-        }
-        #[cfg(not(feature = "jolt"))]
-        {
-            let _ = problem;
-            Err(ModelError::Integration {
-                t: 0.0,
-                reason: crate::UNAVAILABLE.into(),
-            })
-        }
+        });
+        sim.settings.check()?;
+        let problem = problem.clone();
+        // Jolt's world is raw pointers into the C API (joltc): it stays on
+        // the session's own thread.
+        pushval_engine::on_thread(move || {
+            Ok(Box::new(Detailed::new(sim.start(&problem)?)) as Box<dyn EngineSession>)
+        })
     }
 }
 
-/// The engine's run of a Jolt run at time step `dt`.
-#[cfg_attr(not(feature = "jolt"), allow(dead_code))]
-fn engine_run(r: JoltRun, dt: f64) -> EngineRun {
-    let mut diagnostics = serde_json::json!({
-        "steps": r.steps,
-        "max_joint_drift": r.max_joint_drift,
-        "max_tilt": r.max_tilt,
-        "max_lift": r.max_lift,
-        "rest_loads": r.rest_loads,
-        "manifold_sizes": r.manifold_sizes,
-        "mu": r.mu,
-    });
-    // `jolt_box`: per corner of its manifold, reported only when the
-    // corners are the supports (crate::JoltRun::loads).
-    if let Some(loads) = &r.loads {
-        diagnostics["loads"] = serde_json::json!(loads);
+impl DetailedRun for JoltRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
     }
-    EngineRun {
-        dt,
-        steps: r.steps,
-        wall_time: r.wall_time,
-        diagnostics,
-        trajectory: r.trajectory,
-        contact: r.contact,
+
+    /// The run with Jolt's diagnostics (steps, drift, tilt, lift, rest
+    /// loads, manifold sizes, μ; `loads` where the supports are the corners
+    /// of the box's manifold) and its contact record.
+    fn engine_run(self) -> EngineRun {
+        let r = self;
+        let mut diagnostics = serde_json::json!({
+            "steps": r.steps,
+            "max_joint_drift": r.max_joint_drift,
+            "max_tilt": r.max_tilt,
+            "max_lift": r.max_lift,
+            "rest_loads": r.rest_loads,
+            "manifold_sizes": r.manifold_sizes,
+            "mu": r.mu,
+        });
+        // `jolt_box`: per corner of its manifold, reported only when the
+        // corners are the supports (crate::JoltRun::loads).
+        if let Some(loads) = &r.loads {
+            diagnostics["loads"] = serde_json::json!(loads);
+        }
+        EngineRun {
+            dt: r.settings.dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics,
+            trajectory: r.trajectory,
+            contact: r.contact,
+        }
     }
 }

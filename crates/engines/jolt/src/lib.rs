@@ -44,13 +44,14 @@
 //! system; joltc's global set-up is serialised by a lock.
 //!
 //! Without the `jolt` feature the crate builds with no Jolt ([`AVAILABLE`]
-//! is false) and [`JoltSimulator::run`] returns an error.
+//! is false) and `JoltSimulator`'s `start` (and so `run`) returns an error.
 //!
 //! Units are SI throughout (m, s, rad, kg, N).
 #![warn(missing_docs)]
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+use pushval_engine::FirstPush;
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 mod engine;
@@ -63,6 +64,7 @@ mod sys;
 mod world;
 
 pub use engine::{models, JoltModel, ENGINE_CRATE, JOLT_VERSION};
+pub use pushval_engine::{DetailedEngine, DetailedSession};
 
 /// True when this build has Jolt (feature `jolt`).
 pub const AVAILABLE: bool = cfg!(feature = "jolt");
@@ -290,30 +292,59 @@ impl JoltSimulator {
     pub fn new(settings: JoltSettings) -> Self {
         Self { settings }
     }
+}
 
-    /// Runs the problem and returns the trajectory with Jolt's diagnostics.
-    /// Without the `jolt` feature: [`ModelError::Integration`] with
-    /// [`UNAVAILABLE`] as the reason.
-    pub fn run(&self, problem: &Problem) -> Result<JoltRun, ModelError> {
-        let start = Instant::now();
-        problem.check()?;
+/// A Jolt session: the scene, settled, pushed one push at a time. Not
+/// `Send`: Jolt's world is raw pointers into its C API (joltc) and stays on
+/// the thread that built it (the [`Engine`](pushval_engine::Engine) session
+/// builds it on a thread of its own). Built at the first push for an object
+/// that starts moving.
+pub type JoltSession = FirstPush<sessions::Jolt>;
+
+/// The crate's one face: a session of the Jolt scene, finished into a
+/// [`JoltRun`].
+impl DetailedEngine for JoltSimulator {
+    type Session = JoltSession;
+
+    /// The scene of `problem`, settled, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]), on the calling thread. Without the
+    /// `jolt` feature: [`ModelError::Integration`] with [`UNAVAILABLE`] as
+    /// the reason.
+    fn start(&self, problem: &Problem) -> Result<JoltSession, ModelError> {
         self.settings.check()?;
         #[cfg(feature = "jolt")]
         {
-            let mut run = world::simulate(problem, &self.settings)?;
-            run.trajectory.model = self.name();
-            run.wall_time = start.elapsed();
-            Ok(run)
+            let sim = *self;
+            pushval_engine::on_first_push(problem, move |problem| {
+                let started = std::time::Instant::now();
+                Ok(pushval_engine::stepping::PlateSession::new(
+                    world::start(problem, &sim.settings)?,
+                    Box::new(move |w, stepped, problem| {
+                        let mut run = world::finish(w, stepped, problem, &sim.settings);
+                        run.trajectory.model = sim.name();
+                        run.wall_time = started.elapsed();
+                        Ok(run)
+                    }),
+                ))
+            })
         }
         #[cfg(not(feature = "jolt"))]
         {
-            let _ = start;
+            let _ = problem;
             Err(ModelError::Integration {
                 t: 0.0,
                 reason: UNAVAILABLE.into(),
             })
         }
     }
+}
+
+/// The world of a session, or none in a build without the `jolt` feature.
+mod sessions {
+    #[cfg(feature = "jolt")]
+    pub type Jolt = pushval_engine::stepping::PlateSession<crate::world::Stepper, crate::JoltRun>;
+    #[cfg(not(feature = "jolt"))]
+    pub type Jolt = pushval_engine::Unavailable<crate::JoltRun>;
 }
 
 impl Simulator for JoltSimulator {

@@ -84,7 +84,7 @@ pub(crate) struct Spec {
 
 /// Pose and velocity of a body.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct BodyState {
+pub struct BodyState {
     /// Centre of mass (m).
     pub com: [f64; 3],
     /// Rotation quaternion (x, y, z, w).

@@ -419,13 +419,6 @@ pub(crate) fn finish(w: Stepper, run: Stepped, problem: &Problem, s: &JoltSettin
     }
 }
 
-/// Runs the problem in Jolt (checked by the caller): [`start`], one push at
-/// a time, [`finish`].
-pub(crate) fn simulate(problem: &Problem, s: &JoltSettings) -> Result<JoltRun, ModelError> {
-    let (w, run, applied) = start(problem, s)?.run(&problem.pushes)?;
-    Ok(finish(w, run, &applied, s))
-}
-
 /// The sums of one segment's tail that only Jolt gathers.
 struct Tail {
     contacts: Vec<SupportContact>,
@@ -456,7 +449,7 @@ struct Tails {
 
 /// The scene as the shared stepping loop sees it, with what the settle
 /// phase found.
-pub(crate) struct Stepper {
+pub struct Stepper {
     world: World,
     /// The pusher's anchor in the object's frame.
     anchor: [f64; 3],

@@ -5,7 +5,7 @@ mod common;
 
 use common::*;
 use pushval_jolt::predict::{at_rest, AtRest, Direction, Law};
-use pushval_jolt::{JoltRun, JoltSettings, JoltSimulator, Scene};
+use pushval_jolt::{DetailedEngine, JoltRun, JoltSettings, JoltSimulator, Scene};
 
 fn run(scene: Scene, v: f64, phi: f64, t: f64) -> JoltRun {
     JoltSimulator::new(JoltSettings {

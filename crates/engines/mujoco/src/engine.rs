@@ -4,13 +4,13 @@
 //! available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys, Session,
+    Detailed, DetailedEngine, DetailedRun, Engine, EngineCrate, EngineInfo, EngineOptions,
+    EngineRun, FrictionLaw, ModelEntry, OptionError, OptionKeys, Session,
 };
-use pushval_model::{ModelError, Problem};
+use pushval_model::{ModelError, Problem, Trajectory};
 
 use crate::theory::MujocoElliptic;
-use crate::{Cone, MujocoRun, MujocoSettings, AVAILABLE};
+use crate::{Cone, MujocoRun, MujocoSettings, MujocoSimulator, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the
 /// `mujoco-rs` entry of the workspace's Cargo.toml, whose build metadata
@@ -130,52 +130,37 @@ impl Engine for MujocoModel {
     /// with the first push applied. Without the `mujoco` feature:
     /// [`ModelError::Integration`] with [`crate::UNAVAILABLE`].
     fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
-        let settings = MujocoSettings {
+        let sim = MujocoSimulator::new(MujocoSettings {
             timestep: dt,
             ..self.settings
-        };
-        settings.check()?;
-        #[cfg(feature = "mujoco")]
-        {
-            use pushval_engine::stepping::{PlateFinish, PlateSession};
-            pushval_engine::on_first_push(problem, move |problem| {
-                let started = std::time::Instant::now();
-                let stepping = crate::sim::start(problem, &settings)?;
-                let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
-                    let mut r = crate::sim::finish(w, stepped, problem, &settings, started);
-                    r.trajectory.model = format!("mujoco_{}", settings.cone.as_str());
-                    Ok(engine_run(r, dt))
-                });
-                Ok(Box::new(PlateSession::new(stepping, finish)) as Session)
-            })
-        }
-        #[cfg(not(feature = "mujoco"))]
-        {
-            let _ = problem;
-            Err(ModelError::Integration {
-                t: 0.0,
-                reason: crate::UNAVAILABLE.into(),
-            })
-        }
+        });
+        Ok(Box::new(Detailed::new(sim.start(problem)?)))
     }
 }
 
-/// The engine's run of a MuJoCo run at time step `dt`.
-#[cfg_attr(not(feature = "mujoco"), allow(dead_code))]
-fn engine_run(r: MujocoRun, dt: f64) -> EngineRun {
-    EngineRun {
-        dt,
-        steps: r.steps,
-        wall_time: r.wall_time,
-        diagnostics: serde_json::json!({
-            "steps": r.steps,
-            "max_pusher_gap": r.max_pusher_gap,
-            "max_penetration": r.max_penetration,
-            "max_tilt": r.max_tilt,
-            "loads": r.loads,
-        }),
-        trajectory: r.trajectory,
-        contact: r.contact,
+impl DetailedRun for MujocoRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
+    }
+
+    /// The run with MuJoCo's diagnostics (steps, pusher gap, penetration,
+    /// tilt, the feet's loads) and its contact record.
+    fn engine_run(self) -> EngineRun {
+        let r = self;
+        EngineRun {
+            dt: r.settings.timestep,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_pusher_gap": r.max_pusher_gap,
+                "max_penetration": r.max_penetration,
+                "max_tilt": r.max_tilt,
+                "loads": r.loads,
+            }),
+            trajectory: r.trajectory,
+            contact: r.contact,
+        }
     }
 }
 

@@ -54,6 +54,7 @@
 
 use std::time::Duration;
 
+use pushval_engine::FirstPush;
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 pub mod creep;
@@ -65,6 +66,7 @@ mod sim;
 pub use pushval_laws::mujoco as theory;
 
 pub use engine::{models, MujocoModel, ENGINE_CRATE};
+pub use pushval_engine::{DetailedEngine, DetailedSession};
 
 /// True when this build links MuJoCo (feature `mujoco`).
 pub const AVAILABLE: bool = cfg!(feature = "mujoco");
@@ -301,27 +303,56 @@ impl MujocoSimulator {
     pub fn new(settings: MujocoSettings) -> Self {
         Self { settings }
     }
+}
 
-    /// Runs the problem and returns the trajectory with MuJoCo's diagnostics.
-    /// Without the `mujoco` feature: [`ModelError::Integration`] with
-    /// [`UNAVAILABLE`] as the reason.
-    pub fn run(&self, problem: &Problem) -> Result<MujocoRun, ModelError> {
-        problem.check()?;
+/// A MuJoCo session: the scene, settled and calibrated, pushed one push at
+/// a time; owned and `Send`. Built at the first push for an object that
+/// starts moving.
+pub type MujocoSession = FirstPush<sessions::Mujoco>;
+
+/// The crate's one face: a session of the MuJoCo scene, finished into a
+/// [`MujocoRun`].
+impl DetailedEngine for MujocoSimulator {
+    type Session = MujocoSession;
+
+    /// The scene of `problem`, settled and calibrated, through the shared
+    /// stepping loop ([`pushval_engine::stepping`]). Without the `mujoco`
+    /// feature: [`ModelError::Integration`] with [`UNAVAILABLE`] as the
+    /// reason.
+    fn start(&self, problem: &Problem) -> Result<MujocoSession, ModelError> {
         self.settings.check()?;
         #[cfg(feature = "mujoco")]
         {
-            let mut run = sim::run(problem, &self.settings)?;
-            run.trajectory.model = self.name();
-            Ok(run)
+            let sim = *self;
+            pushval_engine::on_first_push(problem, move |problem| {
+                let started = std::time::Instant::now();
+                Ok(pushval_engine::stepping::PlateSession::new(
+                    sim::start(problem, &sim.settings)?,
+                    Box::new(move |w, stepped, problem| {
+                        let mut run = sim::finish(w, stepped, problem, &sim.settings, started);
+                        run.trajectory.model = sim.name();
+                        Ok(run)
+                    }),
+                ))
+            })
         }
         #[cfg(not(feature = "mujoco"))]
         {
+            let _ = problem;
             Err(ModelError::Integration {
                 t: 0.0,
                 reason: UNAVAILABLE.into(),
             })
         }
     }
+}
+
+/// The world of a session, or none in a build without the `mujoco` feature.
+mod sessions {
+    #[cfg(feature = "mujoco")]
+    pub type Mujoco = pushval_engine::stepping::PlateSession<crate::sim::Stepper, crate::MujocoRun>;
+    #[cfg(not(feature = "mujoco"))]
+    pub type Mujoco = pushval_engine::Unavailable<crate::MujocoRun>;
 }
 
 impl Simulator for MujocoSimulator {

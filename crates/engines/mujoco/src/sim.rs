@@ -276,17 +276,9 @@ pub(crate) fn finish(
     }
 }
 
-/// Runs the problem (checked by the caller; see the crate docs for the
-/// scene): [`start`], one push at a time, [`finish`].
-pub(crate) fn run(problem: &Problem, settings: &MujocoSettings) -> Result<MujocoRun, ModelError> {
-    let started = Instant::now();
-    let (w, run, applied) = start(problem, settings)?.run(&problem.pushes)?;
-    Ok(finish(w, run, &applied, settings, started))
-}
-
 /// The object as the stepping loop reads it.
 #[derive(Clone, Copy)]
-pub(crate) struct MjState {
+pub struct MjState {
     s: ObjState,
     /// Yaw, unwrapped (rad).
     theta: f64,
@@ -297,7 +289,7 @@ pub(crate) struct MjState {
 
 /// The scene as the shared stepping loop sees it, with what the settle
 /// phase found.
-pub(crate) struct Stepper {
+pub struct Stepper {
     data: Data,
     /// Position and friction of each foot.
     supports: Vec<(f64, f64, f64)>,

@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use pushval_model::{kinematic, Push, Simulator};
 use pushval_mujoco::theory::coulomb_steady;
-use pushval_mujoco::{Cone, MujocoSettings, MujocoSimulator};
+use pushval_mujoco::{Cone, DetailedEngine, MujocoSettings, MujocoSimulator};
 
 fn sim(cone: Cone) -> MujocoSimulator {
     MujocoSimulator::new(MujocoSettings {

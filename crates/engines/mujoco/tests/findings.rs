@@ -10,7 +10,7 @@ use std::f64::consts::FRAC_PI_4;
 use common::*;
 use pushval_model::Push;
 use pushval_mujoco::theory::{coulomb_steady, steady_omega_load_transfer};
-use pushval_mujoco::{Cone, MujocoSettings, MujocoSimulator};
+use pushval_mujoco::{Cone, DetailedEngine, MujocoSettings, MujocoSimulator};
 
 fn run(settings: MujocoSettings, speed: f64) -> pushval_mujoco::MujocoRun {
     MujocoSimulator::new(settings)

@@ -30,16 +30,12 @@
 #![cfg(feature = "mujoco")]
 
 use pushval_engine::{rest_speed, Engine, REST_SPEED};
-use pushval_model::{
-    Body, DynamicModel, Initial, Problem, Push, Release, Simulator, Support, Switching, Vec2,
-};
+use pushval_model::{DynamicModel, Initial, Problem, Push, Simulator, Vec2};
 use pushval_mujoco::{Cone, MujocoModel, MujocoSettings};
 
 const G: f64 = 9.81;
 /// The seed plate's friction coefficient.
-const MU: f64 = 0.5;
-/// Half the side of the seed plate (m).
-const A: f64 = 0.125;
+const MU: f64 = Problem::SEED_MU;
 /// MuJoCo's default contact `solimp` d₀ and d_max.
 const D0: f64 = 0.9;
 const DMAX: f64 = 0.95;
@@ -47,23 +43,7 @@ const DMAX: f64 = 0.95;
 /// The seed plate (0.25 m square, 1 kg, μ 0.5 on its four corners, pushed
 /// at the middle of its left side) with a release after `pushes`.
 fn problem(pushes: Vec<Push>, initial: Initial) -> Problem {
-    let f = MU * G / 4.0;
-    let sup: Vec<Support> = [(-A, -A), (A, -A), (A, A), (-A, A)]
-        .iter()
-        .map(|&(x, y)| Support {
-            position: Vec2::new(x, y),
-            friction: f,
-        })
-        .collect();
-    Problem {
-        body: Body::new(1.0, (2.0 * A) * (2.0 * A) / 6.0, Vec2::new(-A, 0.0), &sup).unwrap(),
-        limits: Default::default(),
-        pushes,
-        initial,
-        switching: Switching::Impulsive,
-        sample_dt: 0.01,
-        release: Some(Release::default()),
-    }
+    Problem::seed_plate(G, pushes, initial).unwrap()
 }
 
 /// A plate thrown from `position` at angle `theta` with centre-of-mass

@@ -6,7 +6,7 @@
 
 use pushval_model::{Body, Initial, Problem, Push, Support, Switching, Vec2};
 use pushval_physx::predict::{steady_omega, Law};
-use pushval_physx::{FootContacts, FrictionType, PhysxSettings, PhysxSimulator};
+use pushval_physx::{DetailedEngine, FootContacts, FrictionType, PhysxSettings, PhysxSimulator};
 
 fn main() {
     let h = 0.125;

@@ -4,13 +4,13 @@
 //! `physx` feature they are listed but not available.
 
 use pushval_engine::{
-    Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw, ModelEntry,
-    OptionError, OptionKeys, Session,
+    Detailed, DetailedEngine, DetailedRun, Engine, EngineCrate, EngineInfo, EngineOptions,
+    EngineRun, EngineSession, FrictionLaw, ModelEntry, OptionError, OptionKeys, Session,
 };
-use pushval_model::{ModelError, Problem};
+use pushval_model::{ModelError, Problem, Trajectory};
 
 use crate::predict::PhysxClamp;
-use crate::{FootContacts, FrictionType, PhysxRun, PhysxSettings, AVAILABLE};
+use crate::{FootContacts, FrictionType, PhysxRun, PhysxSettings, PhysxSimulator, AVAILABLE};
 
 /// The engine crate and version this adapter is built against (the `physx`
 /// entry of the workspace's Cargo.toml; a test checks it against Cargo.lock).
@@ -145,63 +145,46 @@ impl Engine for PhysxModel {
     /// `physx` feature: [`ModelError::Integration`] with
     /// [`crate::UNAVAILABLE`].
     fn session(&self, problem: &Problem, dt: f64) -> Result<Session, ModelError> {
-        let settings = PhysxSettings {
+        let sim = PhysxSimulator::new(PhysxSettings {
             dt,
             ..self.settings
-        };
-        settings.check()?;
-        #[cfg(feature = "physx")]
-        {
-            use pushval_engine::stepping::{PlateFinish, PlateSession};
-            pushval_engine::on_first_push(problem, move |problem| {
-                let problem = problem.clone();
-                // PhysX's objects are raw pointers into the SDK, and the
-                // session holds PhysX's turn (a `MutexGuard`, released on
-                // the thread that took it): the world stays on the
-                // session's own thread.
-                pushval_engine::on_thread(move || {
-                    let started = std::time::Instant::now();
-                    let stepping = crate::world::start(&problem, &settings)?;
-                    let finish: PlateFinish<_> = Box::new(move |w, stepped, problem| {
-                        let mut r = crate::world::finish(w, stepped, problem, &settings);
-                        r.trajectory.model = settings.friction.model_name().to_string();
-                        r.wall_time = started.elapsed();
-                        Ok(engine_run(r, dt))
-                    });
-                    Ok(Box::new(PlateSession::new(stepping, finish))
-                        as Box<dyn pushval_engine::EngineSession>)
-                })
-            })
-        }
-        #[cfg(not(feature = "physx"))]
-        {
-            let _ = problem;
-            Err(ModelError::Integration {
-                t: 0.0,
-                reason: crate::UNAVAILABLE.into(),
-            })
-        }
+        });
+        sim.settings.check()?;
+        let problem = problem.clone();
+        // PhysX's objects are raw pointers into the SDK, and the session
+        // holds PhysX's turn (a `MutexGuard`, released on the thread that
+        // took it): the world stays on the session's own thread.
+        pushval_engine::on_thread(move || {
+            Ok(Box::new(Detailed::new(sim.start(&problem)?)) as Box<dyn EngineSession>)
+        })
     }
 }
 
-/// The engine's run of a PhysX run at time step `dt`.
-#[cfg_attr(not(feature = "physx"), allow(dead_code))]
-fn engine_run(r: PhysxRun, dt: f64) -> EngineRun {
-    EngineRun {
-        dt,
-        steps: r.steps,
-        wall_time: r.wall_time,
-        diagnostics: serde_json::json!({
-            "steps": r.steps,
-            "max_joint_drift": r.max_joint_drift,
-            "max_tilt": r.max_tilt,
-            "max_lift": r.max_lift,
-            "rest_loads": r.rest_loads,
-            "mu": r.mu,
-            "loads": r.loads,
-        }),
-        trajectory: r.trajectory,
-        contact: r.contact,
+impl DetailedRun for PhysxRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
+    }
+
+    /// The run with PhysX's diagnostics (steps, drift, tilt, lift, rest
+    /// loads, μ, the feet's loads) and its contact record.
+    fn engine_run(self) -> EngineRun {
+        let r = self;
+        EngineRun {
+            dt: r.settings.dt,
+            steps: r.steps,
+            wall_time: r.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": r.steps,
+                "max_joint_drift": r.max_joint_drift,
+                "max_tilt": r.max_tilt,
+                "max_lift": r.max_lift,
+                "rest_loads": r.rest_loads,
+                "mu": r.mu,
+                "loads": r.loads,
+            }),
+            trajectory: r.trajectory,
+            contact: r.contact,
+        }
     }
 }
 

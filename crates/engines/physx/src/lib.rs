@@ -70,13 +70,14 @@
 //! PhysX computes in f32.
 //!
 //! Without the `physx` feature the crate builds with no PhysX at all
-//! ([`AVAILABLE`] is false) and [`PhysxSimulator::run`] returns an error.
+//! ([`AVAILABLE`] is false) and `PhysxSimulator`'s `start` (and so `run`) returns an error.
 //!
 //! Units are SI throughout (m, s, rad, kg, N).
 #![warn(missing_docs)]
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+use pushval_engine::FirstPush;
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 mod engine;
@@ -90,6 +91,7 @@ mod sys;
 mod world;
 
 pub use engine::{models, PhysxModel, ENGINE_CRATE, PHYSX_SDK_VERSION};
+pub use pushval_engine::{DetailedEngine, DetailedSession};
 
 /// True when this build has PhysX (feature `physx`).
 pub const AVAILABLE: bool = cfg!(feature = "physx");
@@ -264,30 +266,60 @@ impl PhysxSimulator {
     pub fn new(settings: PhysxSettings) -> Self {
         Self { settings }
     }
+}
 
-    /// Runs the problem and returns the trajectory with PhysX's diagnostics.
-    /// Without the `physx` feature: [`ModelError::Integration`] with
-    /// [`UNAVAILABLE`] as the reason.
-    pub fn run(&self, problem: &Problem) -> Result<PhysxRun, ModelError> {
-        let start = Instant::now();
-        problem.check()?;
+/// A PhysX session: the scene, settled, pushed one push at a time. It holds
+/// PhysX's turn (one foundation per process) until it ends. Not `Send`:
+/// PhysX's objects are raw pointers into the SDK and the turn is a guard
+/// released on the thread that took it (the
+/// [`Engine`](pushval_engine::Engine) session builds it on a thread of its
+/// own). Built at the first push for an object that starts moving.
+pub type PhysxSession = FirstPush<sessions::Physx>;
+
+/// The crate's one face: a session of the PhysX scene, finished into a
+/// [`PhysxRun`].
+impl DetailedEngine for PhysxSimulator {
+    type Session = PhysxSession;
+
+    /// The scene of `problem`, settled, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]), on the calling thread. Without the
+    /// `physx` feature: [`ModelError::Integration`] with [`UNAVAILABLE`] as
+    /// the reason.
+    fn start(&self, problem: &Problem) -> Result<PhysxSession, ModelError> {
         self.settings.check()?;
         #[cfg(feature = "physx")]
         {
-            let mut run = world::simulate(problem, &self.settings)?;
-            run.trajectory.model = self.name();
-            run.wall_time = start.elapsed();
-            Ok(run)
+            let sim = *self;
+            pushval_engine::on_first_push(problem, move |problem| {
+                let started = std::time::Instant::now();
+                Ok(pushval_engine::stepping::PlateSession::new(
+                    world::start(problem, &sim.settings)?,
+                    Box::new(move |w, stepped, problem| {
+                        let mut run = world::finish(w, stepped, problem, &sim.settings);
+                        run.trajectory.model = sim.name();
+                        run.wall_time = started.elapsed();
+                        Ok(run)
+                    }),
+                ))
+            })
         }
         #[cfg(not(feature = "physx"))]
         {
-            let _ = start;
+            let _ = problem;
             Err(ModelError::Integration {
                 t: 0.0,
                 reason: UNAVAILABLE.into(),
             })
         }
     }
+}
+
+/// The world of a session, or none in a build without the `physx` feature.
+mod sessions {
+    #[cfg(feature = "physx")]
+    pub type Physx = pushval_engine::stepping::PlateSession<crate::world::Stepper, crate::PhysxRun>;
+    #[cfg(not(feature = "physx"))]
+    pub type Physx = pushval_engine::Unavailable<crate::PhysxRun>;
 }
 
 impl Simulator for PhysxSimulator {

@@ -114,7 +114,7 @@ fn raw(t: PxTransform) -> physx_sys::PxTransform {
 
 /// The object's state as read from the engine.
 #[derive(Clone, Copy)]
-pub(crate) struct State {
+pub struct State {
     pose: PxTransform,
     vel: [f64; 3],
     theta: f64,
@@ -218,13 +218,6 @@ pub(crate) fn finish(w: Stepper, run: Stepped, problem: &Problem, s: &PhysxSetti
         max_joint_drift: run.max_joint_drift,
         history: run.history,
     }
-}
-
-/// Runs the problem (checked by the caller): [`start`], one push at a time,
-/// [`finish`].
-pub(crate) fn simulate(problem: &Problem, s: &PhysxSettings) -> Result<PhysxRun, ModelError> {
-    let (w, run, applied) = start(problem, s)?.run(&problem.pushes)?;
-    Ok(finish(w, run, &applied, s))
 }
 
 /// A built scene. Dropped in PhysX's order: the joint, the scene with its
@@ -493,7 +486,7 @@ impl World {
 /// The scene as the shared stepping loop sees it: the world, the
 /// foundation it was built in and PhysX's turn (dropped in that order), and
 /// what the settle phase found.
-pub(crate) struct Stepper {
+pub struct Stepper {
     world: World,
     /// Dropped after the world.
     _physics: PhysicsFoundation<physx::foundation::DefaultAllocator, PxShape>,

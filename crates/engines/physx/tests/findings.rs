@@ -11,7 +11,9 @@ use pushval_model::Body;
 use pushval_physx::predict::{
     at_rest, holds_at_rest, lock_moments, locks, steady_omega, AtRest, Law,
 };
-use pushval_physx::{FootContacts, FrictionType, PhysxRun, PhysxSettings, PhysxSimulator};
+use pushval_physx::{
+    DetailedEngine, FootContacts, FrictionType, PhysxRun, PhysxSettings, PhysxSimulator,
+};
 
 fn run(body: &Body, p: pushval_model::Push, s: PhysxSettings) -> PhysxRun {
     PhysxSimulator::new(s).run(&problem(body, p)).unwrap()

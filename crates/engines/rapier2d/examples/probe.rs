@@ -5,7 +5,7 @@ use std::f64::consts::FRAC_PI_4;
 use pushval_model::{
     Body, DynamicModel, Initial, Problem, Push, Simulator, Support, Switching, Vec2,
 };
-use pushval_rapier2d::{EngineSettings, FrictionVelocity, RapierSimulator};
+use pushval_rapier2d::{DetailedEngine, EngineSettings, FrictionVelocity, RapierSimulator};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();

@@ -9,7 +9,9 @@
 use std::path::PathBuf;
 
 use pushval_model::{DynamicModel, RootKind, SegmentDynamics, Simulator, Trajectory};
-use pushval_rapier2d::{tail_mean_omega, EngineSettings, FrictionVelocity, RapierSimulator};
+use pushval_rapier2d::{
+    tail_mean_omega, DetailedEngine, EngineSettings, FrictionVelocity, RapierSimulator,
+};
 
 fn errors(a: &Trajectory, b: &Trajectory) -> (f64, f64) {
     let (mut p, mut t) = (0.0f64, 0.0f64);

@@ -10,7 +10,7 @@ use pushval_model::{
     Body, DynamicModel, Initial, Problem, Push, Simulator, Support, Switching, Vec2,
 };
 use pushval_rapier2d::{
-    tail_mean_omega, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
+    tail_mean_omega, DetailedEngine, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
 };
 
 fn plate(speed: f64, from_rest: bool) -> Problem {

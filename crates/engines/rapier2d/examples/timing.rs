@@ -4,7 +4,9 @@
 //!
 //! `cargo run --release -p pushval-rapier --example timing [FILE] [REPEATS]`
 
-use pushval_rapier2d::{EngineSettings, FrictionVelocity, Precision, RapierSimulator};
+use pushval_rapier2d::{
+    DetailedEngine, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
+};
 
 fn main() {
     let mut args = std::env::args().skip(1);

@@ -2,7 +2,7 @@
 //! scenario file (diagnostics).
 //! `cargo run --release -p pushval-rapier --example trace FILE DT MODE [EVERY]`
 use pushval_model::{DynamicModel, Simulator};
-use pushval_rapier2d::{EngineSettings, FrictionVelocity, RapierSimulator};
+use pushval_rapier2d::{DetailedEngine, EngineSettings, FrictionVelocity, RapierSimulator};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();

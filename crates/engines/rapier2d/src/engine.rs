@@ -1,11 +1,8 @@
 //! The rapier2d models as pushval engine plug-ins: `rapier2d` (per-support
 //! Coulomb forces, gated by default) and the four 2-D friction idioms.
 
-use std::time::Instant;
-
-use pushval_engine::stepping::{PlateSession, PlateWorld, Stepped, Stepping};
 use pushval_engine::{
-    on_first_push, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw,
+    Detailed, DetailedEngine, Engine, EngineCrate, EngineInfo, EngineOptions, FrictionLaw,
     ModelEntry, OptionError, OptionKeys, Session, COULOMB,
 };
 use pushval_laws::idioms::{
@@ -13,7 +10,7 @@ use pushval_laws::idioms::{
 };
 use pushval_model::{ModelError, Problem};
 
-use crate::{EngineSettings, FrictionModel, FrictionVelocity, Precision, RapierSimulator, RawRun};
+use crate::{EngineSettings, FrictionModel, FrictionVelocity, Precision, RapierSimulator};
 
 /// The engine crate and version this adapter is built against (the
 /// `rapier2d-f64` and `rapier2d` entries of the workspace's Cargo.toml; a
@@ -245,52 +242,10 @@ impl Engine for Rapier2dModel {
             dt,
             ..self.settings
         });
-        sim.settings.check()?;
-        let name = self.info.name.clone();
-        on_first_push(problem, move |problem| {
-            let start = Instant::now();
-            match sim.settings.precision {
-                Precision::F64 => crate::f64_engine::world::start(problem, &sim.settings, &[])
-                    .map(|s| session_of(name, sim, s, crate::f64_engine::world::raw_run, start)),
-                Precision::F32 => crate::f32_engine::world::start(problem, &sim.settings, &[])
-                    .map(|s| session_of(name, sim, s, crate::f32_engine::world::raw_run, start)),
-            }
-        })
+        Ok(Box::new(
+            Detailed::new(sim.start(problem)?).named(self.info.name.clone()),
+        ))
     }
-}
-
-/// The session over `stepping`, whose world `raw` reads once it is done;
-/// the run is named `name`.
-fn session_of<W>(
-    name: String,
-    sim: RapierSimulator,
-    stepping: Stepping<W>,
-    raw: fn(W, &Stepped) -> RawRun,
-    start: Instant,
-) -> Session
-where
-    W: PlateWorld + Send + 'static,
-    W::State: Send,
-{
-    Box::new(PlateSession::new(
-        stepping,
-        Box::new(move |world, stepped, problem| {
-            let r = sim.rapier_run(problem, raw(world, &stepped), start);
-            let mut trajectory = r.trajectory;
-            trajectory.model = name;
-            Ok(EngineRun {
-                contact: None,
-                trajectory,
-                dt: sim.settings.dt,
-                steps: r.steps,
-                wall_time: start.elapsed(),
-                diagnostics: serde_json::json!({
-                    "max_joint_drift": r.max_joint_drift,
-                    "steps": r.steps,
-                }),
-            })
-        }),
-    ))
 }
 
 /// The idioms' laws by name, with the idioms' default slip speed: the

@@ -34,6 +34,8 @@
 
 use std::time::{Duration, Instant};
 
+use pushval_engine::stepping::PlateSession;
+use pushval_engine::{on_first_push, DetailedRun, EngineRun, FirstPush};
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 pub mod engine;
@@ -49,7 +51,7 @@ pub mod slide;
 
 pub use engine::{laws, models, Rapier2dModel, ENGINE_CRATE};
 pub use idioms::FrictionModel;
-pub use pushval_engine::{tail_mean_omega, StepRecord};
+pub use pushval_engine::{drive, tail_mean_omega, DetailedEngine, DetailedSession, StepRecord};
 
 /// What the per-precision engine code hands back.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -198,7 +200,7 @@ pub struct EngineSettings {
     /// [`idioms`]); their impulse cap uses the segment's nominal step.
     pub friction_model: FrictionModel,
     /// Attach colliders (default `false`): a convex polygon on the object
-    /// (the outline given to [`RapierSimulator::run_with_outline`], else the
+    /// (the outline given to [`RapierSimulator::start_with_outline`], else the
     /// convex hull of the supports and the contact point) and a 5 mm ball on
     /// the pusher. They are massless (density 0: the body's mass and inertia
     /// stay the ones set directly), in collision groups that exclude each
@@ -318,39 +320,45 @@ impl RapierSimulator {
         Self { settings }
     }
 
-    /// Runs the problem and returns the trajectory with the engine's diagnostics.
-    pub fn run(&self, problem: &Problem) -> Result<RapierRun, ModelError> {
-        self.run_with_outline(problem, &[])
-    }
-
-    /// [`RapierSimulator::run`] with the object's outline (m, object frame
-    /// with the origin at the centre of mass) for the object's collider when
-    /// [`EngineSettings::colliders`] is set: the collider is the outline's
-    /// convex hull. An empty outline means the convex hull of the supports
-    /// and the contact point. Without colliders the outline is not used.
-    pub fn run_with_outline(
+    /// [`DetailedEngine::start`] with the object's outline (m, object
+    /// frame with the origin at the centre of mass) for the object's
+    /// collider when [`EngineSettings::colliders`] is set: the collider is
+    /// the outline's convex hull. An empty outline means the convex hull of
+    /// the supports and the contact point. Without colliders the outline is
+    /// not used.
+    pub fn start_with_outline(
         &self,
         problem: &Problem,
         outline: &[[f64; 2]],
-    ) -> Result<RapierRun, ModelError> {
-        let start = Instant::now();
-        problem.check()?;
+    ) -> Result<RapierSession, ModelError> {
         self.settings.check()?;
-        let raw = match self.settings.precision {
-            Precision::F64 => {
-                let (world, stepped, _) =
-                    f64_engine::world::start(problem, &self.settings, outline)?
-                        .run(&problem.pushes)?;
-                f64_engine::world::raw_run(world, &stepped)
-            }
-            Precision::F32 => {
-                let (world, stepped, _) =
-                    f32_engine::world::start(problem, &self.settings, outline)?
-                        .run(&problem.pushes)?;
-                f32_engine::world::raw_run(world, &stepped)
-            }
-        };
-        Ok(self.rapier_run(problem, raw, start))
+        let sim = *self;
+        let outline = outline.to_vec();
+        on_first_push(problem, move |problem| {
+            let start = Instant::now();
+            Ok(match sim.settings.precision {
+                Precision::F64 => session::Worlds::F64(Box::new(PlateSession::new(
+                    f64_engine::world::start(problem, &sim.settings, &outline)?,
+                    Box::new(move |world, stepped, problem| {
+                        Ok(sim.rapier_run(
+                            problem,
+                            f64_engine::world::raw_run(world, &stepped),
+                            start,
+                        ))
+                    }),
+                ))),
+                Precision::F32 => session::Worlds::F32(Box::new(PlateSession::new(
+                    f32_engine::world::start(problem, &sim.settings, &outline)?,
+                    Box::new(move |world, stepped, problem| {
+                        Ok(sim.rapier_run(
+                            problem,
+                            f32_engine::world::raw_run(world, &stepped),
+                            start,
+                        ))
+                    }),
+                ))),
+            })
+        })
     }
 
     /// The run of `raw` on `problem` (the pushes applied), started at `start`.
@@ -375,6 +383,18 @@ impl RapierSimulator {
     }
 }
 
+/// The crate's one face: a session of the rapier world, pushed one push at
+/// a time, finished into a [`RapierRun`].
+impl DetailedEngine for RapierSimulator {
+    type Session = RapierSession;
+
+    /// The world of `problem` in the settings' precision, without colliders'
+    /// outline ([`RapierSimulator::start_with_outline`]).
+    fn start(&self, problem: &Problem) -> Result<RapierSession, ModelError> {
+        self.start_with_outline(problem, &[])
+    }
+}
+
 impl Simulator for RapierSimulator {
     fn name(&self) -> String {
         "rapier2d".to_string()
@@ -382,5 +402,76 @@ impl Simulator for RapierSimulator {
 
     fn simulate(&self, problem: &Problem) -> Result<Trajectory, ModelError> {
         self.run(problem).map(|r| r.trajectory)
+    }
+}
+
+impl DetailedRun for RapierRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
+    }
+
+    /// The run with the joint drift and the step count as diagnostics.
+    fn engine_run(self) -> EngineRun {
+        EngineRun {
+            contact: None,
+            dt: self.settings.dt,
+            steps: self.steps,
+            wall_time: self.wall_time,
+            diagnostics: serde_json::json!({
+                "max_joint_drift": self.max_joint_drift,
+                "steps": self.steps,
+            }),
+            trajectory: self.trajectory,
+        }
+    }
+}
+
+/// A rapier2d session: the world in the settings' precision, owned and
+/// `Send`; built at the first push for an object that starts moving.
+pub type RapierSession = FirstPush<session::Worlds>;
+
+mod session {
+    use pushval_engine::stepping::PlateSession;
+    use pushval_engine::{DetailedSession, EngineState};
+    use pushval_model::{ModelError, Push, SlideReport};
+
+    use crate::{f32_engine, f64_engine, RapierRun};
+
+    /// The session's world in either precision.
+    pub enum Worlds {
+        F64(Box<PlateSession<f64_engine::world::World2d, RapierRun>>),
+        F32(Box<PlateSession<f32_engine::world::World2d, RapierRun>>),
+    }
+
+    /// Both precisions' sessions answer alike.
+    macro_rules! each {
+        ($self:expr, $s:ident => $e:expr) => {
+            match $self {
+                Worlds::F64($s) => $e,
+                Worlds::F32($s) => $e,
+            }
+        };
+    }
+
+    impl DetailedSession for Worlds {
+        type Run = RapierRun;
+        fn state(&self) -> EngineState {
+            each!(self, s => s.state())
+        }
+        fn advance(&mut self, push: &Push) -> Result<(), ModelError> {
+            each!(self, s => s.advance(push))
+        }
+        fn steps_taken(&self) -> usize {
+            each!(self, s => s.steps_taken())
+        }
+        fn release(&mut self, max_duration: f64) -> Result<(), ModelError> {
+            each!(self, s => s.release(max_duration))
+        }
+        fn slide(&self) -> Option<SlideReport> {
+            each!(self, s => s.slide())
+        }
+        fn finish(self) -> Result<RapierRun, ModelError> {
+            each!(self, s => (*s).finish())
+        }
     }
 }

@@ -73,7 +73,7 @@ impl Rot {
 
 /// The object's state as read from the engine, in f64.
 #[derive(Clone, Copy)]
-pub(crate) struct State {
+pub struct State {
     x: f64,
     y: f64,
     /// Unwrapped angle.
@@ -91,7 +91,7 @@ const PUSHER_RADIUS: Real = 0.005;
 /// The rapier world of one run and what its steps carry from one to the
 /// next, as the shared loop's [`PlateWorld`] (a 2-D world: height and tilt
 /// zero).
-pub(crate) struct World2d {
+pub struct World2d {
     world: PhysicsWorld,
     object: RigidBodyHandle,
     pusher: RigidBodyHandle,
@@ -131,7 +131,7 @@ pub(crate) struct World2d {
 
 /// Builds the world of `problem` in this precision's rapier build and hands
 /// it to the shared loop; `outline` is the object's outline for its collider
-/// (see `RapierSimulator::run_with_outline`). An object not starting at rest
+/// (see `RapierSimulator::start_with_outline`). An object not starting at rest
 /// starts with the first push of `problem`'s schedule (the first push
 /// applied: see `pushval_engine::on_first_push`).
 pub(crate) fn start(

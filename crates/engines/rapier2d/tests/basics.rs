@@ -3,7 +3,7 @@
 mod common;
 
 use pushval_model::{Simulator, Trajectory};
-use pushval_rapier2d::{EngineSettings, Precision, RapierSimulator};
+use pushval_rapier2d::{DetailedEngine, EngineSettings, Precision, RapierSimulator};
 
 fn finite(t: &Trajectory) -> bool {
     t.samples

@@ -9,7 +9,7 @@
 mod common;
 
 use pushval_model::Trajectory;
-use pushval_rapier2d::{EngineSettings, Precision, RapierSimulator};
+use pushval_rapier2d::{drive, DetailedEngine, EngineSettings, Precision, RapierSimulator};
 
 fn run(from_rest: bool, precision: Precision, colliders: bool) -> Trajectory {
     RapierSimulator::new(EngineSettings {
@@ -50,10 +50,14 @@ fn colliders_are_built_from_the_outline() {
         colliders: true,
         ..Default::default()
     });
-    assert!(with.run_with_outline(&problem, &on_a_line).is_err());
+    assert!(with
+        .start_with_outline(&problem, &on_a_line)
+        .and_then(|s| drive(s, &problem))
+        .is_err());
     // Without colliders the outline is not used.
     assert!(RapierSimulator::default()
-        .run_with_outline(&problem, &on_a_line)
+        .start_with_outline(&problem, &on_a_line)
+        .and_then(|s| drive(s, &problem))
         .is_ok());
     // The plate's own outline (its corners, about the centre of mass).
     let square = [
@@ -63,7 +67,11 @@ fn colliders_are_built_from_the_outline() {
         [-0.125, 0.125],
     ];
     let a = RapierSimulator::default().run(&problem).unwrap();
-    let b = with.run_with_outline(&problem, &square).unwrap();
+    let b = drive(
+        with.start_with_outline(&problem, &square).unwrap(),
+        &problem,
+    )
+    .unwrap();
     assert_eq!(a.steps, b.steps);
     for (p, q) in a.trajectory.samples.iter().zip(&b.trajectory.samples) {
         assert_eq!((p.x, p.y, p.theta), (q.x, q.y, q.theta));

@@ -6,7 +6,7 @@ mod common;
 
 use pushval_model::{DynamicModel, Simulator};
 use pushval_rapier2d::{
-    tail_mean_omega, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
+    tail_mean_omega, DetailedEngine, EngineSettings, FrictionVelocity, Precision, RapierSimulator,
 };
 
 const DTS: [f64; 4] = [1e-2, 5e-3, 2.5e-3, 1e-3];

@@ -7,7 +7,7 @@ use pushval_model::{Body, Initial, Problem, Push, SegmentDynamics, Support, Swit
 use pushval_rapier2d::idioms::{
     lock_angles, predicted_mean_omega, predicted_steady_omega, stop_gain, support_force, LawContext,
 };
-use pushval_rapier2d::{EngineSettings, FrictionModel, RapierRun, RapierSimulator};
+use pushval_rapier2d::{DetailedEngine, EngineSettings, FrictionModel, RapierRun, RapierSimulator};
 
 const PHI: f64 = FRAC_PI_4 + 0.3;
 

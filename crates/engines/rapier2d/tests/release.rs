@@ -27,40 +27,29 @@
 //! bound is one-sided as said.
 
 use pushval_engine::{Engine, EngineRun, REST_SPEED};
-use pushval_model::{Body, Initial, Problem, Release, Support, Switching, Vec2};
+use pushval_model::{Initial, Problem, Vec2};
 use pushval_rapier2d::{EngineSettings, FrictionModel, Rapier2dModel};
 
 const G: f64 = 9.81;
-const MU: f64 = 0.5;
+const MU: f64 = Problem::SEED_MU;
 /// Half the side of the seed plate (m).
-const A: f64 = 0.125;
+const A: f64 = 0.5 * Problem::SEED_SIDE;
 const H: f64 = 1e-3;
 const V_S: f64 = 0.01;
 
 fn thrown(v: [f64; 2], omega: f64) -> Problem {
-    let f = MU * G / 4.0;
-    let sup: Vec<Support> = [(-A, -A), (A, -A), (A, A), (-A, A)]
-        .iter()
-        .map(|&(x, y)| Support {
-            position: Vec2::new(x, y),
-            friction: f,
-        })
-        .collect();
-    Problem {
-        body: Body::new(1.0, (2.0 * A) * (2.0 * A) / 6.0, Vec2::new(-A, 0.0), &sup).unwrap(),
-        limits: Default::default(),
-        pushes: vec![],
-        initial: Initial {
+    Problem::seed_plate(
+        G,
+        vec![],
+        Initial {
             theta: 0.0,
             omega,
             position: Vec2::new(0.0, 0.0),
             velocity: Vec2::new(v[0], v[1]),
             from_rest: false,
         },
-        switching: Switching::Impulsive,
-        sample_dt: 0.01,
-        release: Some(Release::default()),
-    }
+    )
+    .unwrap()
 }
 
 fn engine(model: FrictionModel) -> Rapier2dModel {

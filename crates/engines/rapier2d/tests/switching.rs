@@ -4,7 +4,7 @@
 mod common;
 
 use pushval_model::{Problem, Switching};
-use pushval_rapier2d::{EngineSettings, FrictionVelocity, RapierSimulator};
+use pushval_rapier2d::{DetailedEngine, EngineSettings, FrictionVelocity, RapierSimulator};
 
 #[test]
 fn omega_jump_at_switch_conserves_contact_momentum() {

@@ -2,14 +2,11 @@
 //! `FrictionModel::Coulomb`) and `rapier3d_simplified` (its default,
 //! `Simplified`), the plate on ball feet on a ground plane.
 
-use std::time::Instant;
-
-use pushval_engine::stepping::{PlateFinish, PlateSession};
 use pushval_engine::{
-    on_first_push, Engine, EngineCrate, EngineInfo, EngineOptions, EngineRun, FrictionLaw,
+    Detailed, DetailedEngine, Engine, EngineCrate, EngineInfo, EngineOptions, FrictionLaw,
     ModelEntry, OptionError, OptionKeys, Session,
 };
-use pushval_model::{ModelError, Problem, Simulator};
+use pushval_model::{ModelError, Problem};
 
 use crate::predict::{Law, Rapier3dTilt, SceneParams};
 use crate::{ContactFriction, FeetColliders, Rapier3dSettings, Rapier3dSimulator};
@@ -127,30 +124,7 @@ impl Engine for Rapier3dModel {
             dt,
             ..self.settings
         });
-        sim.settings.check()?;
-        on_first_push(problem, move |problem| {
-            let started = Instant::now();
-            let (stepping, set_up) = crate::world::start(problem, &sim.settings)?;
-            let finish: PlateFinish<_> = Box::new(move |_, stepped, problem| {
-                let mut r = crate::world::finish(set_up, stepped, problem);
-                r.trajectory.model = sim.name();
-                Ok(EngineRun {
-                    dt,
-                    steps: r.steps,
-                    wall_time: started.elapsed(),
-                    diagnostics: serde_json::json!({
-                        "steps": r.steps,
-                        "max_joint_drift": r.max_joint_drift,
-                        "max_tilt": r.max_tilt,
-                        "max_lift": r.max_lift,
-                        "loads": r.loads,
-                    }),
-                    trajectory: r.trajectory,
-                    contact: r.contact,
-                })
-            });
-            Ok(Box::new(PlateSession::new(stepping, finish)) as Session)
-        })
+        Ok(Box::new(Detailed::new(sim.start(problem)?)))
     }
 }
 

@@ -60,6 +60,8 @@
 
 use std::time::{Duration, Instant};
 
+use pushval_engine::stepping::PlateSession;
+use pushval_engine::{on_first_push, DetailedRun, EngineRun, FirstPush};
 use pushval_model::{ModelError, Problem, Simulator, Trajectory};
 
 mod engine;
@@ -68,6 +70,7 @@ pub use pushval_laws::rapier3d as predict;
 mod world;
 
 pub use engine::{models, Rapier3dModel, ENGINE_CRATE};
+pub use pushval_engine::{DetailedEngine, DetailedSession};
 
 /// Which of rapier3d's friction models the contact solver uses
 /// (`IntegrationParameters::friction_model`).
@@ -329,16 +332,61 @@ impl Rapier3dSimulator {
     pub fn new(settings: Rapier3dSettings) -> Self {
         Self { settings }
     }
+}
 
-    /// Runs the problem and returns the trajectory with the engine's diagnostics.
-    pub fn run(&self, problem: &Problem) -> Result<Rapier3dRun, ModelError> {
-        let start = Instant::now();
-        problem.check()?;
+/// A rapier3d session: the scene, settled, pushed one push at a time;
+/// owned and `Send`. Built at the first push for an object that starts
+/// moving.
+pub type Rapier3dSession = FirstPush<PlateSession<world::Scene3d, Rapier3dRun>>;
+
+/// The crate's one face: a session of the scene, finished into a
+/// [`Rapier3dRun`].
+impl DetailedEngine for Rapier3dSimulator {
+    type Session = Rapier3dSession;
+
+    /// The scene of `problem`, settled, through the shared stepping loop
+    /// ([`pushval_engine::stepping`]).
+    fn start(&self, problem: &Problem) -> Result<Rapier3dSession, ModelError> {
         self.settings.check()?;
-        let mut run = world::simulate(problem, &self.settings)?;
-        run.trajectory.model = self.name();
-        run.wall_time = start.elapsed();
-        Ok(run)
+        let sim = *self;
+        on_first_push(problem, move |problem| {
+            let started = Instant::now();
+            let (stepping, set_up) = world::start(problem, &sim.settings)?;
+            Ok(PlateSession::new(
+                stepping,
+                Box::new(move |_, stepped, problem| {
+                    let mut run = world::finish(set_up, stepped, problem);
+                    run.trajectory.model = sim.name();
+                    run.wall_time = started.elapsed();
+                    Ok(run)
+                }),
+            ))
+        })
+    }
+}
+
+impl DetailedRun for Rapier3dRun {
+    fn trajectory_mut(&mut self) -> &mut Trajectory {
+        &mut self.trajectory
+    }
+
+    /// The run with the joint drift, tilt, lift and the feet's loads as
+    /// diagnostics, and its contact record.
+    fn engine_run(self) -> EngineRun {
+        EngineRun {
+            dt: self.settings.dt,
+            steps: self.steps,
+            wall_time: self.wall_time,
+            diagnostics: serde_json::json!({
+                "steps": self.steps,
+                "max_joint_drift": self.max_joint_drift,
+                "max_tilt": self.max_tilt,
+                "max_lift": self.max_lift,
+                "loads": self.loads,
+            }),
+            trajectory: self.trajectory,
+            contact: self.contact,
+        }
     }
 }
 

@@ -29,7 +29,7 @@ fn v3(x: f64, y: f64, z: f64) -> Vector {
 
 /// The object's state as read from the engine.
 #[derive(Clone, Copy)]
-pub(crate) struct State {
+pub struct State {
     pose: Pose,
     theta: f64,
     omega: f64,
@@ -116,7 +116,7 @@ fn nearest(points: &[[f64; 2]], x: f64, y: f64) -> usize {
 }
 
 /// The scene as the shared stepping loop sees it.
-pub(crate) struct Scene3d {
+pub struct Scene3d {
     world: PhysicsWorld,
     object: RigidBodyHandle,
     pusher: RigidBodyHandle,
@@ -224,13 +224,6 @@ pub(crate) struct SetUp {
     rest_loads: Vec<f64>,
     manifolds: usize,
     manifold_points: usize,
-}
-
-/// Runs the problem.
-pub(crate) fn simulate(problem: &Problem, s: &Rapier3dSettings) -> Result<Rapier3dRun, ModelError> {
-    let (stepping, set_up) = start(problem, s)?;
-    let (_, run, problem) = stepping.run(&problem.pushes)?;
-    Ok(finish(set_up, run, &problem))
 }
 
 /// Builds the scene, settles it and hands it to the shared loop; an object

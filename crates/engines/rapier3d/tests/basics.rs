@@ -4,7 +4,9 @@
 use std::f64::consts::FRAC_PI_4;
 
 use pushval_model::{Body, Initial, Problem, Push, Simulator, Support, Switching, Vec2};
-use pushval_rapier3d::{ContactFriction, FeetColliders, Rapier3dSettings, Rapier3dSimulator};
+use pushval_rapier3d::{
+    ContactFriction, DetailedEngine, FeetColliders, Rapier3dSettings, Rapier3dSimulator,
+};
 
 const MU: f64 = 0.5;
 const G: f64 = 9.81;

@@ -8,7 +8,9 @@ use pushval_model::{Body, Initial, Problem, Push, Support, Switching, Vec2};
 use pushval_rapier3d::predict::{
     coulomb_steady, predict_steady, simplified_locks, simplified_steady, Law,
 };
-use pushval_rapier3d::{ContactFriction, FeetColliders, Rapier3dSettings, Rapier3dSimulator};
+use pushval_rapier3d::{
+    ContactFriction, DetailedEngine, FeetColliders, Rapier3dSettings, Rapier3dSimulator,
+};
 
 const MU: f64 = 0.5;
 const G: f64 = 9.81;
