@@ -315,6 +315,7 @@ fn main() {
         if quick { 21 } else { 61 },
     );
     target.push_str(&short_horizon_line(root, if quick { 201 } else { 2001 }));
+    target.push_str(&mpc_pattern_line(if quick { 3 } else { 11 }));
     target.push_str(&load_line());
     if model_only {
         eprintln!();
@@ -655,6 +656,106 @@ fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
         "# model_short_horizon final state only at the predictor's tolerance, every push seen before (PushCache warm; the same state to the bit): median {mc:.6e} s\n",
     ));
     out
+}
+
+/// The predictor's calls as the model-predictive controller makes them, as
+/// a comment line of `work_precision_target.csv`: for each of the control
+/// study's 20 goals at 1 m/s, the plan from rest (6 pushes), then one
+/// period's warm re-plan as `benches/control.rs` times it (the plan's first
+/// push run for 0.2 s on the dynamic model with μ × 0.8, then at most four
+/// Levenberg–Marquardt iterations from there, warm-started from the plan
+/// and from the predictor's cache of it). Each re-plan is timed `runs`
+/// times on a copy of the planner (thread CPU time, median); the line gives
+/// the median re-plan, the predictor calls it makes, and the re-plans' time
+/// over their calls: a call's cost in the controller's own pattern (the
+/// solver's own work included, a small part).
+fn mpc_pattern_line(runs: usize) -> String {
+    use pushval::control::mpc::PlantScale;
+    use pushval::control::plan::{straight_time, PlanSpec, Planner};
+    use pushval::control::predict::{Motion, Start};
+    use pushval::control::study::{goals, scene};
+    use pushval::control::{At, ModelKind, Reach};
+    let problem = scene().unwrap();
+    let goals = goals(&problem, &[1.0], 20);
+    let start = Start::of_problem(&problem);
+    let reach = Reach::default();
+    let (mut replans, mut total, mut calls) = (Vec::new(), 0.0, 0usize);
+    for goal in &goals {
+        let spec = PlanSpec {
+            segments: 6,
+            speed: 1.0,
+            predictor: ModelKind::Dynamic,
+            at: At::Release,
+        };
+        let mut planner = Planner::new(
+            &problem,
+            *goal,
+            spec,
+            straight_time(&start, goal, 1.0),
+            reach,
+        );
+        let Some(plan) = planner.plan(&start) else {
+            continue;
+        };
+        let mut plant = PlantScale {
+            mu_scale: 0.8,
+            inertia_scale: 1.0,
+        }
+        .apply(&problem)
+        .unwrap();
+        plant.pushes = vec![pushval_model::Push {
+            duration: 0.2,
+            ..plan.pushes[0]
+        }];
+        let s = *DynamicModel::default()
+            .simulate(&plant)
+            .unwrap()
+            .samples
+            .last()
+            .unwrap();
+        let v_cm =
+            pushval_engine::rigid_cm_velocity(&problem, Some(&plant.pushes[0]), s.theta, s.omega);
+        let st = pushval_engine::EngineState {
+            t: s.t,
+            x: s.x,
+            y: s.y,
+            theta: s.theta,
+            omega: s.omega,
+            v_cm,
+        };
+        let from = Start {
+            theta: s.theta,
+            position: Vec2::new(s.x, s.y),
+            motion: Motion::Moving {
+                omega: s.omega,
+                momentum: st.contact_momentum(&problem),
+            },
+        };
+        let warm = planner.with_duration(&plan.params, planner.duration(&plan.params) - 0.2);
+        let mut times = Vec::with_capacity(runs);
+        let mut n = 0;
+        for _ in 0..runs {
+            let mut p = planner.clone();
+            let r0 = p.predict.runs();
+            let t0 = thread_cpu_time();
+            std::hint::black_box(p.solve(&from, warm.clone(), 4));
+            times.push((thread_cpu_time() - t0).as_secs_f64());
+            n = p.predict.runs() - r0;
+        }
+        times.sort_by(f64::total_cmp);
+        let m = times[times.len() / 2];
+        replans.push(m);
+        total += m;
+        calls += n;
+    }
+    replans.sort_by(f64::total_cmp);
+    format!(
+        "# MPC pattern ({} warm re-plans, one per study goal at 1 m/s, 6 pushes, the predictor's cache warm from the plan): median re-plan {:.6e} s, {:.1} predictor calls per re-plan, {:.6e} s per call (all re-plans' time over all their calls)\n",
+        replans.len(),
+        replans[replans.len() / 2],
+        calls as f64 / replans.len() as f64,
+        total / calls as f64
+    )
 }
 
 /// The machine's load averages (1, 5, 15 min, from `/proc/loadavg`) when

@@ -465,11 +465,8 @@ pub(crate) struct TailCursor {
     beta: [f64; ORDER],
     /// `κ_m` (m).
     kappa: [C; ORDER],
-    /// `γ_1 … γ_n` of `e^{−i b(E)} = Σ γ_m E^m` (index `m − 1`).
-    gamma: [C; ORDER],
-    /// Size of the k-th terms of ω and the angle at `E = 1`, as angles
-    /// (rad): `|α_k| τ` (the angle's `|β_k| = |α_k| τ/k` is no larger).
-    mag: [f64; ORDER],
+    /// `γ_0 … γ_ORDER` of `e^{−i b(E)} = Σ γ_m E^m` (those past `n` unused).
+    gamma: [C; ORDER + 1],
     /// `ε∞` (rad).
     eps_inf: f64,
     /// `e^{i(θ_s + ε∞)}`.
@@ -561,14 +558,12 @@ impl TailCursor {
             kappa[m - 1] = w * gamma[m] * z * inv_z2[m - 1];
             sum_kappa += kappa[m - 1];
         }
-        let mag = ta.map(f64::abs);
         Self {
             tail,
             n,
             beta,
             kappa,
-            gamma: std::array::from_fn(|m| gamma[m + 1]),
-            mag,
+            gamma,
             eps_inf,
             rot_inf,
             w,
@@ -647,10 +642,12 @@ impl TailCursor {
         // Size of a term as an angle (rad): the λ terms over the lengths they
         // scale, |V| τ for the path and |p_c| for the lever. A block drops
         // the terms that stay below the tail's `drop` (rad).
-        let mut mag = self.mag;
+        // Size of the k-th terms of ω and the angle at `E = 1`, as angles
+        // (rad): `|α_k| τ` (the angle's `|β_k| = |α_k| τ/k` is no larger).
+        let mut mag: [f64; ORDER] = std::array::from_fn(|k| (tl.alpha[k] * tl.tau).abs());
         let len_scale = tl.vel.norm() * tl.tau + pc.norm();
         for m in 0..n {
-            lam[m] = self.kappa[m] - r * self.gamma[m];
+            lam[m] = self.kappa[m] - r * self.gamma[m + 1];
             if len_scale > 0.0 {
                 mag[m] = mag[m].max(lam[m].norm_sqr().sqrt() / len_scale);
             }
