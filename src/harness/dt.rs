@@ -77,9 +77,42 @@ pub struct DtEstimate {
     /// reads a steady ω from (tail means; denominator the run at h with
     /// [`rel_err`]'s floor); None when no segment settles.
     pub omega_steady_rel_max: Option<f64>,
+    /// Where the problem releases the plate and the step is chosen
+    /// automatically: the auto stop-time tolerance this rung would give (s,
+    /// [`StopFloor::tolerance`]: never below its factor's number of steps,
+    /// since the rest rule reads the stop at a step's end). None otherwise.
+    pub stop_time: Option<f64>,
     /// Whether every figure is within its ladder target
-    /// ([`DT_FRACTION`] of a number in `[tolerance]`, or the auto target).
+    /// ([`DT_FRACTION`] of a number in `[tolerance]`, or the auto target),
+    /// and the stop-time tolerance, where there is one, within its ceiling.
     pub meets: bool,
+}
+
+/// What the stop time asks of an automatic step where the problem
+/// releases the plate: the auto stop-time tolerance a rung gives must be
+/// within `ceiling`, or the gate would fail the row for its step alone (a
+/// second-order engine's coarse step can be longer than the time the
+/// plate takes to cover the position ceiling).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopFloor {
+    /// The most the stop-time tolerance may be (s,
+    /// [`stop_ceiling`](super::tolerance::stop_ceiling)).
+    pub ceiling: f64,
+    /// The dynamic model's own error in its stop time (s).
+    pub model_error: f64,
+    /// The auto tolerance's factor on the engine's estimate
+    /// ([`AUTO_FACTOR`](super::tolerance::AUTO_FACTOR)).
+    pub factor: f64,
+}
+
+impl StopFloor {
+    /// The auto stop-time tolerance (s) at step `h` (s) for the engine's
+    /// stop-time estimate `estimate` (s): the factor times the larger of the
+    /// estimate and one step (the rest rule reads the stop at a step's end),
+    /// plus the model's own error.
+    pub fn tolerance(&self, estimate: f64, h: f64) -> f64 {
+        self.factor * estimate.max(h) + self.model_error
+    }
 }
 
 /// How the engine's time step was chosen, for the outputs.
@@ -101,6 +134,9 @@ pub struct DtChoice {
     /// Wall time of the search's engine runs (the chosen run and its 2h
     /// partner included).
     pub search_time: Duration,
+    /// The stop-time ceiling the rungs were held to (s), where the problem
+    /// releases the plate and the step is automatic.
+    pub stop_ceiling: Option<f64>,
 }
 
 impl DtChoice {
@@ -108,8 +144,14 @@ impl DtChoice {
     pub fn reason(&self) -> String {
         let t = &self.targets;
         let figures = |e: &DtEstimate| {
+            let stop = match (e.stop_time, self.stop_ceiling) {
+                (Some(s), Some(c)) => {
+                    format!("; stop-time tolerance {s:.2e} s (ceiling {c:.2e} s)")
+                }
+                _ => String::new(),
+            };
             format!(
-                "position {:.2e} m, theta {:.2e} rad, steady omega {} (targets {:.2e} m, {:.2e} rad, {:.2e})",
+                "position {:.2e} m, theta {:.2e} rad, steady omega {} (targets {:.2e} m, {:.2e} rad, {:.2e}){stop}",
                 e.position_max,
                 e.theta_max,
                 e.omega_steady_rel_max.map_or("-".into(), |w| format!("{w:.2e}")),
@@ -160,6 +202,7 @@ impl DtChoice {
                     "position_max_estimate": num(e.position_max),
                     "theta_max_estimate": num(e.theta_max),
                     "omega_steady_rel_max_estimate": e.omega_steady_rel_max.map_or(serde_json::Value::Null, num),
+                    "stop_time_tolerance": e.stop_time.map_or(serde_json::Value::Null, num),
                     "meets": e.meets,
                 })
             })
@@ -171,7 +214,8 @@ impl DtChoice {
                 DtSource::Automatic => "automatic",
             },
             "reason": self.reason(),
-            "criterion": "Richardson self-convergence estimate |X(2h) - X(h)| / (2^p - 1) of the run at h, each gated figure within its target: fraction x [tolerance] for a number, the auto target for \"auto\"",
+            "criterion": "Richardson self-convergence estimate |X(2h) - X(h)| / (2^p - 1) of the run at h, each gated figure within its target: fraction x [tolerance] for a number, the auto target for \"auto\"; where the plate is released, the auto stop-time tolerance at h within its ceiling",
+            "stop_time_ceiling": self.stop_ceiling.map_or(serde_json::Value::Null, num),
             "fraction": DT_FRACTION,
             "order": self.order,
             "ladder": dt_ladder(),
@@ -233,6 +277,7 @@ pub fn dt_estimate(
         position_max,
         theta_max,
         omega_steady_rel_max,
+        stop_time: None,
         meets,
     }
 }
@@ -242,13 +287,15 @@ pub fn dt_estimate(
 /// estimate ([`dt_estimate`], engine runs at 2h and h only) is within
 /// [`DT_FRACTION`] of every `[tolerance]` figure, or the floor when none is.
 /// `segments` (from the dynamic model's run) only say which segments the
-/// gate reads a steady ω from. Returns the choice and every engine run
-/// made, for reuse.
+/// gate reads a steady ω from. Where the problem releases the plate,
+/// `stop` holds every automatic rung's stop-time tolerance to its ceiling
+/// too. Returns the choice and every engine run made, for reuse.
 pub fn choose_engine_dt(
     sc: &Scenario,
     engine: &dyn Engine,
     problem: &Problem,
     segments: &[SegmentInfo],
+    stop: Option<StopFloor>,
 ) -> Result<(DtChoice, Vec<EngineRun>), ModelError> {
     let order = engine.order_for(problem);
     let targets = ladder_targets(sc, DT_FRACTION);
@@ -270,6 +317,7 @@ pub fn choose_engine_dt(
                 order,
                 targets,
                 search_time: start.elapsed(),
+                stop_ceiling: None,
             },
             vec![a, b],
         ));
@@ -322,7 +370,7 @@ pub fn choose_engine_dt(
                 continue;
             }
         };
-        let est = dt_estimate(
+        let mut est = dt_estimate(
             sc,
             segments,
             h,
@@ -330,6 +378,12 @@ pub fn choose_engine_dt(
             &runs[b].trajectory,
             order,
         );
+        if let Some(f) = stop {
+            let e = super::rest::stop_estimate(&runs[a].trajectory, &runs[b].trajectory, order);
+            let s = f.tolerance(e, h);
+            est.stop_time = Some(s);
+            est.meets &= s <= f.ceiling;
+        }
         rungs.push(est);
         if est.meets || i + 1 == ladder.len() {
             return Ok((
@@ -341,6 +395,7 @@ pub fn choose_engine_dt(
                     order,
                     targets,
                     search_time: start.elapsed(),
+                    stop_ceiling: stop.map(|f| f.ceiling),
                 },
                 runs,
             ));

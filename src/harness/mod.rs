@@ -20,7 +20,8 @@ pub mod tolerance;
 
 pub use dt::{
     choose_engine_dt, dt_estimate, dt_ladder, engine_convergence, trajectory_order, Convergence,
-    DtChoice, DtEstimate, DtSource, TrajectoryOrder, DT_FLOOR, DT_FRACTION, DT_LADDER_TOP,
+    DtChoice, DtEstimate, DtSource, StopFloor, TrajectoryOrder, DT_FLOOR, DT_FRACTION,
+    DT_LADDER_TOP,
 };
 pub use rest::{paired, rest_of, Rest, RestDiff};
 pub use segments::{analyse_segments, analyse_segments_with, tail_omega, SegmentInfo, SETTLED_REL};
@@ -447,19 +448,24 @@ pub fn run_scenario(sc: &Scenario, opts: &RunOptions) -> Result<ScenarioReport, 
             // The dynamic model ran first: its segments say which ones the
             // gate reads a steady ω from.
             let segments = analyse_segments(sc, &problem, &runs[0].trajectory);
-            choose_engine_dt(sc, engine.as_ref(), &problem, &segments).and_then(|(choice, done)| {
-                let run = match done.iter().find(|r| r.dt == choice.dt) {
-                    Some(r) => r.clone(),
-                    None => engine.run(&problem, choice.dt)?,
-                };
-                let mut settings = engine.settings(choice.dt);
-                settings["dt_source"] = serde_json::json!(match choice.source {
-                    DtSource::Scenario => "scenario",
-                    DtSource::Automatic => "automatic",
-                });
-                settings["dt_choice"] = choice.json();
-                Ok((run, settings, Some((choice, done))))
-            })
+            // A thrown plate: the automatic step must also let the stop
+            // time's tolerance stay within its ceiling.
+            let stop = tolerance::stop_floor(sc, &problem, &runs[0].trajectory, opts.model_tol);
+            choose_engine_dt(sc, engine.as_ref(), &problem, &segments, stop).and_then(
+                |(choice, done)| {
+                    let run = match done.iter().find(|r| r.dt == choice.dt) {
+                        Some(r) => r.clone(),
+                        None => engine.run(&problem, choice.dt)?,
+                    };
+                    let mut settings = engine.settings(choice.dt);
+                    settings["dt_source"] = serde_json::json!(match choice.source {
+                        DtSource::Scenario => "scenario",
+                        DtSource::Automatic => "automatic",
+                    });
+                    settings["dt_choice"] = choice.json();
+                    Ok((run, settings, Some((choice, done))))
+                },
+            )
         } else {
             // Informational rows keep the adapter's step (or the scenario's):
             // their findings (results/friction_models/) are stated at it.

@@ -106,3 +106,13 @@ pub fn rest_diff(problem: &Problem, reference: &Trajectory, run: &Trajectory) ->
         stop_time,
     })
 }
+
+/// The self-convergence estimate of the stop time (s) of the run at h
+/// (`fine`) from it and the run at 2h (`coarse`) of a scheme of order
+/// `order`, `|t(2h) − t(h)| / (2^p − 1)`; infinite when either did not stop.
+pub fn stop_estimate(coarse: &Trajectory, fine: &Trajectory, order: f64) -> f64 {
+    match (rest_of(coarse), rest_of(fine)) {
+        (Some(c), Some(f)) => (c.t - f.t).abs() / (2f64.powf(order) - 1.0),
+        _ => f64::INFINITY,
+    }
+}

@@ -9,10 +9,10 @@
 use pushval_model::{DynamicModel, Integrator, Problem, Simulator, Trajectory};
 use pushval_scenario::{Limit, Scenario};
 
-use super::dt::{Convergence, DtEstimate, DtSource, TrajectoryOrder};
+use super::dt::{Convergence, DtEstimate, DtSource, StopFloor, TrajectoryOrder};
 use super::figures::limits;
 pub use super::figures::{ladder_targets, Figures, AUTO_TARGET};
-use super::rest::rest_of;
+use super::rest::{rest_of, stop_estimate};
 
 /// An `"auto"` tolerance is this multiple of the engine's self-convergence
 /// estimate (itself not trusted below [`AUTO_TARGET`]): the estimate assumes
@@ -470,6 +470,53 @@ pub fn release_speed(problem: &Problem, omega: f64) -> f64 {
     v.norm() + omega.abs() * reach
 }
 
+/// The most a stop-time tolerance may be (s), with the plate's speed at
+/// the release (m/s): the time in which the plate, at that speed, covers the
+/// position ceiling (`[tolerance] auto_ceiling`). None when the problem has
+/// no release or the model (`reference`) did not stop.
+pub fn stop_ceiling(
+    sc: &Scenario,
+    problem: &Problem,
+    reference: &Trajectory,
+) -> Option<(f64, f64)> {
+    problem.release?;
+    rest_of(reference)?;
+    let omega0 = reference
+        .samples
+        .iter()
+        .rev()
+        .find(|s| s.t <= reference.slide.as_ref().map_or(0.0, |s| s.t_release) + 1e-12)
+        .map_or(problem.initial.omega, |s| s.omega);
+    let speed = release_speed(problem, omega0);
+    let ceiling = if speed > 0.0 {
+        sc.tolerance.auto_ceiling[0] / speed
+    } else {
+        f64::INFINITY
+    };
+    Some((ceiling, speed))
+}
+
+/// What a thrown plate's stop time asks of the engine's step (the
+/// automatic step's rungs are held to it, [`choose_engine_dt`]): its
+/// ceiling, the model's own error in its stop time (a run at a 100 times
+/// looser `model_tol`) and [`AUTO_FACTOR`]. None when the problem has no
+/// release or the model did not stop.
+///
+/// [`choose_engine_dt`]: super::dt::choose_engine_dt
+pub fn stop_floor(
+    sc: &Scenario,
+    problem: &Problem,
+    reference: &Trajectory,
+    model_tol: f64,
+) -> Option<StopFloor> {
+    let (ceiling, _) = stop_ceiling(sc, problem, reference)?;
+    Some(StopFloor {
+        ceiling,
+        model_error: stop_model_error(problem, reference, model_tol),
+        factor: AUTO_FACTOR,
+    })
+}
+
 /// The stop time's tolerance for an engine of order `order` whose runs at
 /// `h` and `2h` are `fine` and `coarse`; with the sentence that fails the
 /// row when the engine's accuracy cannot back it below its ceiling. None
@@ -485,25 +532,14 @@ pub fn stop_tolerance(
     order: f64,
     model_error: f64,
 ) -> Option<(StopTolerance, Option<String>)> {
-    problem.release?;
-    rest_of(reference)?;
-    let estimate = match (rest_of(coarse), rest_of(fine)) {
-        (Some(c), Some(f)) => (c.t - f.t).abs() / (2f64.powf(order) - 1.0),
-        _ => f64::INFINITY,
-    };
-    let omega0 = reference
-        .samples
-        .iter()
-        .rev()
-        .find(|s| s.t <= reference.slide.as_ref().map_or(0.0, |s| s.t_release) + 1e-12)
-        .map_or(problem.initial.omega, |s| s.omega);
-    let speed = release_speed(problem, omega0);
-    let ceiling = if speed > 0.0 {
-        sc.tolerance.auto_ceiling[0] / speed
-    } else {
-        f64::INFINITY
-    };
-    let auto = AUTO_FACTOR * estimate.max(h) + model_error;
+    let (ceiling, speed) = stop_ceiling(sc, problem, reference)?;
+    let estimate = stop_estimate(coarse, fine, order);
+    let auto = StopFloor {
+        ceiling,
+        model_error,
+        factor: AUTO_FACTOR,
+    }
+    .tolerance(estimate, h);
     let problem_text = (!(auto <= ceiling)).then(|| {
         format!(
             "the engine cannot back an auto stop_time at dt = {h:.4e} s: {AUTO_FACTOR} x max(its self-convergence estimate {estimate:.2e} s, dt) + model error {model_error:.2e} s = {auto:.2e} s is above the stop-time ceiling {ceiling:.2e} s (the position ceiling {:.2e} m at the release speed {speed:.3} m/s); set a finer [engine] dt",

@@ -707,6 +707,7 @@ fn trajectory_order_reads_the_order_of_c_h_to_the_p() {
         position_max: 1e-6,
         theta_max: 2e-6,
         omega_steady_rel_max: Some(3e-6),
+        stop_time: None,
         meets: true,
     };
     let safer = pushval::harness::tolerance::reorder(&e, 2.0, SAFE_ORDER);

@@ -320,3 +320,73 @@ fn a_gated_engine_that_cannot_let_go_is_not_applicable() {
         .unwrap_or_else(|| panic!("{junit}"));
     assert!(skipped.contains("release"), "{skipped}");
 }
+
+/// A second-order engine on a thrown plate: the rest rule reads the stop at
+/// a step's end, so the stop-time tolerance is never below 4 steps, and
+/// the step its order alone would pick (2.6e-4 s for `pure_python --scheme
+/// heun` here: 1.04e-3 s) is longer than the 8.0e-4 s in which the plate
+/// covers the position ceiling. The automatic step is held to that ceiling
+/// too: the gate picks a finer rung, says why in `dt_choice`, and passes.
+#[test]
+fn an_automatic_step_keeps_the_stop_time_within_its_ceiling() {
+    let dir = tempfile::tempdir().unwrap();
+    let engines = dir.path().join("engines.toml");
+    std::fs::write(
+        &engines,
+        format!(
+            "[engine.heun]\ncommand = [\"python3\", {:?}, \"--scheme\", \"heun\"]\norder = 2\nsession = true\n",
+            root().join("adapters/python/pure_python.py").display().to_string()
+        ),
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(root().join("scenarios/thrown-square.toml"))
+        .unwrap()
+        .replace(
+            "models = [\"dynamic\", \"rapier2d\", \"box2d\", \"rapier3d\", \"rapier2d_impulse_disk\"]",
+            "models = [\"dynamic\", \"heun\"]\ngate = [\"heun\"]",
+        );
+    assert!(text.contains("gate = [\"heun\"]"));
+    let sc = dir.path().join("thrown-heun.toml");
+    std::fs::write(&sc, text).unwrap();
+    let out = dir.path().join("run");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .arg("run")
+        .arg(&sc)
+        .arg("--engines")
+        .arg(&engines)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let choice = &summary["models"]["heun"]["settings"]["dt_choice"];
+    let ceiling = choice["stop_time_ceiling"]
+        .as_f64()
+        .expect("a stop-time ceiling");
+    let rungs = choice["rungs"].as_array().unwrap();
+    let last = rungs.last().unwrap();
+    let dt = last["dt"].as_f64().unwrap();
+    // The chosen rung's stop-time tolerance is within the ceiling, and at
+    // least 4 of its steps (the rest rule's resolution).
+    let stop = last["stop_time_tolerance"].as_f64().unwrap();
+    assert!(stop <= ceiling && stop >= 4.0 * dt, "{choice}");
+    assert_eq!(last["meets"], true, "{choice}");
+    // The rung above it was refused for the stop time alone: its figures
+    // met their targets, its 4 steps did not fit under the ceiling.
+    let prev = &rungs[rungs.len() - 2];
+    assert_eq!(prev["meets"], false, "{choice}");
+    assert!(4.0 * prev["dt"].as_f64().unwrap() > ceiling, "{choice}");
+    let t = &choice["targets"];
+    for (e, k) in [
+        ("position_max_estimate", "position_max"),
+        ("theta_max_estimate", "theta_max"),
+    ] {
+        assert!(
+            prev[e].as_f64().unwrap() <= t[k].as_f64().unwrap(),
+            "{k}: {choice}"
+        );
+    }
+    assert_eq!(summary["models"]["heun"]["pass"], true, "{summary}");
+}
