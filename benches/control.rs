@@ -15,15 +15,15 @@
 //!
 //! `cargo bench --bench control`
 
+mod replan;
+
 use criterion::{criterion_group, BatchSize, BenchmarkId, Criterion};
 use pushval::control::mpc::PlantScale;
 use pushval::control::plan::{straight_time, PlanSpec, Planner};
-use pushval::control::predict::{Motion, Start};
+use pushval::control::predict::Start;
 use pushval::control::study::{goals, scene};
 use pushval::control::{ModelKind as Predictor, Reach};
 use pushval::outdir::Csv;
-use pushval_engine::EngineState;
-use pushval_model::{DynamicModel, Simulator, Vec2};
 
 fn control(c: &mut Criterion) {
     let problem = scene().unwrap();
@@ -73,46 +73,7 @@ fn control(c: &mut Criterion) {
                 Planner::new(&problem, *goal, spec, straight_time(&start, goal, v), reach);
             let plan = planner.plan(&start).unwrap();
             // The plant (μ × 0.8) runs the plan's first push for 0.2 s.
-            let mut plant = PlantScale {
-                mu_scale: 0.8,
-                inertia_scale: 1.0,
-            }
-            .apply(&problem)
-            .unwrap();
-            plant.pushes = vec![pushval_model::Push {
-                duration: 0.2,
-                ..plan.pushes[0]
-            }];
-            let s = *DynamicModel::default()
-                .simulate(&plant)
-                .unwrap()
-                .samples
-                .last()
-                .unwrap();
-            let v_cm = pushval_engine::rigid_cm_velocity(
-                &problem,
-                Some(&plant.pushes[0]),
-                s.theta,
-                s.omega,
-            );
-            let st = EngineState {
-                t: s.t,
-                x: s.x,
-                y: s.y,
-                theta: s.theta,
-                omega: s.omega,
-                v_cm,
-            };
-            let from = Start {
-                theta: s.theta,
-                position: Vec2::new(s.x, s.y),
-                motion: Motion::Moving {
-                    omega: s.omega,
-                    momentum: st.contact_momentum(&problem),
-                },
-            };
-            let remaining = planner.duration(&plan.params) - 0.2;
-            let warm = planner.with_duration(&plan.params, remaining);
+            let (from, warm) = replan::replan_case(&problem, &planner, &plan);
             g.bench_with_input(
                 BenchmarkId::new("replan_warm", format!("goal{i}_{v}mps")),
                 &planner,

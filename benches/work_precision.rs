@@ -35,6 +35,7 @@ use pushval_model::{
 };
 use pushval_scenario::Scenario;
 
+mod replan;
 mod short_horizon;
 
 struct Row {
@@ -670,9 +671,8 @@ fn short_horizon_line(root: &std::path::Path, runs: usize) -> String {
 /// over their calls: a call's cost in the controller's own pattern (the
 /// solver's own work included, a small part).
 fn mpc_pattern_line(runs: usize) -> String {
-    use pushval::control::mpc::PlantScale;
     use pushval::control::plan::{straight_time, PlanSpec, Planner};
-    use pushval::control::predict::{Motion, Start};
+    use pushval::control::predict::Start;
     use pushval::control::study::{goals, scene};
     use pushval::control::{At, ModelKind, Reach};
     let problem = scene().unwrap();
@@ -697,41 +697,7 @@ fn mpc_pattern_line(runs: usize) -> String {
         let Some(plan) = planner.plan(&start) else {
             continue;
         };
-        let mut plant = PlantScale {
-            mu_scale: 0.8,
-            inertia_scale: 1.0,
-        }
-        .apply(&problem)
-        .unwrap();
-        plant.pushes = vec![pushval_model::Push {
-            duration: 0.2,
-            ..plan.pushes[0]
-        }];
-        let s = *DynamicModel::default()
-            .simulate(&plant)
-            .unwrap()
-            .samples
-            .last()
-            .unwrap();
-        let v_cm =
-            pushval_engine::rigid_cm_velocity(&problem, Some(&plant.pushes[0]), s.theta, s.omega);
-        let st = pushval_engine::EngineState {
-            t: s.t,
-            x: s.x,
-            y: s.y,
-            theta: s.theta,
-            omega: s.omega,
-            v_cm,
-        };
-        let from = Start {
-            theta: s.theta,
-            position: Vec2::new(s.x, s.y),
-            motion: Motion::Moving {
-                omega: s.omega,
-                momentum: st.contact_momentum(&problem),
-            },
-        };
-        let warm = planner.with_duration(&plan.params, planner.duration(&plan.params) - 0.2);
+        let (from, warm) = replan::replan_case(&problem, &planner, &plan);
         let mut times = Vec::with_capacity(runs);
         let mut n = 0;
         for _ in 0..runs {
