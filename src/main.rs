@@ -927,16 +927,24 @@ fn main() -> ExitCode {
             shard,
             merge,
             studies,
-        }) => pushval::study::cli(
-            &name,
-            pushval::study::Options {
-                quick,
-                shard,
-                merge,
-                studies: studies.unwrap_or_else(pushval::study::spec::default_dir),
-                ..pushval::study::Options::new(out)
-            },
-        ),
+        }) => match studies {
+            // A folder the user named that is not there is a mistake, not
+            // a request for the shipped study files.
+            Some(dir) if !dir.is_dir() => Err(anyhow::anyhow!(
+                "--studies {}: no such folder (the study files, MODEL.toml, live in one)",
+                dir.display()
+            )),
+            studies => pushval::study::cli(
+                &name,
+                pushval::study::Options {
+                    quick,
+                    shard,
+                    merge,
+                    studies: studies.unwrap_or_else(pushval::study::spec::default_dir),
+                    ..pushval::study::Options::new(out)
+                },
+            ),
+        },
     };
     pushval::registry::shutdown_sessions();
     match result {

@@ -374,6 +374,24 @@ fn bad_names_and_study_files_exit_2() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("box2d.toml") && err.contains("t_run"), "{err}");
     assert!(!dir.path().join("README.md").exists(), "nothing written");
+    // A --studies folder that is not there is refused, not replaced by the
+    // shipped study files.
+    let missing = studies.path().join("missing");
+    let out = Command::new(env!("CARGO_BIN_EXE_pushval"))
+        .current_dir(root())
+        .args(["study", "box2d", "--quick", "--studies"])
+        .arg(&missing)
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--studies") && err.contains("missing"),
+        "{err}"
+    );
+    assert!(!dir.path().join("README.md").exists(), "nothing written");
 }
 
 /// The `rect` elements of an SVG as (x, fill, stroke), after checking the
