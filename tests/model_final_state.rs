@@ -1,6 +1,8 @@
 //! The dynamic model's final state ([`DynamicModel::final_state`], what a
 //! predictor asks for) on every shipped scenario: the full sampled run's
-//! last sample (≤ 1e-12 m, rad), or the same error when the run fails.
+//! last sample to within the tolerance (its settling segments end by the
+//! series in δ, the sampled run's by the series in E), or the same error
+//! when the run fails.
 
 use std::path::PathBuf;
 
@@ -26,8 +28,23 @@ fn final_state_is_the_last_sample_of_every_scenario(
             let dp = (end.x - last.x).hypot(end.y - last.y);
             let dth = (end.theta - last.theta).abs();
             let dw = (end.omega - last.omega).abs();
+            // Ten tolerances, plus twice what the sampled run itself is off
+            // from a DOP853 run at 1e-13 with no closed form (the
+            // integrator's error between two hand-over points).
+            let reference = DynamicModel {
+                integrator: Integrator::Dop853 { tol: 1e-13 },
+                skip_settled: false,
+                ..Default::default()
+            }
+            .simulate(&problem)
+            .unwrap();
+            let r = reference.samples.last().unwrap();
+            let own = (last.x - r.x)
+                .hypot(last.y - r.y)
+                .max((last.theta - r.theta).abs());
+            let bound = 10.0 * tol + 2.0 * own;
             assert!(
-                dp <= 1e-12 && dth <= 1e-12 && dw <= 1e-12 * (1.0 + last.omega.abs()),
+                dp <= bound && dth <= bound && dw <= bound * (1.0 + last.omega.abs()),
                 "{}: {dp:e} m, {dth:e} rad, {dw:e} rad/s",
                 path.display()
             );

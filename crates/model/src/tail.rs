@@ -41,9 +41,13 @@
 //! stages (the linearising map, the hand-over rule, the cursor that samples
 //! it) pass one another fixed-size coefficient arrays of the one truncation
 //! order [`ORDER`] and crate-private types; apart, each file would need the
-//! others' internals.
+//! others' internals. A run that wants a segment's end alone (the
+//! predictor) takes the series in `δ` instead ([`ends`]): the same motion,
+//! no linearising map and no rotation series.
 
 use nalgebra::Complex;
+
+pub(crate) mod ends;
 
 use crate::{dynamic::SegmentDynamics, Vec2};
 
@@ -219,36 +223,6 @@ pub(crate) fn series_for(a: &[f64; ORDER], order: usize, d: f64) -> Option<[f64;
     }))
 }
 
-/// What [`SettleRule::new_with`] keeps of one segment's dynamics about one
-/// root: the Taylor coefficients `g_0 … g_ORDER` of ω̇ there and the first
-/// `order` terms of the linearising map (zero beyond).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct MapMemo {
-    g: [f64; ORDER + 1],
-    a: [f64; ORDER],
-    order: usize,
-}
-
-impl MapMemo {
-    /// The terms [`linearising_map`] returns for `reach` and `small`, if
-    /// the terms kept reach its stopping point: its test, step by step on
-    /// the same values (so the same point, to the bit).
-    fn cut(&self, reach: f64, small: f64) -> Option<([f64; ORDER], usize)> {
-        let mut reach_km1 = reach;
-        for k in 2..=self.order {
-            let reach_k = reach_km1 * reach;
-            if k >= 4 && self.a[k - 1].abs() * reach_k + self.a[k - 2].abs() * reach_km1 < small {
-                return Some((
-                    std::array::from_fn(|i| if i < k { self.a[i] } else { 0.0 }),
-                    k,
-                ));
-            }
-            reach_km1 = reach_k;
-        }
-        (self.order == ORDER).then_some((self.a, ORDER))
-    }
-}
-
 /// When a transient may be handed over to the closed-form [`Tail`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SettleRule {
@@ -277,31 +251,8 @@ impl SettleRule {
         w_start: f64,
         duration: f64,
     ) -> Option<Self> {
-        Self::new_with(seg, omega, tol, w_start, duration, &mut None)
-    }
-
-    /// [`SettleRule::new`] reusing what `memo` holds for this segment's
-    /// dynamics and root (the Taylor coefficients of `g` there and the
-    /// linearising map's terms so far) and leaving there what it computed.
-    /// The rule is the one [`SettleRule::new`] gives, bit for bit: the map's
-    /// terms do not depend on how many of them are asked for, only the
-    /// stopping point does, and that is tested again on the terms kept.
-    pub(crate) fn new_with(
-        seg: &SegmentDynamics,
-        omega: f64,
-        tol: f64,
-        w_start: f64,
-        duration: f64,
-        memo: &mut Option<MapMemo>,
-    ) -> Option<Self> {
-        let g = match memo {
-            Some(m) => m.g,
-            None => {
-                let mut g = [0.0; ORDER + 1];
-                seg.omega_dot_taylor(omega, &mut g);
-                g
-            }
-        };
+        let mut g = [0.0; ORDER + 1];
+        seg.omega_dot_taylor(omega, &mut g);
         if !(g[1] < 0.0) || g.iter().any(|v| !v.is_finite()) {
             return None;
         }
@@ -318,14 +269,7 @@ impl SettleRule {
         // 1.25 |δ₀| on it); that check decides, so this only sets the work.
         let reach = 1.25 * (w_start - omega).abs();
         let small = rule.allowed(duration);
-        (rule.a, rule.order) = match memo.as_ref().and_then(|m| m.cut(reach, small)) {
-            Some(kept) => kept,
-            None => {
-                let (a, order) = linearising_map(&g, reach, small);
-                *memo = Some(MapMemo { g, a, order });
-                (a, order)
-            }
-        };
+        (rule.a, rule.order) = linearising_map(&g, reach, small);
         rule.a.iter().all(|v| v.is_finite()).then_some(rule)
     }
 

@@ -107,10 +107,16 @@ fn gap(f: &FinalState, s: &pushval_model::Sample) -> (f64, f64, f64) {
     )
 }
 
-/// The final state is the full run's last sample: the same steps, switches
-/// and closed forms, only the last pose evaluated once instead of as part
-/// of a block of samples (≤ 1e-12 m, rad, rad/s). Every integrator, with
-/// and without the settled-arc shortcut.
+/// The final state is the full run's last sample, to within the
+/// tolerance. Without the settled-arc shortcut both take the same steps and
+/// differ only by rounding (≤ 1e-12 m, rad, rad/s). With it, a settling
+/// segment ends by the series in δ where the sampled run follows the series
+/// in E: two closed forms, each within a share of the tolerance of the
+/// motion, and hand-overs at other steps, so they agree to within a few
+/// tolerances (10 × tol here; RK4's tolerance is dt⁴) plus twice the
+/// sampled run's own error against a DOP853 run at 1e-13 without closed
+/// forms (what the integrator leaves between two hand-over points; it
+/// matters for fixed-step RK4). Every integrator.
 #[rstest]
 fn final_state_is_the_last_sample(
     #[values(paper_problem(), short_horizon(), pivot_and_hold())] p: Problem,
@@ -129,12 +135,30 @@ fn final_state_is_the_last_sample(
     let last = full.samples.last().unwrap();
     assert_eq!(f.t, last.t);
     let (dp, dth, dw) = gap(&f, last);
+    let tol = match integrator {
+        Integrator::Dop853 { tol } | Integrator::Adaptive { tol } => tol,
+        Integrator::Rk4 { dt } => dt.powi(4),
+    };
+    let bound = if skip_settled {
+        let reference = model(Integrator::Dop853 { tol: 1e-13 }, false)
+            .simulate(&p)
+            .unwrap();
+        let r = reference.samples.last().unwrap();
+        let own = ((last.x - r.x).hypot(last.y - r.y)).max((last.theta - r.theta).abs());
+        10.0 * tol + 2.0 * own
+    } else {
+        1e-12
+    };
     assert!(
-        dp <= 1e-12 && dth <= 1e-12 && dw <= 1e-12 * (1.0 + last.omega.abs()),
+        dp <= bound && dth <= bound && dw <= bound * (1.0 + last.omega.abs()),
         "{integrator:?}, skip {skip_settled}: {dp:e} m, {dth:e} rad, {dw:e} rad/s"
     );
-    // The same work, less any dense output built for samples.
-    assert_eq!(f.stats.steps, full.stats.steps);
+    if skip_settled {
+        // Never more work than the sampled run, less any dense output.
+        assert!(f.stats.steps <= full.stats.steps);
+    } else {
+        assert_eq!(f.stats.steps, full.stats.steps);
+    }
     assert!(f.stats.rhs_evals <= full.stats.rhs_evals);
 }
 
@@ -288,4 +312,51 @@ fn cached_final_state_is_the_uncached_one_to_the_bit() {
         m.final_state_cached(&p, &mut cache).unwrap(),
         m.final_state(&p).unwrap()
     );
+}
+
+/// The end of a settling segment by the series in δ, over the ground it
+/// must cover: one push on the paper plate and on a plate with a heavily
+/// loaded corner, in eight directions, from starts on either side of the
+/// root (and at rest: a root ω* = 0 among them, where the contact point's
+/// sum takes its short form), at three speeds and over spans from a third
+/// of τ to twenty τ. Against a DOP853 run at 1e-13 that takes no closed
+/// form, the final state at tolerance 1e-10 is within 10 × tol (m, rad) of
+/// what DOP853 at 1e-10 leaves without closed forms (the series add at
+/// most that; a start beyond their radius is integrated until they hold,
+/// never answered from them).
+#[rstest]
+fn a_settling_segments_end_meets_its_tolerance(
+    #[values(paper_plate(), pivot_body())] body: pushval_model::Body,
+    #[values(0.3, 1.0, 2.0)] speed: f64,
+) {
+    let tol = 1e-10;
+    let m = model(Integrator::Dop853 { tol }, true);
+    let reference = model(Integrator::Dop853 { tol: 1e-13 }, false);
+    let mut worst: (f64, f64) = (0.0, 0.0);
+    for k in 0..8 {
+        let phi = -1.2 + 0.3 * k as f64;
+        for omega in [-3.0, -1.0, -0.2, 0.0, 0.2, 1.0, 3.0] {
+            for duration in [0.03, 0.3, 2.0] {
+                let mut p = one_push(body.clone(), duration, speed, phi);
+                p.initial = Initial {
+                    omega,
+                    ..Default::default()
+                };
+                let Ok(f) = m.final_state(&p) else { continue };
+                let r = reference.simulate(&p).unwrap();
+                let (dp, dth, _) = gap(&f, r.samples.last().unwrap());
+                // What the integrator alone leaves, over the same span.
+                let plain = model(Integrator::Dop853 { tol }, false)
+                    .final_state(&p)
+                    .unwrap();
+                let (pp, pth, _) = gap(&plain, r.samples.last().unwrap());
+                assert!(
+                    dp <= 10.0 * tol + pp && dth <= 10.0 * tol + pth,
+                    "phi {phi}, omega {omega}, duration {duration}, speed {speed}: {dp:e} m, {dth:e} rad"
+                );
+                worst = (worst.0.max(dp), worst.1.max(dth));
+            }
+        }
+    }
+    eprintln!("worst {:e} m, {:e} rad", worst.0, worst.1);
 }

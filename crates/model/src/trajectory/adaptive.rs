@@ -1,9 +1,8 @@
 //! One segment of the dynamic model by an adaptive embedded pair:
 //! Dormand–Prince 5(4) or DOP853, with dense output at the samples.
 
-use super::segment::{pose_of, Recorder, SegmentRun};
+use super::segment::{pose_of, Closed, Recorder, SegmentRun};
 use crate::integrate::{self, State};
-use crate::tail::Tail;
 use crate::ModelError;
 
 /// One attempted step of either method. It lives for one step on the
@@ -59,7 +58,7 @@ pub(super) fn integrate<F: FnMut(&State) -> State>(
     tol: f64,
     eighth: bool,
     h_carry: &mut Option<(f64, f64)>,
-) -> Result<(State, Option<Tail>), ModelError> {
+) -> Result<(State, Option<Closed>), ModelError> {
     let (t0, t1) = (seg.t0, seg.t1);
     // Relative tolerance on ω only: the angle and the position depend on the
     // choice of frame, and their error must not (invariance under rigid
@@ -79,7 +78,7 @@ pub(super) fn integrate<F: FnMut(&State) -> State>(
     // distance from the steady state, so the step carried over shrinks by
     // (distance then / distance now)^(1/8); otherwise the usual starting-step
     // estimate.
-    let dev_new = seg.settle.map(|r| (y[1] - r.omega).abs());
+    let dev_new = seg.root().map(|r| (y[1] - r).abs());
     let mut h = match (*h_carry, dev_new) {
         (Some((hc, dev_old)), Some(dn)) if dev_old > 0.0 && dn > 0.0 => {
             hc * (dev_old / dn).powf(1.0 / (order as f64 + 2.0)).min(1.0)
@@ -132,7 +131,7 @@ pub(super) fn integrate<F: FnMut(&State) -> State>(
                 rec.out.stats.steps += 1;
                 let stalled = seg.pivot.is_some() && hh < 1e-12 * t.abs().max(1.0);
                 if seg.landed(t, &y, w_before, stalled, rec.out.stats.steps)? {
-                    break 'steps Some(seg.pivot_tail_from(t, &y));
+                    break 'steps Some(Closed::Tail(seg.pivot_tail_from(t, &y)));
                 }
                 let hn = next_step(hh, err);
                 if !landing || hn < h {
@@ -154,7 +153,7 @@ pub(super) fn integrate<F: FnMut(&State) -> State>(
         }
         None
     };
-    let dev = seg.settle.map_or(f64::NAN, |r| (y[1] - r.omega).abs());
+    let dev = seg.root().map_or(f64::NAN, |r| (y[1] - r).abs());
     *h_carry = Some((h, dev));
     Ok((y, tail))
 }

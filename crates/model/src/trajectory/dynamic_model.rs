@@ -5,11 +5,12 @@
 
 use super::checker::Checker;
 use super::push_cache::PushCache;
-use super::segment::{pose_of, Recorder, SegmentRun};
+use super::segment::{pose_of, Closed, Recorder, SegmentRun};
 use super::{adaptive, rk4, SegmentReport, Trajectory};
 use crate::dynamic::{SegmentDynamics, SteadyState};
 use crate::integrate::State;
-use crate::tail::{SettleRule, Tail};
+use crate::tail::ends::EndSeries;
+use crate::tail::SettleRule;
 use crate::{rotate, Body, ModelError, Problem, Push, RootKind, Rotor, Simulator, Vec2};
 
 /// Which integrator the dynamic model uses.
@@ -108,6 +109,7 @@ impl DynamicModel {
         last: bool,
         omega: f64,
         r_min: f64,
+        ends_only: bool,
         checker: &mut Checker,
     ) -> SegmentRun {
         let dynamics = match spare {
@@ -141,18 +143,30 @@ impl DynamicModel {
             Integrator::Adaptive { tol } | Integrator::Dop853 { tol } => tol,
             Integrator::Rk4 { dt } => dt.powi(4),
         };
-        let settle = match target {
+        let stable = match target {
             Some(SteadyState {
                 kind: RootKind::Stable,
                 tau: Some(tau),
                 omega: ws,
-            }) if self.skip_settled && tau > 0.0 => match cached {
-                Some((i, c)) => {
-                    SettleRule::new_with(&dynamics, ws, tol, omega, t1 - t0, c.memo(i, ws))
-                }
-                None => SettleRule::new(&dynamics, ws, tol, omega, t1 - t0),
-            },
+            }) if self.skip_settled && tau > 0.0 => Some(ws),
             _ => None,
+        };
+        // A run that samples follows the series in E; one that wants the
+        // end alone, the series in δ (the same closed form, cheaper).
+        let (settle, ends) = match stable {
+            Some(ws) if ends_only => {
+                // As many terms as the check at the segment's start asks for
+                // (with the bound 1.25 |δ₀|); that check decides.
+                let reach = (omega - ws).abs();
+                let fresh = || EndSeries::new(&dynamics, ws, reach, push.speed, t1 - t0, tol);
+                let ends: Option<EndSeries> = match cached {
+                    Some((i, c)) => c.memo(i, ws, [reach, push.speed, t1 - t0, tol], fresh),
+                    None => fresh(),
+                };
+                (None, ends)
+            }
+            Some(ws) => (SettleRule::new(&dynamics, ws, tol, omega, t1 - t0), None),
+            None => (None, None),
         };
         // A stable pivot is reached in finite time (ω̇ jumps there); past
         // it the support sticks and the object turns about it at the
@@ -175,6 +189,7 @@ impl DynamicModel {
             vel: dir * push.speed,
             tol,
             settle,
+            ends,
             pivot,
             omega_limit,
         }
@@ -191,7 +206,7 @@ impl DynamicModel {
         rec: &mut Recorder,
         h_carry: &mut Option<(f64, f64)>,
         y: State,
-    ) -> Result<(State, Option<Tail>), ModelError> {
+    ) -> Result<(State, Option<Closed>), ModelError> {
         let vel = seg.vel;
         let mut rotor = Rotor::new();
         let mut rhs = |y: &State| {
@@ -298,6 +313,7 @@ impl DynamicModel {
             .filter(|r| *r > 0.0)
             .fold(f64::INFINITY, f64::min);
         let n_seg = problem.pushes.len();
+        let ends_only = rec.ends_only;
         if reports {
             rec.out.segments.reserve_exact(n_seg);
         }
@@ -331,6 +347,7 @@ impl DynamicModel {
                 j + 1 == n_seg,
                 omega,
                 r_min,
+                ends_only,
                 &mut rec.checker,
             );
             let mut report = SegmentReport {
@@ -351,9 +368,9 @@ impl DynamicModel {
                 (c, theta, omega) = pose_of(&y);
                 closed_form = tail;
             }
-            if let Some(tail) = closed_form {
-                report.settled_at = Some(tail.t);
-                (c, theta, omega) = rec.samples_of_tail(&seg, tail);
+            if let Some(closed) = closed_form {
+                report.settled_at = Some(closed.start());
+                (c, theta, omega) = rec.finish_closed(&seg, closed);
             }
             report.omega_end = omega;
             if reports {

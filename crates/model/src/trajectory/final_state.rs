@@ -1,8 +1,11 @@
 //! The dynamic model asked only for what the caller needs: the state at
 //! the end of the schedule ([`DynamicModel::final_state`]), or samples at
-//! the caller's own times ([`DynamicModel::sample_at`]). Both take the
-//! same path as [`Simulator::simulate`] (the same steps, switches and
-//! closed forms), so their states are the full run's at those times.
+//! the caller's own times ([`DynamicModel::sample_at`]). `sample_at` takes
+//! the same path as [`Simulator::simulate`] (the same steps, switches and
+//! closed forms), so its samples are the full run's at those times;
+//! `final_state` ends each settling segment by the series in `δ`
+//! (`tail::ends`), cheaper than the sampled series in `E`, so it agrees
+//! with the full run's last sample to within the tolerance.
 
 use super::dynamic_model::DynamicModel;
 use super::push_cache::PushCache;
@@ -41,10 +44,13 @@ impl DynamicModel {
     ///
     /// `problem.sample_dt` is not read: no sample is taken, stored or
     /// interpolated, no segment report is kept, and an integrated step
-    /// builds no dense output. The state equals the last sample of
-    /// [`Simulator::simulate`] on the same problem (the same steps and
-    /// closed forms; only the evaluation of the final pose may differ, by
-    /// rounding). The assumption checks are made at samples, so none is
+    /// builds no dense output. A segment that settles toward a stable root
+    /// ends by the series in `δ = ω − ω*` (its end state alone, about a
+    /// fifth of the set-up of the sampled series in `E`), handed over to as
+    /// soon as they hold to a share of the tolerance; so the state agrees
+    /// with the last sample of [`Simulator::simulate`] on the same problem
+    /// to within the tolerance, not to rounding (with `skip_settled` off
+    /// both take the same steps and agree to rounding). The assumption checks are made at samples, so none is
     /// made here whatever `check_assumptions` says: run `simulate` for them.
     /// With a `[release]`, the state is the slide's end: at rest, or at
     /// `max_duration` when the plate has not stopped.
@@ -54,7 +60,7 @@ impl DynamicModel {
 
     /// [`DynamicModel::final_state`] with the analysis of each push kept in
     /// `cache` between calls (the root its segments tend to and the series
-    /// tail's coefficients, see [`PushCache`]): the same state to the bit,
+    /// in `δ` about it, see [`PushCache`]): the same state to the bit,
     /// at less cost when pushes repeat, as in a planner's finite-difference
     /// Jacobian or a warm-started re-plan.
     pub fn final_state_cached(
@@ -73,6 +79,7 @@ impl DynamicModel {
         problem.check()?;
         self.check_integrator()?;
         let mut rec = Recorder::with_sampler(problem, String::new(), false, Sampler::none());
+        rec.ends_only = true;
         let end = self.run(problem, &mut rec, false, cache)?;
         if let Some(release) = &problem.release {
             // Through the free slide to rest, with no sample taken.

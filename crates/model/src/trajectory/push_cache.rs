@@ -5,7 +5,7 @@
 //! segment most of a run's work depends on the push alone.
 
 use crate::dynamic::{SegmentDynamics, SteadyState};
-use crate::tail::MapMemo;
+use crate::tail::ends::EndSeries;
 use crate::{Body, InertialTerm, Push};
 
 /// Pushes remembered at most; the oldest is replaced beyond that.
@@ -14,7 +14,8 @@ const CAPACITY: usize = 32;
 /// Per push (speed and direction, to the bit) on one body: the steady state
 /// a segment tends to, when that does not depend on where ω starts (the
 /// inertial slope `k < 0`: `G` decreases and has one root), and the series
-/// tail's coefficients about it. [`DynamicModel::final_state_cached`] with
+/// in `δ` about it (`r_n`, `Φ_n`, `F_n`, which scale with the start's
+/// `δ₀^n`: a warm segment only sums them). [`DynamicModel::final_state_cached`] with
 /// a cache returns what [`DynamicModel::final_state`] returns, bit for bit;
 /// the cache only spares the work. It forgets everything when the body or
 /// the reading of the inertial term changes.
@@ -40,7 +41,9 @@ struct Entry {
     root: Option<Option<SteadyState>>,
     /// ω* (bits) the memo is about.
     memo_root: u64,
-    memo: Option<MapMemo>,
+    /// The series in `δ` about that root (None until made; `Some(None)`:
+    /// it has none).
+    memo: Option<Option<EndSeries>>,
 }
 
 impl PushCache {
@@ -113,14 +116,33 @@ impl PushCache {
         }
     }
 
-    /// The memo slot of entry `i` for the root `omega` (emptied if it was
-    /// about another root).
-    pub(super) fn memo(&mut self, i: usize, omega: f64) -> &mut Option<MapMemo> {
+    /// The series in `δ` of entry `i` about the root `omega`, cut as
+    /// `fresh()` would cut it ([`EndSeries::cut`] with `cut`'s reach, speed,
+    /// span and tolerance): from the terms kept, or `fresh()` kept instead
+    /// when they do not reach that far (the terms are the same, only the
+    /// number computed differs). So a call gets the same series, to the
+    /// bit, whatever the cache held.
+    pub(super) fn memo(
+        &mut self,
+        i: usize,
+        omega: f64,
+        cut: [f64; 4],
+        fresh: impl FnOnce() -> Option<EndSeries>,
+    ) -> Option<EndSeries> {
         let e = &mut self.entries[i];
-        if e.memo_root != omega.to_bits() {
-            e.memo_root = omega.to_bits();
-            e.memo = None;
+        if e.memo_root == omega.to_bits() {
+            match e.memo {
+                Some(None) => return None,
+                Some(Some(s)) => {
+                    if let Some(s) = s.cut(cut[0], cut[1], cut[2], cut[3]) {
+                        return Some(s);
+                    }
+                }
+                None => {}
+            }
         }
-        &mut e.memo
+        e.memo_root = omega.to_bits();
+        e.memo = Some(fresh());
+        e.memo.flatten()
     }
 }

@@ -1,9 +1,8 @@
 //! One segment of the dynamic model by classical RK4 at a fixed step,
 //! sampled by cubic Hermite interpolation (kept for benchmarks).
 
-use super::segment::{pose_of, Recorder, SegmentRun};
+use super::segment::{pose_of, Closed, Recorder, SegmentRun};
 use crate::integrate::{self, State};
-use crate::tail::Tail;
 use crate::ModelError;
 
 /// Integrates `seg` from the state `y` (derivative `k1`) in equal steps of
@@ -17,7 +16,7 @@ pub(super) fn integrate<F: FnMut(&State) -> State>(
     mut y: State,
     mut k1: State,
     dt: f64,
-) -> Result<(State, Option<Tail>), ModelError> {
+) -> Result<(State, Option<Closed>), ModelError> {
     let (t0, t1) = (seg.t0, seg.t1);
     let n = ((t1 - t0) / dt - 1e-9).ceil().max(1.0) as usize;
     let h = (t1 - t0) / n as f64;
@@ -41,7 +40,7 @@ pub(super) fn integrate<F: FnMut(&State) -> State>(
         rec.out.stats.steps += 1;
         if seg.landed(t, &y, w_before, false, rec.out.stats.steps)? {
             // First order in h here: RK4 is kept for benchmarks.
-            return Ok((y, Some(seg.pivot_tail_from(t, &y))));
+            return Ok((y, Some(Closed::Tail(seg.pivot_tail_from(t, &y)))));
         }
         if let Some(tail) = seg.tail_after_step(t, &y) {
             return Ok((y, Some(tail)));

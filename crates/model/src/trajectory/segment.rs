@@ -7,7 +7,8 @@ use super::sampling::{pose_sample, sample_tail, Sampler};
 use super::Trajectory;
 use crate::dynamic::SegmentDynamics;
 use crate::integrate::State;
-use crate::tail::{SettleRule, Tail};
+use crate::tail::ends::EndSeries;
+use crate::tail::{SettleRule, Tail, TailPose};
 use crate::{ModelError, Problem, Rotor, Vec2};
 
 /// What a run has produced so far: the trajectory (samples, segments,
@@ -18,6 +19,9 @@ pub(super) struct Recorder<'p> {
     pub(super) checker: Checker<'p>,
     /// Serves `R(θ)` for the samples.
     rotor: Rotor,
+    /// Only the run's end is asked for: settling segments end by the series
+    /// in `δ` ([`EndSeries`]) instead of the sampled tail.
+    pub(super) ends_only: bool,
     /// The contact point in the object frame (m).
     pc: Vec2,
 }
@@ -45,6 +49,7 @@ impl<'p> Recorder<'p> {
             checker: Checker::new(problem, check_assumptions),
             rotor: Rotor::new(),
             pc: problem.body.contact(),
+            ends_only: false,
         }
     }
 
@@ -70,6 +75,15 @@ impl<'p> Recorder<'p> {
                 .push(pose_sample(&mut self.rotor, ts, c, theta, omega, &self.pc));
             self.checker.sample(&seg.dynamics, omega, ts, seg.index);
             self.sampler.next += 1;
+        }
+    }
+
+    /// The contact point, θ and ω at the end of `seg` from the closed form
+    /// `closed`, sampling it on the way if it is a tail.
+    pub(super) fn finish_closed(&mut self, seg: &SegmentRun, closed: Closed) -> (Vec2, f64, f64) {
+        match closed {
+            Closed::Tail(tail) => self.samples_of_tail(seg, tail),
+            Closed::End { pose, .. } => (pose.c, pose.theta, pose.omega),
         }
     }
 
@@ -102,6 +116,27 @@ pub(super) fn pose_of(y: &State) -> (Vec2, f64, f64) {
     (Vec2::new(y[2], y[3]), y[0], y[1])
 }
 
+/// Where a segment goes on in closed form: a tail to sample (the series in
+/// `E`, or an arc), or, where nothing is sampled, its end state alone.
+pub(super) enum Closed {
+    Tail(Tail),
+    /// The segment's end state from the series in `δ` taken at `t` (s).
+    End {
+        t: f64,
+        pose: TailPose,
+    },
+}
+
+impl Closed {
+    /// When the closed form takes over (s).
+    pub(super) fn start(&self) -> f64 {
+        match self {
+            Closed::Tail(tail) => tail.t,
+            Closed::End { t, .. } => *t,
+        }
+    }
+}
+
 /// One push segment as the integrators see it: its dynamics, its span, and
 /// where its motion leaves the integrator for a closed form.
 pub(super) struct SegmentRun {
@@ -120,6 +155,9 @@ pub(super) struct SegmentRun {
     pub(super) tol: f64,
     /// The hand-over to the series tail, toward a stable root.
     pub(super) settle: Option<SettleRule>,
+    /// The end in closed form toward a stable root, for a run that takes
+    /// no sample (then `settle` is None).
+    pub(super) ends: Option<EndSeries>,
     /// ω at a stable pivot ω tends to (rad/s).
     pub(super) pivot: Option<f64>,
     /// |ω| beyond which the run is a runaway (rad/s).
@@ -127,12 +165,25 @@ pub(super) struct SegmentRun {
 }
 
 impl SegmentRun {
-    /// The series tail from time `t` (s) at contact point `c`, angle `theta`
-    /// and ω = `w`, if it holds from there.
-    pub(super) fn try_tail(&self, t: f64, c: Vec2, theta: f64, w: f64) -> Option<Tail> {
+    /// The stable root the segment's closed forms tend to (rad/s).
+    pub(super) fn root(&self) -> Option<f64> {
+        self.settle.map(|r| r.omega).or(self.ends.map(|e| e.omega))
+    }
+
+    /// The closed form from time `t` (s) at contact point `c`, angle `theta`
+    /// and ω = `w`, if it holds from there: the segment's end state alone
+    /// where nothing is sampled, the series tail otherwise.
+    pub(super) fn try_tail(&self, t: f64, c: Vec2, theta: f64, w: f64) -> Option<Closed> {
+        if let Some(e) = &self.ends {
+            let g_w = self.dynamics.omega_dot(w);
+            return e
+                .end(self.t1 - t, c, theta, w, g_w, self.vel, self.tol)
+                .map(|pose| Closed::End { t, pose });
+        }
         self.settle
             .as_ref()
             .and_then(|r| r.tail(&self.dynamics, t, c, theta, w, self.vel, self.t1 - t))
+            .map(Closed::Tail)
     }
 
     /// Whether ω has reached the pivot (or crossed it) going from `w0` to `w1`.
@@ -151,9 +202,9 @@ impl SegmentRun {
     /// Where the segment goes on from its start at contact point `c`, angle
     /// `theta` and ω = `omega`: the pivot's arc or the series tail, if either
     /// holds there.
-    pub(super) fn closed_form_at_start(&self, c: Vec2, theta: f64, omega: f64) -> Option<Tail> {
+    pub(super) fn closed_form_at_start(&self, c: Vec2, theta: f64, omega: f64) -> Option<Closed> {
         if self.pivot_reached(omega, omega) {
-            Some(self.pivot_tail(self.t0, c, theta))
+            Some(Closed::Tail(self.pivot_tail(self.t0, c, theta)))
         } else {
             self.try_tail(self.t0, c, theta, omega)
         }
@@ -198,7 +249,7 @@ impl SegmentRun {
 
     /// The series tail from the state `y` at `t` (s), inside the segment.
     #[inline]
-    pub(super) fn tail_after_step(&self, t: f64, y: &State) -> Option<Tail> {
+    pub(super) fn tail_after_step(&self, t: f64, y: &State) -> Option<Closed> {
         if t < self.t1 {
             let (c, theta, w) = pose_of(y);
             self.try_tail(t, c, theta, w)
