@@ -94,8 +94,9 @@ impl EndSeries {
         let tau = -1.0 / g[1];
         // Three recurrences, one term of each per n, so the processor
         // overlaps their serial chains; each sum in four partial sums over
-        // arrays padded with P zeros in front (a chunk of four may run past
-        // the first term):
+        // arrays padded with zeros (a chunk of four may run past the first
+        // term), the terms read backwards also kept in reverse (`rr[N − k]
+        // = r_k`, the same for G) so both factors run forwards in memory:
         //   r Σ g_{j+1} δ^j = 1:  r_0 = −τ, r_n = τ Σ_{j=1..n} g_{j+1} r_{n−j};
         //   G = e^{iΦ}:           G_0 = 1,  m G_m = i Σ_{k=1..m} k Φ_k G_{m−k},
         //                         with n Φ_n = ω* r_n + r_{n−1};
@@ -109,6 +110,10 @@ impl EndSeries {
         let (mut gre, mut gim) = ([0.0; L], [0.0; L]);
         r[P] = -tau;
         gre[P] = 1.0;
+        const R: usize = N + 2 * P;
+        let (mut rr, mut grr, mut gir) = ([0.0; R], [0.0; R], [0.0; R]);
+        rr[N] = -tau;
+        grr[N] = 1.0;
         let mut phi = [0.0; N];
         let mut f = [C::new(0.0, 0.0); N];
         f[0] = C::new(-tau, 0.0);
@@ -123,32 +128,34 @@ impl EndSeries {
             for c in 0..chunks {
                 for (l, a) in acc.iter_mut().enumerate() {
                     let j = 1 + 4 * c + l;
-                    *a += gp[j + 1] * r[P + n - j];
+                    *a += gp[j + 1] * rr[N - n + j];
                 }
             }
             r[P + n] = tau * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
+            rr[N - n] = r[P + n];
             kphi[P + n] = omega * r[P + n] + r[P + n - 1];
             phi[n] = kphi[P + n] * INV[n];
-            // G_n: k = 1 + 4c + l against G_{n−k}.
+            // G_n: k = 1 + 4c + l against G_{n−k} (k Φ_k is still zero for
+            // k > n, as the padding is).
             let (mut are, mut aim) = ([0.0; 4], [0.0; 4]);
             for c in 0..chunks {
                 for l in 0..4 {
                     let k = 1 + 4 * c + l;
-                    let kp = if k <= n { kphi[P + k] } else { 0.0 };
-                    are[l] += kp * gre[P + n - k];
-                    aim[l] += kp * gim[P + n - k];
+                    are[l] += kphi[P + k] * grr[N - n + k];
+                    aim[l] += kphi[P + k] * gir[N - n + k];
                 }
             }
             let sre = (are[0] + are[1]) + (are[2] + are[3]);
             let sim = (aim[0] + aim[1]) + (aim[2] + aim[3]);
             gre[P + n] = -sim * INV[n];
             gim[P + n] = sre * INV[n];
+            (grr[N - n], gir[N - n]) = (gre[P + n], gim[P + n]);
             // F_n: j = 4c + l against r_{n−j}.
             let (mut fre, mut fim) = ([0.0; 4], [0.0; 4]);
             for c in 0..(n + 1).div_ceil(4) {
                 for l in 0..4 {
                     let j = 4 * c + l;
-                    let rv = r[P + n - j];
+                    let rv = rr[N - n + j];
                     fre[l] += gre[P + j] * rv;
                     fim[l] += gim[P + j] * rv;
                 }
