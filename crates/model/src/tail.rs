@@ -69,12 +69,16 @@ const DROP_FLOOR: f64 = 1e-18;
 /// Terms kept of the series in `E`.
 pub(crate) const ORDER: usize = 20;
 
-/// `1/m` for `m = 0 ..= ORDER` (`INV[0]` unused): the same values as the
+/// The longest series of this module: the series in `E` ([`ORDER`] terms)
+/// and those in `δ` ([`ends::N`]).
+const LONGEST: usize = if ends::N > ORDER { ends::N } else { ORDER };
+
+/// `1/m` for `m = 0 ..= LONGEST` (`INV[0]` unused): the same values as the
 /// divisions, taken from a table so none sits in a recurrence.
-const INV: [f64; ORDER + 1] = {
-    let mut t = [0.0; ORDER + 1];
+const INV: [f64; LONGEST + 1] = {
+    let mut t = [0.0; LONGEST + 1];
     let mut m = 1;
-    while m <= ORDER {
+    while m <= LONGEST {
         t[m] = 1.0 / m as f64;
         m += 1;
     }

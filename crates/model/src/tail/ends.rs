@@ -33,25 +33,13 @@
 
 use nalgebra::Complex;
 
-use super::{TailPose, SETTLE_FRACTION};
+use super::{TailPose, INV, SETTLE_FRACTION};
 use crate::{dynamic::SegmentDynamics, Vec2};
 
 type C = Complex<f64>;
 
 /// Terms kept of each series in `δ` (powers `0 … N − 1`).
 pub(crate) const N: usize = 24;
-
-/// `1/n` for `n = 0 … N` (`INV[0]` unused), a table so no division sits in
-/// a recurrence.
-const INV: [f64; N + 1] = {
-    let mut t = [0.0; N + 1];
-    let mut n = 1;
-    while n <= N {
-        t[n] = 1.0 / n as f64;
-        n += 1;
-    }
-    t
-};
 
 /// The series of one segment's dynamics about one stable root, for
 /// `δ₀ = 1` (module docs): `r_n`, `Φ_n` and `F_n`.

@@ -160,7 +160,9 @@ impl DynamicModel {
                 let reach = (omega - ws).abs();
                 let fresh = || EndSeries::new(&dynamics, ws, reach, push.speed, t1 - t0, tol);
                 let ends: Option<EndSeries> = match cached {
-                    Some((i, c)) => c.memo(i, ws, [reach, push.speed, t1 - t0, tol], fresh),
+                    Some((i, c)) => {
+                        c.memo(i, ws, |s| s.cut(reach, push.speed, t1 - t0, tol), fresh)
+                    }
                     None => fresh(),
                 };
                 (None, ends)

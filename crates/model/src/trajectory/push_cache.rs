@@ -117,8 +117,8 @@ impl PushCache {
     }
 
     /// The series in `δ` of entry `i` about the root `omega`, cut as
-    /// `fresh()` would cut it ([`EndSeries::cut`] with `cut`'s reach, speed,
-    /// span and tolerance): from the terms kept, or `fresh()` kept instead
+    /// `fresh()` would cut it (`cut`, an [`EndSeries::cut`] with `fresh`'s
+    /// reach, speed, span and tolerance): from the terms kept, or `fresh()` kept instead
     /// when they do not reach that far (the terms are the same, only the
     /// number computed differs). So a call gets the same series, to the
     /// bit, whatever the cache held.
@@ -126,7 +126,7 @@ impl PushCache {
         &mut self,
         i: usize,
         omega: f64,
-        cut: [f64; 4],
+        cut: impl FnOnce(&EndSeries) -> Option<EndSeries>,
         fresh: impl FnOnce() -> Option<EndSeries>,
     ) -> Option<EndSeries> {
         let e = &mut self.entries[i];
@@ -134,7 +134,7 @@ impl PushCache {
             match e.memo {
                 Some(None) => return None,
                 Some(Some(s)) => {
-                    if let Some(s) = s.cut(cut[0], cut[1], cut[2], cut[3]) {
+                    if let Some(s) = cut(&s) {
                         return Some(s);
                     }
                 }

@@ -167,7 +167,10 @@ pub(super) struct SegmentRun {
 impl SegmentRun {
     /// The stable root the segment's closed forms tend to (rad/s).
     pub(super) fn root(&self) -> Option<f64> {
-        self.settle.map(|r| r.omega).or(self.ends.map(|e| e.omega))
+        self.settle
+            .as_ref()
+            .map(|r| r.omega)
+            .or_else(|| self.ends.as_ref().map(|e| e.omega))
     }
 
     /// The closed form from time `t` (s) at contact point `c`, angle `theta`
