@@ -110,29 +110,44 @@ impl EndSeries {
         // reach^n, for the stopping test.
         let mut reach_n = 1.0;
         for n in 1..N {
-            // Whole chunks of four past the n terms (the padding is zero).
-            let m = 4 * n.div_ceil(4);
-            // r_n: j = 1 + 4c + l against r_{n−j} (`rr[N − n + j]`).
-            let acc = dot4(&gp[2..2 + m], &rr[N - n + 1..N - n + 1 + m]);
+            let chunks = n.div_ceil(4);
+            // r_n: j = 1 + 4c + l against r_{n−j} at P + n − j.
+            let mut acc = [0.0; 4];
+            for c in 0..chunks {
+                for (l, a) in acc.iter_mut().enumerate() {
+                    let j = 1 + 4 * c + l;
+                    *a += gp[j + 1] * rr[N - n + j];
+                }
+            }
             r[P + n] = tau * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
             rr[N - n] = r[P + n];
             kphi[P + n] = omega * r[P + n] + r[P + n - 1];
             phi[n] = kphi[P + n] * INV[n];
             // G_n: k = 1 + 4c + l against G_{n−k} (k Φ_k is still zero for
             // k > n, as the padding is).
-            let kp = &kphi[P + 1..P + 1 + m];
-            let are = dot4(kp, &grr[N - n + 1..N - n + 1 + m]);
-            let aim = dot4(kp, &gir[N - n + 1..N - n + 1 + m]);
+            let (mut are, mut aim) = ([0.0; 4], [0.0; 4]);
+            for c in 0..chunks {
+                for l in 0..4 {
+                    let k = 1 + 4 * c + l;
+                    are[l] += kphi[P + k] * grr[N - n + k];
+                    aim[l] += kphi[P + k] * gir[N - n + k];
+                }
+            }
             let sre = (are[0] + are[1]) + (are[2] + are[3]);
             let sim = (aim[0] + aim[1]) + (aim[2] + aim[3]);
             gre[P + n] = -sim * INV[n];
             gim[P + n] = sre * INV[n];
             (grr[N - n], gir[N - n]) = (gre[P + n], gim[P + n]);
             // F_n: j = 4c + l against r_{n−j}.
-            let m1 = 4 * (n + 1).div_ceil(4);
-            let rv = &rr[N - n..N - n + m1];
-            let fre = dot4(&gre[P..P + m1], rv);
-            let fim = dot4(&gim[P..P + m1], rv);
+            let (mut fre, mut fim) = ([0.0; 4], [0.0; 4]);
+            for c in 0..(n + 1).div_ceil(4) {
+                for l in 0..4 {
+                    let j = 4 * c + l;
+                    let rv = rr[N - n + j];
+                    fre[l] += gre[P + j] * rv;
+                    fim[l] += gim[P + j] * rv;
+                }
+            }
             f[n] = C::new(
                 (fre[0] + fre[1]) + (fre[2] + fre[3]),
                 (fim[0] + fim[1]) + (fim[2] + fim[3]),
@@ -303,27 +318,6 @@ fn budget(d: f64, omega: f64, tau: f64, speed: f64, span: f64, tol: f64) -> f64 
     (allowed / (turn * (speed * span).max(1.0)))
         .min(allowed / speed)
         .min(allowed * (1.0 + omega.abs()) * tau / d)
-}
-
-/// Four partial sums of `a · b`, lane `l` taking the products at `l`,
-/// `l + 4`, `l + 8`, … in that order (`a` and `b` of one length, a multiple
-/// of four): the sums of the recurrences in [`EndSeries::new`], over
-/// slices so that the compiler sees the bounds once and keeps the lanes in
-/// vector registers.
-#[inline(always)]
-fn dot4(a: &[f64], b: &[f64]) -> [f64; 4] {
-    let mut acc = [0.0; 4];
-    let len = a.len().min(b.len());
-    let mut i = 0;
-    while i + 4 <= len {
-        let x: &[f64; 4] = a[i..i + 4].try_into().unwrap();
-        let y: &[f64; 4] = b[i..i + 4].try_into().unwrap();
-        for l in 0..4 {
-            acc[l] += x[l] * y[l];
-        }
-        i += 4;
-    }
-    acc
 }
 
 /// `|re| + |im|`, a bound on `|z|` within √2 of it and without `hypot`.
