@@ -23,9 +23,17 @@
 //! c(T) = c_s + V e^{i(θ_s − Φ(1))} Σ_n F̃_n (x_T^{n − iμ} − 1)/(n − iμ)
 //! ```
 //!
-//! Every series is `δ₀^n` times one of the root's own (`r_n`, `Φ_n`, `F_n`
-//! for `δ₀ = 1`), so [`EndSeries`] holds those per push and root and an end
-//! costs `O(N)` plus the Newton steps. The series hold where `|δ₀|` is
+//! `F` needs no series of `e^{iΦ}` of its own: `δΦ' = (ω* + δ) r + μ`, so
+//! `δG' = i(ω* + δ) F + iμ G` for `G = e^{iΦ}`, which ties `G_n` to `F_n`
+//! and `F_{n−1}`, and put into `F_n = Σ G_j r_{n−j}` it leaves one
+//! convolution a term (`EndSeries::new`). The sum's weights are kept as
+//! `H_n = F_n/(n − iμ)`, so the end is `e^{iy} P(x_T) − P(1)` with
+//! `P = Σ_{n≥1} H̃_n x^n` and `y = −μ ln x_T`, a Horner sum.
+//!
+//! Every series is `δ₀^n` times one of the root's own (`r_n`, `H_n` for
+//! `δ₀ = 1`; `Φ(1) = ω* R(1) + Λ(1)` is a sum of `r_n`), so [`EndSeries`]
+//! holds those per push and root and an end costs `O(N)` (Horner sums in
+//! `δ₀ x`) plus the Newton steps. The series hold where `|δ₀|` is
 //! inside their radius (the nearest complex singularity of `1/g`: another
 //! root, or a support whose sliding velocity would vanish); [`EndSeries::end`]
 //! checks the last terms and `r̃(1)` against `δ₀/g(ω₀)` itself before it
@@ -42,7 +50,9 @@ type C = Complex<f64>;
 pub(crate) const N: usize = 24;
 
 /// The series of one segment's dynamics about one stable root, for
-/// `δ₀ = 1` (module docs): `r_n`, `Φ_n` and `F_n`.
+/// `δ₀ = 1` (module docs): `r_n`, and `F_n` as `H_n = F_n/(n − iμ)`, the
+/// weight of `x^{n − iμ} − 1` in the contact point's sum (`Φ(1)` is
+/// `ω* R(1) + Λ(1)`, sums of `r_n` too).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct EndSeries {
     /// ω* (rad/s).
@@ -53,10 +63,9 @@ pub(crate) struct EndSeries {
     len: usize,
     /// `r_n` (s per (rad/s)^n).
     r: [f64; N],
-    /// `Φ_n` (rad per (rad/s)^n; `Φ_0 = 0`).
-    phi: [f64; N],
-    /// `F_n` (s per (rad/s)^n).
-    f: [C; N],
+    /// `H_n = F_n/(n − iμ)` for `n ≥ 1` (s per (rad/s)^n; `H_0` unused:
+    /// `F_0 = −τ`).
+    h: [C; N],
 }
 
 impl EndSeries {
@@ -80,31 +89,35 @@ impl EndSeries {
             return None;
         }
         let tau = -1.0 / g[1];
-        // Three recurrences, one term of each per n, so the processor
+        // Two recurrences, one term of each per n, so the processor
         // overlaps their serial chains; each sum in four partial sums over
-        // arrays padded with zeros (a chunk of four may run past the first
-        // term), the terms read backwards also kept in reverse (`rr[N − k]
-        // = r_k`, the same for G) so both factors run forwards in memory:
+        // arrays padded with zeros (a chunk of four may run past the last
+        // term), the terms of r also kept in reverse (`rr[N − k] = r_k`) so
+        // both factors run forwards in memory:
         //   r Σ g_{j+1} δ^j = 1:  r_0 = −τ, r_n = τ Σ_{j=1..n} g_{j+1} r_{n−j};
-        //   G = e^{iΦ}:           G_0 = 1,  m G_m = i Σ_{k=1..m} k Φ_k G_{m−k},
-        //                         with n Φ_n = ω* r_n + r_{n−1};
-        //   F = G r:              F_n = Σ_{j=0..n} G_j r_{n−j}.
+        //   F = G r, G = e^{iΦ}:  with n Φ_n = ω* r_n + r_{n−1}, δΦ' =
+        //                         (ω* + δ) r + μ, so δG' = i(ω* + δ) F + iμ G:
+        //                         (n − iμ) G_n = i (ω* F_n + F_{n−1}). Put in
+        //                         F_n = Σ_{j=0..n} G_j r_{n−j} (G_0 = 1, r_0 = −τ):
+        //                         F_n = ((n − iμ) A_n − iτ F_{n−1})/n with
+        //                         A_n = r_n + Σ_{j=1..n−1} G_j r_{n−j}.
+        // So `F` costs one convolution of complex by real a term, where the
+        // exponential's own recurrence (`m G_m = i Σ k Φ_k G_{m−k}`) and
+        // the product `G r` took two; `F_{n−1}`'s weight `τ/n` shrinks, so
+        // rounding does not grow along n.
         const P: usize = 4;
         const L: usize = N + 2 * P;
         let mut gp = [0.0; L];
         gp[..N + 1].copy_from_slice(&g);
         let mut r = [0.0; L];
-        let mut kphi = [0.0; L];
         let (mut gre, mut gim) = ([0.0; L], [0.0; L]);
         r[P] = -tau;
-        gre[P] = 1.0;
         const R: usize = N + 2 * P;
-        let (mut rr, mut grr, mut gir) = ([0.0; R], [0.0; R], [0.0; R]);
+        let mut rr = [0.0; R];
         rr[N] = -tau;
-        grr[N] = 1.0;
-        let mut phi = [0.0; N];
-        let mut f = [C::new(0.0, 0.0); N];
-        f[0] = C::new(-tau, 0.0);
+        let mu = omega * tau;
+        let mut h = [C::new(0.0, 0.0); N];
+        let mut prev = C::new(-tau, 0.0);
         let budget = budget(reach, omega, tau, speed, span, tol);
         let mut len = N;
         // reach^n, for the stopping test.
@@ -119,46 +132,41 @@ impl EndSeries {
                     *a += gp[j + 1] * rr[N - n + j];
                 }
             }
-            r[P + n] = tau * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
-            rr[N - n] = r[P + n];
-            kphi[P + n] = omega * r[P + n] + r[P + n - 1];
-            phi[n] = kphi[P + n] * INV[n];
-            // G_n: k = 1 + 4c + l against G_{n−k} (k Φ_k is still zero for
-            // k > n, as the padding is).
+            let rn = tau * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
+            // A_n − r_n: j = 1 + 4c + l against r_{n−j} (G_j is still zero
+            // for j ≥ n, as the padding is).
             let (mut are, mut aim) = ([0.0; 4], [0.0; 4]);
             for c in 0..chunks {
                 for l in 0..4 {
-                    let k = 1 + 4 * c + l;
-                    are[l] += kphi[P + k] * grr[N - n + k];
-                    aim[l] += kphi[P + k] * gir[N - n + k];
-                }
-            }
-            let sre = (are[0] + are[1]) + (are[2] + are[3]);
-            let sim = (aim[0] + aim[1]) + (aim[2] + aim[3]);
-            gre[P + n] = -sim * INV[n];
-            gim[P + n] = sre * INV[n];
-            (grr[N - n], gir[N - n]) = (gre[P + n], gim[P + n]);
-            // F_n: j = 4c + l against r_{n−j}.
-            let (mut fre, mut fim) = ([0.0; 4], [0.0; 4]);
-            for c in 0..(n + 1).div_ceil(4) {
-                for l in 0..4 {
-                    let j = 4 * c + l;
+                    let j = 1 + 4 * c + l;
                     let rv = rr[N - n + j];
-                    fre[l] += gre[P + j] * rv;
-                    fim[l] += gim[P + j] * rv;
+                    are[l] += gre[P + j] * rv;
+                    aim[l] += gim[P + j] * rv;
                 }
             }
-            f[n] = C::new(
-                (fre[0] + fre[1]) + (fre[2] + fre[3]),
-                (fim[0] + fim[1]) + (fim[2] + fim[3]),
+            let a_re = rn + ((are[0] + are[1]) + (are[2] + are[3]));
+            let a_im = (aim[0] + aim[1]) + (aim[2] + aim[3]);
+            (r[P + n], rr[N - n]) = (rn, rn);
+            let nf = n as f64;
+            let fnew = C::new(
+                (nf * a_re + mu * a_im + tau * prev.im) * INV[n],
+                (nf * a_im - mu * a_re - tau * prev.re) * INV[n],
             );
+            // G_n = i (ω* F_n + F_{n−1}) (n + iμ)/(n² + μ²), and
+            // H_n = F_n (n + iμ)/(n² + μ²).
+            let q = 1.0 / (nf * nf + mu * mu);
+            let b = fnew * omega + prev;
+            gre[P + n] = -(b.re * mu + b.im * nf) * q;
+            gim[P + n] = (b.re * nf - b.im * mu) * q;
+            h[n] = fnew * C::new(nf * q, mu * q);
             let reach_prev = reach_n;
             reach_n *= reach;
             let last = [r[P + n - 1], r[P + n]];
-            if stops(n, last, [f[n - 1], f[n]], [reach_prev, reach_n], budget) {
+            if stops(n, last, [prev, fnew], [reach_prev, reach_n], budget) {
                 len = n + 1;
                 break;
             }
+            prev = fnew;
         }
         let r: [f64; N] = std::array::from_fn(|n| r[P + n]);
         Some(Self {
@@ -166,9 +174,17 @@ impl EndSeries {
             tau,
             len,
             r,
-            phi,
-            f,
+            h,
         })
+    }
+
+    /// `F_n` (s per (rad/s)^n), from `H_n`.
+    fn f(&self, n: usize) -> C {
+        if n == 0 {
+            C::new(-self.tau, 0.0)
+        } else {
+            self.h[n] * C::new(n as f64, -self.omega * self.tau)
+        }
     }
 
     /// The state `span` (s) after contact point `c`, angle `theta` and ω =
@@ -191,23 +207,28 @@ impl EndSeries {
         if !d0.is_finite() || span < 0.0 {
             return None;
         }
-        // The scaled series r̃_n = r_n δ₀^n, F̃_n, Φ̃_n.
+        // Every sum is a polynomial in `X = δ₀ x` of the unscaled terms
+        // (`r̃_n x^n = r_n X^n`), by Horner: first at `x = 1`.
         let len = self.len;
-        let mut r = [0.0; N];
-        let mut f = [C::new(0.0, 0.0); N];
-        let mut dn = 1.0;
-        let (mut r1, mut phi1) = (0.0, 0.0);
-        for n in 0..len {
-            r[n] = self.r[n] * dn;
-            f[n] = self.f[n] * dn;
-            r1 += r[n];
-            phi1 += self.phi[n] * dn;
-            dn *= d0;
+        let (r, h) = (&self.r, &self.h);
+        let mu = ws * tau;
+        // r̃(1); R(1) = Σ r̃_n/n; Λ(1) = δ₀ Σ r̃_{n−1}/n (to n = len); the
+        // contact point's P(1) = Σ_{n≥1} H̃_n.
+        let (mut r1, mut big_r1, mut lam1) = (0.0, 0.0, r[len - 1] * INV[len] * d0);
+        let mut p_one = C::new(0.0, 0.0);
+        for n in (1..len).rev() {
+            r1 = (r1 + r[n]) * d0;
+            big_r1 = (big_r1 + r[n] * INV[n]) * d0;
+            lam1 = (lam1 + r[n - 1] * INV[n]) * d0;
+            p_one = (p_one + h[n]) * d0;
         }
+        r1 += r[0];
         // What the series leave out, and r̃(1) against δ₀/g(ω₀) (s): the
         // first shows a series still converging, the second one taken
         // beyond its radius.
-        let cut = (r[len - 2].abs() + r[len - 1].abs()).max(l1(f[len - 2]) + l1(f[len - 1]));
+        let dl = d0.powi(len as i32 - 2);
+        let cut = ((r[len - 2].abs() + r[len - 1].abs() * d0.abs()) * dl.abs())
+            .max((l1(self.f(len - 2)) + l1(self.f(len - 1)) * d0.abs()) * dl.abs());
         let residual = if d0 == 0.0 {
             0.0
         } else {
@@ -218,15 +239,14 @@ impl EndSeries {
         }
         // u = ln x at the end: t(x) = span by Newton from the linear flow's
         // u = −span/τ (dt/du = r̃(x) < 0 where the series hold).
-        let rk: [f64; N] = std::array::from_fn(|n| r[n] * INV[n.max(1)]);
-        let big_r1: f64 = rk[1..].iter().sum();
         let mut u = -span / tau;
         let mut x = u.exp();
         for it in 0.. {
+            let xd = x * d0;
             let (mut p1, mut p2) = (0.0, 0.0);
             for n in (1..len).rev() {
-                p1 = (p1 + rk[n]) * x;
-                p2 = (p2 + r[n]) * x;
+                p1 = (p1 + r[n] * INV[n]) * xd;
+                p2 = (p2 + r[n]) * xd;
             }
             let dt_du = p2 + r[0];
             if !(dt_du < 0.0) || it == 40 {
@@ -242,29 +262,28 @@ impl EndSeries {
                 break;
             }
         }
-        // ε = δ₀ Σ r̃_n (x^{n+1} − 1)/(n + 1), and the contact point's sum.
-        let mu = ws * tau;
+        // ε = Λ(x) − Λ(1), and the contact point's sum
+        // F̃_0 (x^{−iμ} − 1)/(−iμ) + Σ_{n≥1} H̃_n (x^{n − iμ} − 1)
+        //   = F̃_0 u (e^{iy} − 1)/(iy) + e^{iy} P(x) − P(1).
         let y = -mu * u;
         let (sy, cy) = y.sin_cos();
         let ey = C::new(cy, sy);
-        // n = 0: F̃_0 (x^{−iμ} − 1)/(−iμ) = F̃_0 u (e^{iy} − 1)/(iy).
         let e1 = if y.abs() < 1e-3 {
             C::new(1.0 - y * y / 6.0, y / 2.0 - y * y * y / 24.0)
         } else {
             C::new(sy / y, (1.0 - cy) / y)
         };
-        let mut sum = f[0] * u * e1;
-        let mut eps = 0.0;
-        let mut xn = x;
-        for n in 1..len {
-            eps += r[n - 1] * (xn - 1.0) * INV[n];
-            let nf = n as f64;
-            let z = C::new(nf, mu) / (nf * nf + mu * mu);
-            sum += f[n] * ((ey * xn - 1.0) * z);
-            xn *= x;
+        let xd = x * d0;
+        let mut lam = r[len - 1] * INV[len] * xd;
+        let mut p_x = C::new(0.0, 0.0);
+        for n in (1..len).rev() {
+            lam = (lam + r[n - 1] * INV[n]) * xd;
+            p_x = (p_x + h[n]) * xd;
         }
-        eps += r[len - 1] * (xn - 1.0) * INV[len];
-        eps *= d0;
+        let sum = C::new(-tau, 0.0) * u * e1 + ey * p_x - p_one;
+        let eps = lam - lam1;
+        // Φ(1) = ω* R(1) + Λ(1).
+        let phi1 = ws * big_r1 + lam1;
         let (s0, c0) = (theta - phi1).sin_cos();
         let dc = C::new(vel.x, vel.y) * C::new(c0, s0) * sum;
         Some(TailPose {
@@ -284,7 +303,7 @@ impl EndSeries {
             let reach_prev = reach_n;
             reach_n *= reach;
             let last = [self.r[n - 1], self.r[n]];
-            let f = [self.f[n - 1], self.f[n]];
+            let f = [self.f(n - 1), self.f(n)];
             if stops(n, last, f, [reach_prev, reach_n], budget) {
                 return Some(Self {
                     len: n + 1,
@@ -324,4 +343,81 @@ fn budget(d: f64, omega: f64, tau: f64, speed: f64, span: f64, tol: f64) -> f64 
 #[inline]
 fn l1(z: C) -> f64 {
     z.re.abs() + z.im.abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Body, Push, Support};
+
+    /// The per_call example's plate: 0.25 m square on its four corners.
+    fn plate() -> Body {
+        let a = 0.125;
+        let sup: Vec<Support> = [(-a, -a), (a, -a), (a, a), (-a, a)]
+            .iter()
+            .map(|&(x, y)| Support {
+                position: Vec2::new(x, y),
+                friction: 0.5 * 9.81 / 4.0,
+            })
+            .collect();
+        Body::new(1.0, 0.25f64.powi(2) / 6.0, Vec2::new(-a, -a), &sup).unwrap()
+    }
+
+    /// `F = e^{iΦ} r` term by term the classical way, from the `r_n` the
+    /// series hold: `n Φ_n = ω* r_n + r_{n−1}`, the exponential's own
+    /// recurrence `m G_m = i Σ_k k Φ_k G_{m−k}`, the product `Σ G_j
+    /// r_{n−j}`. `EndSeries::new` gets `F` by the one-term recurrence
+    /// `F_n = ((n − iμ) A_n − iτ F_{n−1})/n` instead; both must agree to
+    /// rounding, on pushes whose roots spread from ω* < 0 through 0.
+    #[test]
+    fn contact_series_match_the_exponential_of_the_angle_series() {
+        let body = plate();
+        let q = std::f64::consts::FRAC_PI_4;
+        let mut roots = Vec::new();
+        for k in 0..9 {
+            let push = Push {
+                duration: 1.0,
+                speed: 1.0,
+                phi: q - 0.6 + 0.15 * k as f64,
+            };
+            let seg = SegmentDynamics::new(&body, &push);
+            let ws = seg.monotone_root().expect("a root").omega;
+            roots.push(ws);
+            // A reach no series converges at: every term is computed.
+            let e = EndSeries::new(&seg, ws, 1e3, 1.0, 1.0, 1e-9).expect("a series");
+            assert_eq!(e.len, N);
+            let (tau, mu) = (e.tau, ws * e.tau);
+            let r = e.r;
+            let phi: Vec<f64> = (0..N)
+                .map(|n| {
+                    if n == 0 {
+                        0.0
+                    } else {
+                        (ws * r[n] + r[n - 1]) / n as f64
+                    }
+                })
+                .collect();
+            let mut g = vec![C::new(0.0, 0.0); N];
+            g[0] = C::new(1.0, 0.0);
+            for m in 1..N {
+                let s: C = (1..=m).map(|k| g[m - k] * (k as f64 * phi[k])).sum();
+                g[m] = C::new(0.0, 1.0) * s / m as f64;
+            }
+            assert!((r[0] + tau).abs() <= 1e-15 * tau);
+            for n in 1..N {
+                let f: C = (0..=n).map(|j| g[j] * r[n - j]).sum();
+                let h = f / C::new(n as f64, -mu);
+                // Terms fall like ρ^{−n}: compare each with its own size
+                // and with the first terms' (rounding of the sums).
+                let scale = h.norm() + 1e-13 * e.h[1].norm().max(tau);
+                assert!(
+                    (e.h[n] - h).norm() <= 1e-11 * scale,
+                    "push {k}, n = {n}: {} against {h}",
+                    e.h[n]
+                );
+                assert!((e.f(n) - f).norm() <= 1e-11 * (f.norm() + 1e-13 * tau));
+            }
+        }
+        assert!(roots.iter().any(|w| *w < 0.0) && roots.iter().any(|w| *w > 0.0));
+    }
 }
