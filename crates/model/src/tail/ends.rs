@@ -83,12 +83,28 @@ impl EndSeries {
         span: f64,
         tol: f64,
     ) -> Option<Self> {
-        let mut g = [0.0; N + 1];
-        seg.omega_dot_taylor(omega, &mut g);
-        if !(g[1] < 0.0) || g.iter().any(|v| !v.is_finite()) {
+        // The Taylor coefficients of g, `gp[j] = g_j`, each made when the
+        // recurrence first needs it (term n reads up to g_{n+1}) where the
+        // segment has one block of supports; else all at once.
+        const P: usize = 4;
+        const L: usize = N + 2 * P;
+        let mut gp = [0.0; L];
+        let mut stream = seg.omega_dot_series(omega);
+        let made = match &mut stream {
+            Some(s) => {
+                gp[0] = s.next_coefficient();
+                gp[1] = s.next_coefficient();
+                2
+            }
+            None => {
+                seg.omega_dot_taylor(omega, &mut gp[..N + 1]);
+                N + 1
+            }
+        };
+        if !(gp[1] < 0.0) || gp[..made].iter().any(|v| !v.is_finite()) {
             return None;
         }
-        let tau = -1.0 / g[1];
+        let tau = -1.0 / gp[1];
         // Two recurrences, one term of each per n, so the processor
         // overlaps their serial chains; each sum in four partial sums over
         // arrays padded with zeros (a chunk of four may run past the last
@@ -105,10 +121,6 @@ impl EndSeries {
         // exponential's own recurrence (`m G_m = i Σ k Φ_k G_{m−k}`) and
         // the product `G r` took two; `F_{n−1}`'s weight `τ/n` shrinks, so
         // rounding does not grow along n.
-        const P: usize = 4;
-        const L: usize = N + 2 * P;
-        let mut gp = [0.0; L];
-        gp[..N + 1].copy_from_slice(&g);
         let mut r = [0.0; L];
         let (mut gre, mut gim) = ([0.0; L], [0.0; L]);
         r[P] = -tau;
@@ -123,6 +135,13 @@ impl EndSeries {
         // reach^n, for the stopping test.
         let mut reach_n = 1.0;
         for n in 1..N {
+            if let Some(s) = &mut stream {
+                let next = s.next_coefficient();
+                if !next.is_finite() {
+                    return None;
+                }
+                gp[n + 1] = next;
+            }
             let chunks = n.div_ceil(4);
             // r_n: j = 1 + 4c + l against r_{n−j} at P + n − j.
             let mut acc = [0.0; 4];
