@@ -14,7 +14,7 @@ const CAPACITY: usize = 32;
 /// Per push (speed and direction, to the bit) on one body: the steady state
 /// a segment tends to, when that does not depend on where ω starts (the
 /// inertial slope `k < 0`: `G` decreases and has one root), and the series
-/// in `δ` about it (`r_n`, `Φ_n`, `F_n`, which scale with the start's
+/// in `δ` about it (`r_n` and `H_n = F_n/(n − iμ)`, which scale with the start's
 /// `δ₀^n`: a warm segment only sums them). [`DynamicModel::final_state_cached`] with
 /// a cache returns what [`DynamicModel::final_state`] returns, bit for bit;
 /// the cache only spares the work. It forgets everything when the body or
