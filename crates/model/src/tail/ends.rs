@@ -367,37 +367,27 @@ fn l1(z: C) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Body, Push, Support};
-
-    /// The per_call example's plate: 0.25 m square on its four corners.
-    fn plate() -> Body {
-        let a = 0.125;
-        let sup: Vec<Support> = [(-a, -a), (a, -a), (a, a), (-a, a)]
-            .iter()
-            .map(|&(x, y)| Support {
-                position: Vec2::new(x, y),
-                friction: 0.5 * 9.81 / 4.0,
-            })
-            .collect();
-        Body::new(1.0, 0.25f64.powi(2) / 6.0, Vec2::new(-a, -a), &sup).unwrap()
-    }
+    use crate::{Initial, Problem, Push};
 
     /// `F = e^{iΦ} r` term by term the classical way, from the `r_n` the
     /// series hold: `n Φ_n = ω* r_n + r_{n−1}`, the exponential's own
     /// recurrence `m G_m = i Σ_k k Φ_k G_{m−k}`, the product `Σ G_j
     /// r_{n−j}`. `EndSeries::new` gets `F` by the one-term recurrence
     /// `F_n = ((n − iμ) A_n − iτ F_{n−1})/n` instead; both must agree to
-    /// rounding, on pushes whose roots spread from ω* < 0 through 0.
+    /// rounding, on pushes whose roots spread from ω* < 0 through 0 to ω* > 0.
     #[test]
     fn contact_series_match_the_exponential_of_the_angle_series() {
-        let body = plate();
-        let q = std::f64::consts::FRAC_PI_4;
+        // The seed plate, pushed at the middle of its side: φ = 0 turns it
+        // not at all (ω* = 0, μ = 0), ±φ turn it either way.
+        let body = Problem::seed_plate(9.81, vec![], Initial::default())
+            .unwrap()
+            .body;
         let mut roots = Vec::new();
         for k in 0..9 {
             let push = Push {
                 duration: 1.0,
                 speed: 1.0,
-                phi: q - 0.6 + 0.15 * k as f64,
+                phi: -0.6 + 0.15 * k as f64,
             };
             let seg = SegmentDynamics::new(&body, &push);
             let ws = seg.monotone_root().expect("a root").omega;
@@ -438,5 +428,6 @@ mod tests {
             }
         }
         assert!(roots.iter().any(|w| *w < 0.0) && roots.iter().any(|w| *w > 0.0));
+        assert!(roots.iter().any(|w| w.abs() < 1e-12));
     }
 }
